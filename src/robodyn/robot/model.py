@@ -1,0 +1,241 @@
+"""Immutable robot description: joints, links, drives, friction.
+
+Every numeric field is a SymPy expression: a number, or an expression over the named parameters
+the description declares (``Robot.parameters`` holds their default values). Loaders build these
+objects; algorithms only read them.
+
+Kinematic convention (one for every description format). The frame of link ``i`` is placed in
+the frame of link ``i-1`` (the base frame for ``i = 0``) by::
+
+    T_i(q_i) = pre_i @ motion(axis_i, q_i) @ post_i
+
+where ``pre_i`` and ``post_i`` are constant 4x4 homogeneous transforms and ``motion`` is a rotation
+by ``q_i`` about ``axis_i`` (revolute) or a translation by ``q_i`` along it (prismatic); ``axis_i``
+is a unit 3-vector in the frame reached after ``pre_i``. Standard DH gives ``pre = I``, ``axis = z``,
+``post = Rz(theta0) Tz(d) Tx(a) Rx(alpha)`` (revolute); modified DH gives
+``pre = Rx(alpha) Tx(a) Rz(theta0) Tz(d)``, ``post = I``; a URDF joint gives ``pre = origin``,
+``post = I``. Each link's inertial data is expressed in its own link frame ``i``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any, Literal
+
+import sympy as sp
+
+JointType = Literal["revolute", "prismatic"]
+
+#: The identity transform, shared.
+IDENTITY4 = sp.ImmutableMatrix(sp.eye(4))
+
+
+@dataclass(frozen=True)
+class Drive:
+    """Actuator drive of one joint.
+
+    Attributes
+    ----------
+    gear_ratio : sympy.Expr
+        Motor angle / joint angle (dimensionless; the sign is kept, only its square or absolute
+        value enters the dynamics).
+    rotor_inertia : sympy.Expr
+        Rotor (motor side) inertia about its axis, kg m^2. Reflected to the joint as
+        ``gear_ratio**2 * rotor_inertia``.
+    torque_constant : sympy.Expr
+        Motor torque per ampere, N m / A (used by later identification stages).
+    """
+
+    gear_ratio: sp.Expr = sp.Integer(1)
+    rotor_inertia: sp.Expr = sp.Integer(0)
+    torque_constant: sp.Expr = sp.Integer(1)
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Joint friction, referred to the joint side (loaders reflect motor-side values).
+
+    The friction torque added to the inverse dynamics of joint ``j`` is::
+
+        tau_f = viscous * qd + coulomb_positive * H(qd) - coulomb_negative * H(-qd) + offset
+
+    with ``H`` the Heaviside step (``H(0) = 0``). Both Coulomb levels are non-negative magnitudes.
+
+    Attributes
+    ----------
+    viscous : sympy.Expr
+        N m s / rad (N s / m for prismatic joints).
+    coulomb_positive, coulomb_negative : sympy.Expr
+        Coulomb friction magnitude when moving in the positive / negative direction, N m (N).
+    offset : sympy.Expr
+        Constant torque offset, N m (N).
+    """
+
+    viscous: sp.Expr = sp.Integer(0)
+    coulomb_positive: sp.Expr = sp.Integer(0)
+    coulomb_negative: sp.Expr = sp.Integer(0)
+    offset: sp.Expr = sp.Integer(0)
+
+    @property
+    def is_zero(self) -> bool:
+        """True when every coefficient is exactly zero."""
+        return all(
+            sp.S(v) == 0
+            for v in (self.viscous, self.coulomb_positive, self.coulomb_negative, self.offset)
+        )
+
+
+@dataclass(frozen=True)
+class Link:
+    """Rigid link attached to the child side of a joint.
+
+    Attributes
+    ----------
+    name : str
+    mass : sympy.Expr
+        kg.
+    com : sympy.ImmutableMatrix, shape (3, 1)
+        Centre of mass in the link frame, m.
+    inertia : sympy.ImmutableMatrix, shape (3, 3)
+        Inertia tensor about the centre of mass, in the link frame axes, kg m^2.
+    hydro : Mapping or None
+        Optional per-link hydrodynamic shape data (used by the underwater stage), kept verbatim.
+    """
+
+    name: str
+    mass: sp.Expr
+    com: sp.ImmutableMatrix
+    inertia: sp.ImmutableMatrix
+    hydro: Mapping[str, Any] | None = None
+
+    @property
+    def first_moment(self) -> sp.ImmutableMatrix:
+        """``mass * com``, shape (3, 1), kg m."""
+        return sp.ImmutableMatrix(self.mass * self.com)
+
+    @property
+    def inertia_at_origin(self) -> sp.ImmutableMatrix:
+        """Inertia about the link frame origin (parallel axis theorem), shape (3, 3)."""
+        c = self.com
+        shift = (c.T * c)[0, 0] * sp.eye(3) - c * c.T
+        return sp.ImmutableMatrix(self.inertia + self.mass * shift)
+
+
+@dataclass(frozen=True)
+class Joint:
+    """One actuated joint and the constant transforms around its motion.
+
+    Attributes
+    ----------
+    name : str
+    type : {"revolute", "prismatic"}
+    pre : sympy.ImmutableMatrix, shape (4, 4)
+        Constant transform from the parent link frame to the joint's motion frame.
+    axis : sympy.ImmutableMatrix, shape (3, 1)
+        Unit joint axis in the motion frame.
+    post : sympy.ImmutableMatrix, shape (4, 4)
+        Constant transform from the moved motion frame to the child link frame.
+    lower, upper : sympy.Expr or None
+        Position limits, rad (m).
+    velocity_limit, effort_limit : sympy.Expr or None
+        rad/s (m/s) and N m (N).
+    drive : Drive
+    friction : Friction
+    convention : str
+        How the description placed the joint: "dh", "mdh" or "origin".
+    source_params : Mapping[str, sympy.Expr]
+        The placement numbers as the user gave them (DH a, alpha, d, theta; or xyz/rpy), for display.
+    """
+
+    name: str
+    type: JointType
+    pre: sp.ImmutableMatrix
+    axis: sp.ImmutableMatrix
+    post: sp.ImmutableMatrix
+    lower: sp.Expr | None = None
+    upper: sp.Expr | None = None
+    velocity_limit: sp.Expr | None = None
+    effort_limit: sp.Expr | None = None
+    drive: Drive = field(default_factory=Drive)
+    friction: Friction = field(default_factory=Friction)
+    convention: str = "origin"
+    source_params: Mapping[str, sp.Expr] = field(default_factory=lambda: MappingProxyType({}))
+
+
+@dataclass(frozen=True)
+class Robot:
+    """A serial manipulator: immutable data, built by :func:`robodyn.load`.
+
+    Attributes
+    ----------
+    name : str
+    joints : tuple of Joint, length n
+        Actuated joints from the base outwards (fixed joints are merged at load time).
+    links : tuple of Link, length n
+        ``links[i]`` moves with ``joints[i]``.
+    base : sympy.ImmutableMatrix, shape (4, 4)
+        Pose of the chain's base frame in the world frame.
+    tool : sympy.ImmutableMatrix, shape (4, 4)
+        Pose of the end effector in the last link frame.
+    gravity : sympy.ImmutableMatrix, shape (3, 1)
+        Gravitational acceleration in the world frame, m/s^2.
+    parameters : Mapping[str, float]
+        Default values of the named symbolic parameters the description declares.
+    source : str
+        Where the description came from (file path or ``builtin:NAME``).
+    """
+
+    name: str
+    joints: tuple[Joint, ...]
+    links: tuple[Link, ...]
+    base: sp.ImmutableMatrix = IDENTITY4
+    tool: sp.ImmutableMatrix = IDENTITY4
+    gravity: sp.ImmutableMatrix = sp.ImmutableMatrix([0, 0, sp.Rational(-981, 100)])
+    parameters: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
+    source: str = "<memory>"
+    description_hash: str = ""
+
+    def __post_init__(self) -> None:
+        if len(self.joints) != len(self.links):
+            raise ValueError(
+                f"{self.source}: robot {self.name!r} has {len(self.joints)} joints but "
+                f"{len(self.links)} links; every joint moves exactly one link"
+            )
+        if not isinstance(self.parameters, MappingProxyType):
+            object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
+        if not self.description_hash:
+            digest = hashlib.sha256(_canonical_text(self).encode()).hexdigest()
+            object.__setattr__(self, "description_hash", digest)
+
+    @property
+    def dof(self) -> int:
+        """Number of actuated joints."""
+        return len(self.joints)
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Joint names, base outwards."""
+        return tuple(j.name for j in self.joints)
+
+    @property
+    def symbols(self) -> dict[str, sp.Symbol]:
+        """The SymPy symbols of the named parameters, by name."""
+        return {name: sp.Symbol(name, real=True) for name in self.parameters}
+
+    def defaults(self) -> dict[sp.Symbol, float]:
+        """Substitution map ``{symbol: default value}`` for the named parameters."""
+        return {sp.Symbol(k, real=True): float(v) for k, v in self.parameters.items()}
+
+
+def _canonical_text(robot: Robot) -> str:
+    """A deterministic text of everything that defines the robot (for hashing)."""
+    parts = [robot.name, str(robot.base), str(robot.tool), str(robot.gravity)]
+    parts += [f"{k}={v!r}" for k, v in sorted(robot.parameters.items())]
+    for j, link in zip(robot.joints, robot.links, strict=True):
+        parts += [j.name, j.type, str(j.pre), str(j.axis), str(j.post), str(j.drive),
+                  str(j.friction), str((j.lower, j.upper))]
+        parts += [link.name, str(link.mass), str(link.com), str(link.inertia), str(link.hydro)]
+    return "\n".join(parts)
