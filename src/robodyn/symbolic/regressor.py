@@ -1,0 +1,110 @@
+"""Linear parameterisation ``tau = Y(q, qd, qdd) @ p`` of the full inverse dynamics.
+
+Per joint ``j`` (base outwards) the parameter vector holds 15 entries::
+
+    XXj XYj XZj YYj YZj ZZj   inertia about the link frame origin, link axes (kg m^2)
+    MXj MYj MZj               first moment m c (kg m)
+    Mj                        mass (kg)
+    Iaj                       rotor inertia reflected to the joint, G^2 J_m (kg m^2)
+    Fvj Fcpj Fcnj Foj         viscous, Coulomb (+), Coulomb (-) and offset friction, joint side
+
+The inertial columns come from the Newton-Euler recursion: each parameter's unit wrench on its
+link, propagated inward (the kinematics does not depend on the parameters).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import sympy as sp
+
+from robodyn import spatial as S
+from robodyn.robot.model import Robot
+from robodyn.symbolic.newton_euler import (
+    ZERO3,
+    base_acceleration,
+    chain_geometry,
+    inward,
+    outward,
+)
+from robodyn.symbolic.program import Recorder
+
+INERTIAL_NAMES = ("XX", "XY", "XZ", "YY", "YZ", "ZZ", "MX", "MY", "MZ", "M")
+JOINT_NAMES = ("Ia", "Fv", "Fcp", "Fcn", "Fo")
+PER_JOINT = len(INERTIAL_NAMES) + len(JOINT_NAMES)
+
+_INERTIA_INDEX = {"XX": (0, 0), "XY": (0, 1), "XZ": (0, 2), "YY": (1, 1), "YZ": (1, 2), "ZZ": (2, 2)}
+
+
+def parameter_names(n: int) -> tuple[str, ...]:
+    """Names of the 15 n parameters, in regressor column order."""
+    return tuple(f"{name}{j + 1}" for j in range(n) for name in INERTIAL_NAMES + JOINT_NAMES)
+
+
+def reflected_rotor_inertia(robot: Robot, j: int) -> sp.Expr:
+    """``G^2 J_m`` of joint ``j`` (kg m^2 or kg)."""
+    d = robot.joints[j].drive
+    return d.gear_ratio**2 * d.rotor_inertia
+
+
+def parameter_values(robot: Robot) -> sp.ImmutableMatrix:
+    """The robot's parameter vector (expressions in its named parameters), shape (15 n, 1)."""
+    vals: list[sp.Expr] = []
+    for j, (joint, link) in enumerate(zip(robot.joints, robot.links, strict=True)):
+        jo = link.inertia_at_origin
+        ms = link.first_moment
+        vals += [jo[_INERTIA_INDEX[k]] for k in INERTIAL_NAMES[:6]]
+        vals += [ms[0], ms[1], ms[2], link.mass]
+        fr = joint.friction
+        vals += [reflected_rotor_inertia(robot, j), fr.viscous, fr.coulomb_positive,
+                 fr.coulomb_negative, fr.offset]
+    return sp.ImmutableMatrix(vals)
+
+
+def friction_columns(qd: sp.Expr) -> list[sp.Expr]:
+    """Regressor entries of (Fv, Fcp, Fcn, Fo) for joint velocity ``qd``."""
+    # tau_f = Fv qd + Fcp H(qd) - Fcn H(-qd) + Fo
+    return [qd, sp.Heaviside(qd, 0), -sp.Heaviside(-qd, 0), sp.Integer(1)]
+
+
+def _unit_wrench(name: str, w: sp.ImmutableMatrix, wd: sp.ImmutableMatrix,
+                 a: sp.ImmutableMatrix) -> tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]:
+    """Force and moment about the link origin per unit of one inertial parameter."""
+    if name == "M":
+        # F = a, N = 0
+        return a, ZERO3
+    if name.startswith("M"):
+        e = sp.ImmutableMatrix([1 if name[1] == ax else 0 for ax in "XYZ"])
+        # F = wd x e + w x (w x e), N = e x a
+        return (sp.ImmutableMatrix(S.cross(wd, e) + S.cross(w, S.cross(w, e))),
+                sp.ImmutableMatrix(S.cross(e, a)))
+    r, c = _INERTIA_INDEX[name]
+    basis = sp.zeros(3, 3)
+    basis[r, c] = 1
+    basis[c, r] = 1
+    # N = J wd + w x (J w)
+    return ZERO3, sp.ImmutableMatrix(basis * wd + S.cross(w, basis * w))
+
+
+def regressor(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
+              qdd: Sequence[sp.Symbol], rec: Recorder) -> sp.ImmutableMatrix:
+    """Full inverse-dynamics regressor ``Y``, shape (n, 15 n), in intermediate-variable form."""
+    n = robot.dof
+    geo = chain_geometry(robot, q, rec)
+    mot = outward(geo, qd, qdd, base_acceleration(robot, True), rec)
+    y = sp.zeros(n, PER_JOINT * n)
+    for j in range(n):
+        for k, name in enumerate(INERTIAL_NAMES):
+            wrench = _unit_wrench(name, mot.w[j], mot.wd[j], mot.a[j])
+            if wrench[0] == ZERO3 and wrench[1] == ZERO3:
+                continue
+            wrenches = [None] * n
+            wrenches[j] = wrench
+            taus = inward(geo, wrenches, rec, prefix=f"y{name}{j + 1}_")
+            for i in range(j + 1):
+                y[i, PER_JOINT * j + k] = taus[i]
+        base = PER_JOINT * j + len(INERTIAL_NAMES)
+        y[j, base] = qdd[j]
+        for k, col in enumerate(friction_columns(qd[j])):
+            y[j, base + 1 + k] = col
+    return sp.ImmutableMatrix(y)
