@@ -97,11 +97,28 @@ def chain_geometry(robot: Robot, q: Sequence[sp.Expr], rec: Recorder) -> ChainGe
 
 @dataclass(frozen=True)
 class Motion:
-    """Outward recursion results per link, link-frame components."""
+    """Outward recursion results per link, link-frame components.
+
+    ``u[i]`` is ``[wd]x + [w]x [w]x``: the acceleration of a point fixed in link i at offset r
+    from the frame origin is ``a + u r`` (its entries are recorded lazily: unused ones are pruned).
+    """
 
     w: tuple[sp.ImmutableMatrix, ...]
     wd: tuple[sp.ImmutableMatrix, ...]
     a: tuple[sp.ImmutableMatrix, ...]
+    u: tuple[sp.ImmutableMatrix, ...]
+
+
+def _u_matrix(w: Vec, wd: Vec, rec: Recorder, k: int) -> sp.ImmutableMatrix:
+    """``U = [wd]x + [w]x^2`` with the products of ``w`` as shared intermediates."""
+    wx, wy, wz = w
+    sq = [rec.scalar(wx * wx, f"wxx{k}"), rec.scalar(wy * wy, f"wyy{k}"),
+          rec.scalar(wz * wz, f"wzz{k}")]
+    xy, xz, yz = (rec.scalar(wx * wy, f"wxy{k}"), rec.scalar(wx * wz, f"wxz{k}"),
+                  rec.scalar(wy * wz, f"wyz{k}"))
+    # [w]x^2 = w w^T - |w|^2 I
+    ww = sp.Matrix([[-sq[1] - sq[2], xy, xz], [xy, -sq[0] - sq[2], yz], [xz, yz, -sq[0] - sq[1]]])
+    return rec.matrix(S.skew(wd) + ww, f"U{k}")
 
 
 def base_acceleration(robot: Robot, with_gravity: bool) -> sp.ImmutableMatrix:
@@ -115,13 +132,14 @@ def outward(geo: ChainGeometry, qd: Sequence[sp.Expr], qdd: Sequence[sp.Expr],
             a0: sp.ImmutableMatrix, rec: Recorder) -> Motion:
     """Outward recursion of angular velocity/acceleration and frame-origin acceleration."""
     w_prev, wd_prev, a_prev = ZERO3, ZERO3, a0
-    ws, wds, accs = [], [], []
+    u_prev = sp.ImmutableMatrix(sp.zeros(3, 3))
+    ws, wds, accs, us = [], [], [], []
     for i in range(len(geo.rot)):
         k = i + 1
         rt, z, p, s = geo.rot[i].T, geo.z[i], geo.p[i], geo.s[i]
         # acceleration of the motion-frame origin, fixed in link i-1:
-        # aJ = a_{i-1} + wd_{i-1} x p + w_{i-1} x (w_{i-1} x p)
-        a_j = a_prev + S.cross(wd_prev, p) + S.cross(w_prev, S.cross(w_prev, p))
+        # aJ = a_{i-1} + wd_{i-1} x p + w_{i-1} x (w_{i-1} x p) = a_{i-1} + U_{i-1} p
+        a_j = a_prev + u_prev * p
         # wp = R^T w_{i-1}
         wp = rec.vector(rt * w_prev, f"wp{k}")
         if geo.prismatic[i]:
@@ -131,8 +149,9 @@ def outward(geo: ChainGeometry, qd: Sequence[sp.Expr], qdd: Sequence[sp.Expr],
             w = rec.vector(wp + z * qd[i], f"w{k}")
             # wd_i = R^T wd_{i-1} + (R^T w_{i-1}) x z qd_i + z qdd_i
             wd = rec.vector(rt * wd_prev + S.cross(wp, z * qd[i]) + z * qdd[i], f"wd{k}")
-        # a_i = R^T aJ + wd_i x s + w_i x (w_i x s)
-        acc = rt * rec.vector(a_j, f"aj{k}") + S.cross(wd, s) + S.cross(w, S.cross(w, s))
+        u = _u_matrix(w, wd, rec, k)
+        # a_i = R^T aJ + wd_i x s + w_i x (w_i x s) = R^T aJ + U_i s
+        acc = rt * rec.vector(a_j, f"aj{k}") + u * s
         if geo.prismatic[i]:
             # + 2 w_i x z qd_i + z qdd_i
             acc = acc + 2 * S.cross(w, z * qd[i]) + z * qdd[i]
@@ -140,20 +159,59 @@ def outward(geo: ChainGeometry, qd: Sequence[sp.Expr], qdd: Sequence[sp.Expr],
         ws.append(w)
         wds.append(wd)
         accs.append(a)
-        w_prev, wd_prev, a_prev = w, wd, a
-    return Motion(tuple(ws), tuple(wds), tuple(accs))
+        us.append(u)
+        w_prev, wd_prev, a_prev, u_prev = w, wd, a, u
+    return Motion(tuple(ws), tuple(wds), tuple(accs), tuple(us))
 
 
-def link_wrench(p: LinkInertial, w: Vec, wd: Vec, a: Vec, rec: Recorder,
-                k: int) -> tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]:
-    """Inertial force and moment about the link frame origin, link-frame components."""
+def link_wrench(p: LinkInertial, w: Vec, wd: Vec, a: Vec, u: sp.ImmutableMatrix,
+                rec: Recorder, k: int) -> tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]:
+    """Inertial force and moment about the link frame origin, link-frame components.
+
+    Barycentric form (linear in the parameters)::
+
+        F = m a + U MS,   N = J wd + w x (J w) + MS x a
+
+    or, when the inertia about the centre of mass is sparser (numeric links), the equivalent
+    centre-of-mass form ``F = m (a + U c)``, ``N = I_c wd + w x (I_c w) + c x F``.
+    """
     ms, j = p.first_moment, p.inertia
-    # F = m a + wd x MS + w x (w x MS)
-    f = rec.vector(p.mass * a + S.cross(wd, ms) + S.cross(w, S.cross(w, ms)), f"F{k}")
+    m = p.mass
+    if _com_form_is_cheaper(p):
+        c = ms / m
+        i_c = j - m * ((c.T * c)[0, 0] * sp.eye(3) - c * c.T)
+        i_c = i_c.applyfunc(_clean)
+        # F = m (a + U c)
+        f = rec.vector(m * rec.vector(a + u * c, f"ac{k}"), f"F{k}")
+        jw = rec.vector(i_c * w, f"Jw{k}")
+        # N = I_c wd + w x (I_c w) + c x F
+        n = rec.vector(i_c * wd + S.cross(w, jw) + S.cross(c, f), f"N{k}")
+        return f, n
+    # F = m a + U MS
+    f = rec.vector(m * a + u * ms, f"F{k}")
     jw = rec.vector(j * w, f"Jw{k}")
     # N = J wd + w x (J w) + MS x a
     n = rec.vector(j * wd + S.cross(w, jw) + S.cross(ms, a), f"N{k}")
     return f, n
+
+
+def _clean(e: sp.Expr) -> sp.Expr:
+    """Round off float noise (e.g. 0.13 - 1e-17) in numeric inertia entries."""
+    if e.is_Float:
+        v = float(e)
+        return sp.Integer(0) if abs(v) < 1e-15 else sp.Float(round(v, 14))
+    return e
+
+
+def _com_form_is_cheaper(p: LinkInertial) -> bool:
+    """True when the link is numeric and its COM inertia has fewer non-zeros than ``J``."""
+    if p.mass.free_symbols or p.inertia.free_symbols or p.first_moment.free_symbols:
+        return False
+    if p.mass == 0 or all(v == 0 for v in p.first_moment):
+        return False
+    c = p.first_moment / p.mass
+    i_c = (p.inertia - p.mass * ((c.T * c)[0, 0] * sp.eye(3) - c * c.T)).applyfunc(_clean)
+    return sum(v != 0 for v in i_c) < sum(v != 0 for v in p.inertia)
 
 
 def inward(geo: ChainGeometry, wrenches: Sequence[tuple[Vec, Vec] | None], rec: Recorder,
@@ -207,7 +265,7 @@ def inverse_dynamics(robot: Robot, q: Sequence[sp.Expr], qd: Sequence[sp.Expr],
     inertials = list(inertials) if inertials is not None else description_inertials(robot)
     geo = chain_geometry(robot, q, rec)
     mot = outward(geo, qd, qdd, base_acceleration(robot, with_gravity), rec)
-    wrenches = [link_wrench(p, mot.w[i], mot.wd[i], mot.a[i], rec, i + 1)
+    wrenches = [link_wrench(p, mot.w[i], mot.wd[i], mot.a[i], mot.u[i], rec, i + 1)
                 for i, p in enumerate(inertials)]
     taus = inward(geo, wrenches, rec)
     return sp.ImmutableMatrix([rec.scalar(t, f"tau{i + 1}") for i, t in enumerate(taus)])

@@ -67,7 +67,7 @@ def friction_columns(qd: sp.Expr) -> list[sp.Expr]:
     return [qd, sp.Heaviside(qd, 0), -sp.Heaviside(-qd, 0), sp.Integer(1)]
 
 
-def _unit_wrench(name: str, w: sp.ImmutableMatrix, wd: sp.ImmutableMatrix,
+def _unit_wrench(name: str, w: sp.ImmutableMatrix, wd: sp.ImmutableMatrix, u: sp.ImmutableMatrix,
                  a: sp.ImmutableMatrix) -> tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]:
     """Force and moment about the link origin per unit of one inertial parameter."""
     if name == "M":
@@ -76,7 +76,7 @@ def _unit_wrench(name: str, w: sp.ImmutableMatrix, wd: sp.ImmutableMatrix,
     if name.startswith("M"):
         e = sp.ImmutableMatrix([1 if name[1] == ax else 0 for ax in "XYZ"])
         # F = wd x e + w x (w x e), N = e x a
-        return (sp.ImmutableMatrix(S.cross(wd, e) + S.cross(w, S.cross(w, e))),
+        return (sp.ImmutableMatrix(u * e),
                 sp.ImmutableMatrix(S.cross(e, a)))
     r, c = _INERTIA_INDEX[name]
     basis = sp.zeros(3, 3)
@@ -95,7 +95,7 @@ def regressor(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
     y = sp.zeros(n, PER_JOINT * n)
     for j in range(n):
         for k, name in enumerate(INERTIAL_NAMES):
-            wrench = _unit_wrench(name, mot.w[j], mot.wd[j], mot.a[j])
+            wrench = _unit_wrench(name, mot.w[j], mot.wd[j], mot.u[j], mot.a[j])
             if wrench[0] == ZERO3 and wrench[1] == ZERO3:
                 continue
             wrenches = [None] * n

@@ -1,0 +1,341 @@
+"""Read a serial-chain URDF file into a :class:`~robodyn.robot.model.Robot`.
+
+The file is parsed by the maintained URDF parser `yourdfpy`_ (meshes and scene graphs are not
+loaded); this module only maps its model onto robodyn's convention::
+
+    T_i(q_i) = origin_i @ motion(axis_i, q_i)          (pre = origin, post = I)
+
+URDF joint ``i``'s ``<origin xyz rpy>`` places the joint frame, which is the child link's frame,
+in the parent link's frame; ``<axis>`` is expressed in the joint frame. ``continuous`` joints
+are revolute joints without position limits; ``fixed`` joints are merged by
+:func:`robodyn.robot.chain.assemble` (the child's mass is added to its parent, or carried by the
+ground before the first moving joint; a fixed transform after the last moving joint becomes the
+tool frame). The tool frame is the identity on the last link otherwise.
+
+Only serial chains are read: a link with two or more child joints, ``floating`` and ``planar``
+joints and ``<mimic>`` joints raise :class:`~robodyn.robot.errors.DescriptionError`.
+
+Numbers are kept as the file gives them: each becomes ``sympy.Float(x)`` (full double
+precision), except exact zeros and exact ``+-1``, which become SymPy integers so the symbolic
+equations fold. Inertial data: ``<inertial><origin xyz rpy>`` places the centre-of-mass frame in
+the link frame, and ``<inertia>`` is about the centre of mass in that frame's axes, so the
+link-frame inertia is ``R @ I @ R.T`` with ``R = rpy_to_matrix(rpy)`` and ``com = xyz``. A link
+without ``<inertial>`` has zero mass. ``<dynamics damping friction>`` becomes
+``Friction(viscous=damping, coulomb_positive=friction, coulomb_negative=friction)``.
+
+.. _yourdfpy: https://github.com/clemense/yourdfpy
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import sympy as sp
+import yourdfpy
+from lxml import etree
+
+from robodyn import spatial as S
+from robodyn.robot import placement, validation
+from robodyn.robot.chain import ChainElement, assemble
+from robodyn.robot.errors import DescriptionError
+from robodyn.robot.model import Friction, Link, Robot
+
+__all__ = ["load_urdf", "number"]
+
+_SUPPORTED = ("revolute", "continuous", "prismatic", "fixed")
+_NOT_YET = ("floating", "planar")
+_Z_AXIS = sp.ImmutableMatrix([0, 0, 1])
+
+
+def number(x: float | str, *, where: str) -> sp.Expr:
+    """A URDF number as SymPy: ``Integer`` for exact ``0`` and ``+-1``, else ``Float(x)``.
+
+    Parameters
+    ----------
+    x : float or str
+        The value as read (a string is converted with :func:`float`).
+    where : str
+        File and field used in the error message.
+
+    Returns
+    -------
+    sympy.Expr
+
+    Raises
+    ------
+    DescriptionError
+        If the value is not a finite number.
+    """
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise DescriptionError(f"{where}: expected a number, got {x!r}") from None
+    if not math.isfinite(v):
+        raise DescriptionError(f"{where}: expected a finite number, got {x!r}")
+    if v == 0.0:
+        return sp.Integer(0)
+    if v in (1.0, -1.0):
+        return sp.Integer(int(v))
+    return sp.Float(v)
+
+
+def load_urdf(path: str | Path, *, strict: bool = False) -> Robot:
+    """Load a serial-chain URDF file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.urdf`` file.
+    strict : bool
+        Turn physical-plausibility warnings on links into :class:`DescriptionError`.
+
+    Returns
+    -------
+    Robot
+        Named after ``<robot name>``; ``source`` is ``str(path)``; default gravity
+        ``(0, 0, -9.81)`` m/s^2; no named parameters.
+
+    Raises
+    ------
+    DescriptionError
+        The file is not well-formed XML or not a URDF, a number is missing or not finite, a
+        joint refers to an undefined link, the tree is not a single serial chain (a link with
+        several child joints, several roots, a loop), a joint is ``floating``, ``planar`` or a
+        ``<mimic>`` joint, a moving joint has a zero axis, or there is no moving joint. Every
+        message starts with the file name and names the joint or link at fault.
+    FileNotFoundError
+        If ``path`` does not exist.
+    """
+    path = Path(path)
+    name = str(path)
+    data = path.read_bytes()
+    root = _parse_xml(data, name)
+    try:
+        model = yourdfpy.URDF.load(
+            io.BytesIO(data),
+            load_meshes=False,
+            build_scene_graph=False,
+            build_collision_scene_graph=False,
+            load_collision_meshes=False,
+        ).robot
+    except Exception as exc:  # yourdfpy raises bare KeyError/AttributeError/ValueError
+        reason = f"{type(exc).__name__}: {exc}"
+        raise DescriptionError(f"{name}: not a readable URDF file: {reason}") from None
+
+    joint_xml = {j.get("name"): j for j in root.findall("joint")}
+    link_xml = {lk.get("name"): lk for lk in root.findall("link")}
+    _check_names(model, name)
+    chain = _serial_chain(model, name)
+    bodies: dict[str, Link] = {}
+    for lk in model.links:
+        where = f"{name}: links.{lk.name}"
+        bodies[lk.name] = _link(lk, link_xml[lk.name], where)
+        validation.check_link(bodies[lk.name], where=where, strict=strict, defaults={})
+    elements = [_element(j, joint_xml[j.name], bodies[j.child], name) for j in chain]
+    try:
+        return assemble(model.name, elements, source=name)
+    except ValueError as exc:
+        raise DescriptionError(str(exc)) from None
+
+
+def _parse_xml(data: bytes, name: str) -> Any:
+    """Parse the file strictly (no recovery, no entities, no network); the root element."""
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, remove_blank_text=True)
+    try:
+        root = etree.fromstring(data, parser=parser)
+    except etree.XMLSyntaxError as exc:
+        raise DescriptionError(f"{name}: not a parseable URDF (XML) file: {exc}") from None
+    if root.getroottree().docinfo.internalDTD is not None:
+        raise DescriptionError(
+            f"{name}: DTD and entity declarations are not supported in URDF files"
+        )
+    if root.tag != "robot":
+        raise DescriptionError(
+            f"{name}: not a URDF file: the root element is <{root.tag}>, not <robot>"
+        )
+    if not root.get("name"):
+        raise DescriptionError(f"{name}: the <robot> element has no 'name' attribute")
+    for tag in ("link", "joint"):
+        for k, elem in enumerate(root.findall(tag)):
+            if not elem.get("name"):
+                raise DescriptionError(f"{name}: <{tag}> number {k + 1} has no 'name' attribute")
+    for elem in root.findall("joint"):
+        for role in ("parent", "child"):
+            ref = elem.find(role)
+            if ref is None or not ref.get("link"):
+                raise DescriptionError(
+                    f"{name}: joint {elem.get('name')!r} has no <{role} link=...> element"
+                )
+    return root
+
+
+def _check_names(model: yourdfpy.Robot, name: str) -> None:
+    """Reject duplicate link or joint names and joints that refer to undefined links."""
+    links: dict[str, yourdfpy.Link] = {}
+    for lk in model.links:
+        if lk.name in links:
+            raise DescriptionError(f"{name}: link {lk.name!r} is defined twice")
+        links[lk.name] = lk
+    seen: set[str] = set()
+    for j in model.joints:
+        if j.name in seen:
+            raise DescriptionError(f"{name}: joint {j.name!r} is defined twice")
+        seen.add(j.name)
+        for role, ref in (("parent", j.parent), ("child", j.child)):
+            if ref not in links:
+                raise DescriptionError(
+                    f"{name}: joint {j.name!r}: {role} link {ref!r} is not defined"
+                )
+
+
+def _serial_chain(model: yourdfpy.Robot, name: str) -> list[yourdfpy.Joint]:
+    """The joints from the root link outwards; raises unless the tree is one serial chain."""
+    if not model.joints:
+        raise DescriptionError(
+            f"{name}: robot {model.name!r} has no joints (a serial chain needs at least one)"
+        )
+    for j in model.joints:
+        if j.type in _NOT_YET:
+            raise DescriptionError(
+                f"{name}: joint {j.name!r}: joint type {j.type!r} is not supported yet "
+                f"(supported: {', '.join(_SUPPORTED)})"
+            )
+        if j.type not in _SUPPORTED:
+            raise DescriptionError(
+                f"{name}: joint {j.name!r}: unknown joint type {j.type!r} "
+                f"(supported: {', '.join(_SUPPORTED)})"
+            )
+        if j.mimic is not None:
+            raise DescriptionError(
+                f"{name}: joint {j.name!r}: <mimic> joints (coupled to joint {j.mimic.joint!r}) "
+                "are not supported yet"
+            )
+    parent_of: dict[str, str] = {}
+    children: dict[str, list[yourdfpy.Joint]] = {}
+    for j in model.joints:
+        if j.child in parent_of:
+            raise DescriptionError(
+                f"{name}: link {j.child!r} is the child of two joints "
+                f"({parent_of[j.child]!r} and {j.name!r}); not a tree"
+            )
+        parent_of[j.child] = j.name
+        children.setdefault(j.parent, []).append(j)
+    for link, js in children.items():
+        if len(js) > 1:
+            raise DescriptionError(
+                f"{name}: link {link!r} has {len(js)} child joints "
+                f"({', '.join(repr(j.name) for j in js)}): branching trees are not supported, "
+                "only serial chains"
+            )
+    roots = [lk.name for lk in model.links if lk.name not in parent_of]
+    if len(roots) != 1:
+        what = "no root link (the joints form a loop)" if not roots else f"{len(roots)} root links"
+        listed = f" ({', '.join(map(repr, roots))})" if roots else ""
+        raise DescriptionError(f"{name}: {what}{listed}; a serial chain has exactly one root link")
+    chain: list[yourdfpy.Joint] = []
+    link = roots[0]
+    while link in children:
+        j = children[link][0]
+        chain.append(j)
+        link = j.child
+    if len(chain) != len(model.joints):
+        missing = sorted({j.name for j in model.joints} - {j.name for j in chain})
+        raise DescriptionError(
+            f"{name}: joints {missing} are not connected to the chain from root link {roots[0]!r}"
+        )
+    return chain
+
+
+def _origin(elem: Any, where: str) -> tuple[list[sp.Expr], list[sp.Expr]]:
+    """``xyz`` (m) and ``rpy`` (rad) of an ``<origin>`` element (zeros when absent)."""
+    out = []
+    for key in ("xyz", "rpy"):
+        text = "0 0 0" if elem is None else elem.get(key, "0 0 0")
+        parts = text.split()
+        if len(parts) != 3:
+            raise DescriptionError(f"{where}: origin {key}={text!r} must have 3 numbers")
+        out.append([number(p, where=f"{where}: origin {key}") for p in parts])
+    return out[0], out[1]
+
+
+def _vector(values: Sequence[float] | np.ndarray, where: str) -> list[sp.Expr]:
+    """A 3-vector of URDF numbers."""
+    vals = list(values)
+    if len(vals) != 3:
+        raise DescriptionError(f"{where}: expected 3 numbers, got {len(vals)}")
+    return [number(v, where=where) for v in vals]
+
+
+def _link(lk: yourdfpy.Link, elem: Any, where: str) -> Link:
+    """A robodyn :class:`Link` (inertial data in the link frame) from a URDF link."""
+    if lk.inertial is None:
+        zero3 = sp.ImmutableMatrix(sp.zeros(3, 1))
+        return Link(lk.name, sp.Integer(0), zero3, sp.ImmutableMatrix(sp.zeros(3)))
+    inertial = lk.inertial
+    if inertial.mass is None:
+        raise DescriptionError(f"{where}: <inertial> has no <mass>")
+    if inertial.inertia is None:
+        raise DescriptionError(f"{where}: <inertial> has no <inertia>")
+    mass = number(inertial.mass, where=f"{where}: mass")
+    i_com = sp.Matrix(3, 3, lambda r, c: number(inertial.inertia[r, c], where=f"{where}: inertia"))
+    xyz, rpy = _origin(elem.find("inertial").find("origin"), f"{where}: inertial")
+    rot = S.rpy_to_matrix(*rpy)
+    # inertia about the COM, re-expressed from COM-frame axes to link-frame axes: R I R^T
+    i_link = rot * i_com * rot.T
+    i_link = (i_link + i_link.T) / 2  # exact symmetry despite rounding
+    return Link(lk.name, mass, sp.ImmutableMatrix(xyz), sp.ImmutableMatrix(i_link))
+
+
+def _element(j: yourdfpy.Joint, elem: Any, link: Link, name: str) -> ChainElement:
+    """One :class:`ChainElement` (joint + the link it carries) from a URDF joint."""
+    where = f"{name}: joint {j.name!r}"
+    xyz, rpy = _origin(elem.find("origin"), where)
+    source_params = dict(zip(("x", "y", "z", "roll", "pitch", "yaw"), (*xyz, *rpy), strict=True))
+    if j.type == "fixed":
+        pre, _, post = placement.from_origin(xyz, rpy, (0, 0, 1))
+        return ChainElement(j.name, "fixed", pre, _Z_AXIS, post, link)
+    axis = _vector(j.axis, f"{where}: axis")
+    if all(a == 0 for a in axis):
+        raise DescriptionError(f"{where}: the axis is the zero vector")
+    pre, unit, post = placement.from_origin(xyz, rpy, axis)
+    fields: dict[str, Any] = {"convention": "origin", "source_params": source_params}
+    fields.update(_limits(j, where))
+    if j.dynamics is not None:
+        fields["friction"] = _friction(j.dynamics, where)
+    jtype = "prismatic" if j.type == "prismatic" else "revolute"
+    return ChainElement(j.name, jtype, pre, unit, post, link, fields)
+
+
+def _limits(j: yourdfpy.Joint, where: str) -> Mapping[str, sp.Expr]:
+    """``lower``/``upper`` (not for continuous joints), ``velocity_limit``, ``effort_limit``."""
+    out: dict[str, sp.Expr] = {}
+    lim = j.limit
+    if lim is None:
+        return out
+    pairs = [("velocity_limit", lim.velocity), ("effort_limit", lim.effort)]
+    if j.type != "continuous":
+        pairs += [("lower", lim.lower), ("upper", lim.upper)]
+    for key, value in pairs:
+        if value is not None:
+            out[key] = number(value, where=f"{where}: limit {key}")
+    if "lower" in out and "upper" in out and out["lower"] > out["upper"]:
+        raise DescriptionError(f"{where}: limit lower={lim.lower} is above upper={lim.upper}")
+    return out
+
+
+def _friction(dyn: yourdfpy.Dynamics, where: str) -> Friction:
+    """Joint friction from ``<dynamics damping friction>`` (missing values are zero)."""
+    values: dict[str, sp.Expr] = {}
+    for label in ("damping", "friction"):
+        raw = getattr(dyn, label)
+        v = sp.Integer(0) if raw is None else number(raw, where=f"{where}: dynamics {label}")
+        if v < 0:
+            raise DescriptionError(f"{where}: dynamics {label}={raw} is negative")
+        values[label] = v
+    coulomb = values["friction"]
+    return Friction(viscous=values["damping"], coulomb_positive=coulomb, coulomb_negative=coulomb)
