@@ -17,7 +17,7 @@ from robodyn.robot.model import Robot
 from robodyn.symbolic import kane as kane_mod
 from robodyn.symbolic import lagrange as lagrange_mod
 from robodyn.symbolic import newton_euler as ne
-from robodyn.symbolic.coriolis import christoffel_coriolis
+from robodyn.symbolic.coriolis import christoffel_coriolis, christoffel_program
 from robodyn.symbolic.kinematics import (
     Kinematics,
     end_effector_jacobian,
@@ -49,14 +49,10 @@ class EquationsOfMotion:
         "newton_euler", "lagrange" or "kane".
     q, qd, qdd : tuple of Symbol, length n
         Joint positions (rad or m), velocities and accelerations.
-    M : (n, n) ImmutableMatrix
-        Joint-space inertia including reflected rotor inertia ``G^2 J_m``.
-    g : (n, 1) ImmutableMatrix
-        Gravity load: the torques that hold the arm still.
-    tau_rigid : (n, 1) ImmutableMatrix
-        Rigid-body inverse dynamics (no rotor inertia, no friction).
-    program : Program or None
-        Recursive (intermediate-variable) form of ``tau`` when the formulation produces one.
+    M_rigid_form, g_form, tau_rigid_form : ImmutableMatrix or Program
+        Rigid-body inertia matrix (n, n), gravity load (n, 1) and inverse dynamics (n, 1) as
+        derived: a recursive :class:`Program` (Newton-Euler) or expressions. The properties
+        ``M``, ``g`` and ``tau_rigid`` give them as expressions.
     derivation_time : float
         Seconds spent deriving ``M``, ``g`` and ``tau``.
     """
@@ -66,17 +62,38 @@ class EquationsOfMotion:
     q: tuple[sp.Symbol, ...]
     qd: tuple[sp.Symbol, ...]
     qdd: tuple[sp.Symbol, ...]
-    M: sp.ImmutableMatrix
-    g: sp.ImmutableMatrix
-    tau_rigid: sp.ImmutableMatrix
-    program: Program | None = None
+    M_rigid_form: sp.ImmutableMatrix | Program
+    g_form: sp.ImmutableMatrix | Program
+    tau_rigid_form: sp.ImmutableMatrix | Program
     derivation_time: float = 0.0
+    symbolic_inertia: bool = False
     _extra: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def dof(self) -> int:
         """Number of joints."""
         return len(self.q)
+
+    @property
+    def program(self) -> Program | None:
+        """Recursive (intermediate-variable) form of the rigid-body ``tau``, when there is one."""
+        form = self.tau_rigid_form
+        return form if isinstance(form, Program) else None
+
+    @cached_property
+    def M(self) -> sp.ImmutableMatrix:  # noqa: N802 - the textbook name
+        """Joint-space inertia including reflected rotor inertia ``G^2 J_m``, shape (n, n)."""
+        return sp.ImmutableMatrix(_expanded(self.M_rigid_form) + _rotor_matrix(self.robot))
+
+    @cached_property
+    def g(self) -> sp.ImmutableMatrix:
+        """Gravity load: the torques that hold the arm still, shape (n, 1)."""
+        return _expanded(self.g_form)
+
+    @cached_property
+    def tau_rigid(self) -> sp.ImmutableMatrix:
+        """Rigid-body inverse dynamics (no rotor inertia, no friction), shape (n, 1)."""
+        return _expanded(self.tau_rigid_form)
 
     @cached_property
     def friction(self) -> sp.ImmutableMatrix:
@@ -103,12 +120,23 @@ class EquationsOfMotion:
     @cached_property
     def C(self) -> sp.ImmutableMatrix:  # noqa: N802 - the textbook name
         """Coriolis/centrifugal matrix (Christoffel form), shape (n, n)."""
+        if isinstance(self.M_rigid_form, Program):
+            # differentiate the recursive form: linear in its size, no expression swell
+            return christoffel_program(self.M_rigid_form, self.q, self.qd).expand()
         return christoffel_coriolis(self.M, self.q, self.qd)
 
     @cached_property
     def params(self) -> sp.ImmutableMatrix:
-        """Parameter vector of the regressor (15 per joint), shape (15 n, 1)."""
-        return parameter_values(self.robot)
+        """Parameter vector of the regressor (15 per joint), shape (15 n, 1).
+
+        With ``symbolic_inertia`` the inertial entries are the barycentric symbols themselves.
+        """
+        values = parameter_values(self.robot)
+        if not self.symbolic_inertia:
+            return values
+        names = self.param_names
+        return sp.ImmutableMatrix([sp.Symbol(names[k], real=True) if k % 15 < 10 else v
+                                   for k, v in enumerate(values)])
 
     @property
     def param_names(self) -> tuple[str, ...]:
@@ -153,11 +181,10 @@ class EquationsOfMotion:
                 tau_ops = cse_op_count(list(extra), self.program.assignments)
             else:
                 tau_ops = cse_op_count(list(self.tau))
-            upper = [self.M[i, j] for i in range(self.dof) for j in range(i, self.dof)]
             self._extra["op_counts"] = {
                 "tau": tau_ops,
-                "M": cse_op_count(upper),
-                "g": cse_op_count(list(self.g)),
+                "M": _form_ops(self.M_rigid_form, upper_triangle=True),
+                "g": _form_ops(self.g_form),
             }
         return self._extra["op_counts"]
 
@@ -170,11 +197,27 @@ class EquationsOfMotion:
         return {s.name for s in self.q + self.qd + self.qdd} | set(self.robot.parameters)
 
 
+def _form_ops(form: sp.ImmutableMatrix | Program, upper_triangle: bool = False) -> OpCount:
+    """Operations after CSE of a derived form (the recursive program when there is one)."""
+    out = form.outputs if isinstance(form, Program) else form
+    if upper_triangle:
+        exprs = [out[i, j] for i in range(out.rows) for j in range(i, out.cols)]
+    else:
+        exprs = list(out)
+    assignments = form.assignments if isinstance(form, Program) else ()
+    return cse_op_count(exprs, assignments)
+
+
+def _expanded(form: sp.ImmutableMatrix | Program) -> sp.ImmutableMatrix:
+    return form.expand() if isinstance(form, Program) else sp.ImmutableMatrix(form)
+
+
 def _rotor_matrix(robot: Robot) -> sp.ImmutableMatrix:
     return sp.ImmutableMatrix(sp.diag(*[reflected_rotor_inertia(robot, j) for j in range(robot.dof)]))
 
 
-def derive(robot: Robot, method: Method = "newton_euler") -> EquationsOfMotion:
+def derive(robot: Robot, method: Method = "newton_euler", *,
+           symbolic_inertia: bool = False) -> EquationsOfMotion:
     """Derive the equations of motion of ``robot``.
 
     Parameters
@@ -183,6 +226,10 @@ def derive(robot: Robot, method: Method = "newton_euler") -> EquationsOfMotion:
     method : {"newton_euler", "lagrange", "kane"}
         Recursive Newton-Euler (intermediate-variable form, linear cost), Lagrange-Euler from the
         energies, or Kane's method.
+    symbolic_inertia : bool
+        Replace every link's mass, first moment and inertia by the barycentric parameter symbols
+        ``XXj, XYj, XZj, YYj, YZj, ZZj, MXj, MYj, MZj, Mj`` (the regressor's names), as needed for
+        identification; supported by ``newton_euler`` (whose equations are linear in them).
 
     Returns
     -------
@@ -191,17 +238,26 @@ def derive(robot: Robot, method: Method = "newton_euler") -> EquationsOfMotion:
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     n = robot.dof
+    if symbolic_inertia and method != "newton_euler":
+        raise ValueError(
+            f"symbolic_inertia=True is supported by method='newton_euler' (the barycentric "
+            f"parameters enter it linearly), not by {method!r}"
+        )
+    inertials = ne.symbolic_inertials(n) if symbolic_inertia else None
     q, qd, qdd = joint_symbols(n)
     start = time.perf_counter()
-    program = None
     if method == "newton_euler":
         reserved = {s.name for s in q + qd + qdd} | set(robot.parameters)
-        rec = Recorder(reserved)
-        tau_rec = ne.inverse_dynamics(robot, q, qd, qdd, rec)
-        program = Program(tuple(rec.assignments), tau_rec).pruned()
-        tau_rigid = program.expand()
-        m_rigid = ne.mass_matrix(robot, q)
-        g = ne.gravity_torque(robot, q)
+        forms = []
+        for build in (
+            lambda rec: ne.inverse_dynamics(robot, q, qd, qdd, rec, inertials=inertials),
+            lambda rec: ne.mass_matrix(robot, q, rec, inertials),
+            lambda rec: ne.gravity_torque(robot, q, rec, inertials),
+        ):
+            rec = Recorder(reserved)
+            out = build(rec)
+            forms.append(Program(tuple(rec.assignments), out).pruned())
+        tau_rigid, m_rigid, g = forms
     elif method == "lagrange":
         m_rigid, potential = lagrange_mod.mass_matrix_and_potential(robot, q)
         g = lagrange_mod.gravity_from_potential(potential, q)
@@ -214,8 +270,8 @@ def derive(robot: Robot, method: Method = "newton_euler") -> EquationsOfMotion:
     elapsed = time.perf_counter() - start
     eom = EquationsOfMotion(
         robot=robot, method=method, q=q, qd=qd, qdd=qdd,
-        M=sp.ImmutableMatrix(m_rigid + _rotor_matrix(robot)), g=sp.ImmutableMatrix(g),
-        tau_rigid=sp.ImmutableMatrix(tau_rigid), program=program, derivation_time=elapsed,
+        M_rigid_form=m_rigid, g_form=g, tau_rigid_form=tau_rigid, derivation_time=elapsed,
+        symbolic_inertia=symbolic_inertia,
     )
     if method == "lagrange":
         # C was already needed for tau: keep it

@@ -271,23 +271,44 @@ def inverse_dynamics(robot: Robot, q: Sequence[sp.Expr], qd: Sequence[sp.Expr],
     return sp.ImmutableMatrix([rec.scalar(t, f"tau{i + 1}") for i, t in enumerate(taus)])
 
 
-def mass_matrix(robot: Robot, q: Sequence[sp.Expr]) -> sp.ImmutableMatrix:
-    """Rigid-body joint-space inertia matrix by n Newton-Euler passes, shape (n, n)."""
+def mass_matrix(robot: Robot, q: Sequence[sp.Expr], rec: Recorder,
+                inertials: Sequence[LinkInertial] | None = None) -> sp.ImmutableMatrix:
+    """Rigid-body joint-space inertia matrix by n Newton-Euler passes, shape (n, n).
+
+    Column j is the inverse dynamics with ``qdd = e_j``, zero velocity and no gravity.
+    """
     n = robot.dof
-    cols = []
+    m = sp.zeros(n, n)
+    prefix = rec.prefix
     for j in range(n):
         unit = [sp.Integer(1) if k == j else sp.Integer(0) for k in range(n)]
-        col = inverse_dynamics(robot, q, [0] * n, unit, Recorder(record=False), with_gravity=False)
-        cols.append(col)
-    m = sp.Matrix(sp.Matrix.hstack(*cols))
-    # symmetrise structurally: M_ij and M_ji are the same quantity computed twice
-    for i in range(n):
-        for j in range(i + 1, n):
-            m[j, i] = m[i, j]
+        rec.prefix = f"{prefix}m{j + 1}_"
+        col = inverse_dynamics(robot, q, [0] * n, unit, rec, with_gravity=False,
+                               inertials=inertials)
+        # M_ij = M_ji: keep the upper triangle of each column
+        for i in range(j + 1):
+            m[i, j] = m[j, i] = col[i]
+    rec.prefix = prefix
     return sp.ImmutableMatrix(m)
 
 
-def gravity_torque(robot: Robot, q: Sequence[sp.Expr]) -> sp.ImmutableMatrix:
+def gravity_torque(robot: Robot, q: Sequence[sp.Expr], rec: Recorder,
+                   inertials: Sequence[LinkInertial] | None = None) -> sp.ImmutableMatrix:
     """Gravity load ``g(q)``: torques that hold the arm still, shape (n, 1)."""
     n = robot.dof
-    return inverse_dynamics(robot, q, [0] * n, [0] * n, Recorder(record=False))
+    prefix = rec.prefix
+    rec.prefix = f"{prefix}g_"
+    out = inverse_dynamics(robot, q, [0] * n, [0] * n, rec, inertials=inertials)
+    rec.prefix = prefix
+    return out
+
+
+def symbolic_inertials(n: int) -> list[LinkInertial]:
+    """Barycentric parameters as symbols ``XXj .. ZZj, MXj, MYj, MZj, Mj`` (regressor names)."""
+    out = []
+    for j in range(1, n + 1):
+        xx, xy, xz, yy, yz, zz, mx, my, mz, m = sp.symbols(
+            f"XX{j} XY{j} XZ{j} YY{j} YZ{j} ZZ{j} MX{j} MY{j} MZ{j} M{j}", real=True)
+        out.append(LinkInertial(m, sp.ImmutableMatrix([mx, my, mz]),
+                                sp.ImmutableMatrix([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])))
+    return out

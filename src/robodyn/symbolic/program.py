@@ -33,16 +33,19 @@ class Recorder:
         When False the recorder returns expressions unchanged (direct, nested expressions).
     """
 
-    def __init__(self, reserved: Iterable[str] = (), *, record: bool = True) -> None:
+    def __init__(self, reserved: Iterable[str] = (), *, record: bool = True,
+                 prefix: str = "") -> None:
         self.assignments: list[tuple[sp.Symbol, sp.Expr]] = []
         self._used = set(reserved)
         self.record = record
+        self.prefix = prefix
 
     def scalar(self, expr: sp.Expr, name: str) -> sp.Expr:
         """Record ``expr`` under ``name`` unless it is trivial; return what to use in its place."""
         expr = sp.sympify(expr)
         if not self.record or is_trivial(expr):
             return expr
+        name = self.prefix + name
         unique = name
         k = 1
         while unique in self._used:
