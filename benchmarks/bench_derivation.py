@@ -74,8 +74,9 @@ def sympy_kanes_method_chain(n: int) -> float:
         k = i + 1
         m, c, length = sp.symbols(f"m{k} c{k} L{k}")
         ixx, iyy, izz, ixy, ixz, iyz = sp.symbols(f"Ixx{k} Iyy{k} Izz{k} Ixy{k} Ixz{k} Iyz{k}")
-        frame = parent_frame.orientnew(f"B{k}", "Axis", [q[i], getattr(parent_frame, axes[i % 3].lower())])
-        frame.set_ang_vel(parent_frame, u[i] * getattr(parent_frame, axes[i % 3].lower()))
+        axis = getattr(parent_frame, axes[i % 3].lower())
+        frame = parent_frame.orientnew(f"B{k}", "Axis", [q[i], axis])
+        frame.set_ang_vel(parent_frame, u[i] * axis)
         joint_point = parent_point if i == 0 else parent_point.locatenew(
             f"J{k}", sp.Symbol(f"L{i}") * parent_frame.z)
         joint_point.v2pt_theory(parent_point, frame_n, parent_frame)
@@ -94,14 +95,15 @@ def sympy_kanes_method_chain(n: int) -> float:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="skip the 30-joint chain and Lagrange")
     args = parser.parse_args()
     puma = rd.load("puma560")
 
     print("== 1. PUMA 560, Newton-Euler, symbolic inertial parameters ==")
     eom, t_core = timed(lambda: rd.derive(puma, "newton_euler", symbolic_inertia=True))
-    _, t_tau = timed(lambda: eom.tau)
+    _, t_tau = timed(lambda: (eom.tau, eom.M, eom.g))
     _, t_y = timed(lambda: eom.Y)
     _, t_c = timed(lambda: eom.C)
     total = t_core + t_tau + t_y + t_c

@@ -25,14 +25,14 @@ def eom_of(name: str, method: str) -> rd.EquationsOfMotion:
 @pytest.mark.parametrize("method", METHODS)
 def test_trolley_pendulum_reproduces_seed_equations_exactly(method):
     eom = eom_of("trolley_pendulum", method)
-    big_m, m, l, g = (sp.Symbol(s, real=True) for s in ("M", "m", "l", "g"))
+    big_m, m, ell, g = (sp.Symbol(s, real=True) for s in ("M", "m", "l", "g"))
     _, th = eom.q
     _, thd = eom.qd
     xdd, thdd = eom.qdd
     # F - (M+m) x'' - (m l/2) cos(th) th'' + (m l/2) sin(th) th'^2 = 0          (2.46)
-    force = (big_m + m) * xdd + m * l / 2 * sp.cos(th) * thdd - m * l / 2 * sp.sin(th) * thd**2
+    force = (big_m + m) * xdd + m * ell / 2 * sp.cos(th) * thdd - m * ell / 2 * sp.sin(th) * thd**2
     # (m g l/2) sin(th) - (m l/2) cos(th) x'' - (m l^2/3) th'' = 0 (unactuated)  (2.47)
-    torque = m * l / 2 * sp.cos(th) * xdd + m * l**2 / 3 * thdd - m * g * l / 2 * sp.sin(th)
+    torque = m * ell / 2 * sp.cos(th) * xdd + m * ell**2 / 3 * thdd - m * g * ell / 2 * sp.sin(th)
     assert sp.simplify(eom.tau[0] - force) == 0
     assert sp.simplify(eom.tau[1] - torque) == 0
 
@@ -82,8 +82,10 @@ def test_formulations_agree_symbolically_on_small_robots(name):
             assert diff == sp.zeros(*a.shape), f"{name}: newton_euler vs {method}"
 
 
+# kinova_gen3 (7 joints, general URDF origins) is checked against Pinocchio instead, in
+# test_pinocchio_oracle.py: its Lagrange and Kane derivations take minutes.
 ALL = ("trolley_pendulum", "trolley_double_pendulum", "planar_2r", "aa300", "puma560",
-       "puma560_akb", "kinova_gen3")
+       "puma560_akb")
 
 
 @pytest.mark.parametrize("name", ALL)

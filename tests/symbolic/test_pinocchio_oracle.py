@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 import robodyn as rd
-from tests.numeric_eval import evaluator
+from tests.numeric_eval import evaluator, program_evaluator
 
 pin = pytest.importorskip("pinocchio")
 
@@ -89,3 +91,29 @@ def test_random_chain_matches_pinocchio(tmp_path, seed):
         pin.forwardKinematics(model, data, pq)
         np.testing.assert_allclose(f_fk(q)[:3, 3], data.oMi[model.njoints - 1].translation,
                                    atol=1e-9)
+
+
+GEN3_URDF = Path(__file__).resolve().parents[3] / "shared" / "data" / "kinova-gen3" / "gen3.urdf"
+
+
+@pytest.mark.skipif(not GEN3_URDF.exists(), reason="../shared/data/kinova-gen3 not beside the repo")
+def test_builtin_kinova_gen3_matches_pinocchio_on_the_original_urdf():
+    eom = rd.derive(rd.load("kinova_gen3"), method="newton_euler")
+    model = pin.buildModelFromUrdf(str(GEN3_URDF))
+    data = model.createData()
+    f_tau = program_evaluator(eom, eom.program)
+    f_m = program_evaluator(eom, eom.M_rigid_form)
+    f_g = program_evaluator(eom, eom.g_form)
+    f_y = program_evaluator(eom, eom.regressor_program)
+    p = np.array(eom.params.xreplace(eom.numeric()), dtype=float).ravel()
+    rng = np.random.default_rng(11)
+    for _ in range(3):
+        q, qd, qdd = rng.uniform(-2, 2, 7), rng.uniform(-2, 2, 7), rng.uniform(-2, 2, 7)
+        pq = pin_q(model, q)
+        np.testing.assert_allclose(f_m(q), pin.crba(model, data, pq), atol=1e-9)
+        np.testing.assert_allclose(f_g(q).ravel(), pin.computeGeneralizedGravity(model, data, pq),
+                                   atol=1e-9)
+        ref = pin.rnea(model, data, pq, qd, qdd)
+        np.testing.assert_allclose(f_tau(q, qd, qdd).ravel(), ref, atol=1e-9)
+        # gen3 has no drives or friction: the regressor reproduces the rigid-body torques
+        np.testing.assert_allclose(f_y(q, qd, qdd) @ p, ref, atol=1e-9)

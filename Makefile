@@ -1,0 +1,38 @@
+# robodyn: set-up, demo, tests and benchmarks.  `make demo` and `make test` are all you need.
+
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed
+
+.PHONY: venv demo test bench clean distclean
+
+## venv: create .venv and install robodyn (editable) with its test tools; reruns are instant
+venv: $(STAMP)
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e ".[test]"
+	touch $(STAMP)
+
+## demo: PUMA 560 three ways; equations, comparison and report in out/ (open out/report.html)
+demo: $(STAMP)
+	$(BIN)/robodyn demo -o out
+
+## test: lint, then the test suite
+test: $(STAMP)
+	$(BIN)/ruff check src tests benchmarks && $(BIN)/pytest -q
+
+## bench: timing suites in benchmarks/
+bench: $(STAMP)
+	@set -e; for f in benchmarks/bench_*.py; do echo "== $$f"; $(BIN)/python $$f; done
+
+## clean: remove generated files (keeps .venv)
+clean:
+	rm -rf out build dist .pytest_cache .ruff_cache src/*.egg-info
+	find src tests benchmarks tools -name __pycache__ -type d -prune -exec rm -rf {} +
+
+## distclean: clean, and remove .venv too
+distclean: clean
+	rm -rf $(VENV)

@@ -1,0 +1,222 @@
+"""The ``robodyn`` command line and the text/LaTeX/JSON renderers."""
+
+from __future__ import annotations
+
+import csv
+import json
+import re
+import time
+import warnings
+
+import pytest
+import sympy as sp
+
+import robodyn as rd
+from robodyn.cli import Agreement, main
+from robodyn.symbolic.render import render_json, render_latex, render_mathml, render_text
+
+NEGATIVE_MASS = """\
+name: bad_arm
+parameters: {l1: 1.0}
+joints:
+  - name: j1
+    type: revolute
+    dh: {a: l1, alpha: 0, d: 0, theta: 0}
+    link:
+      name: upper
+      mass: -2.0
+      com: [-0.5, 0, 0]
+      inertia: {ixx: 0.01, iyy: 0.01, izz: 0.01, ixy: 0, ixz: 0, iyz: 0}
+"""
+
+
+def run(argv: list[str]) -> int:
+    """``main(argv)``; argparse errors and ``--help`` exit through SystemExit."""
+    try:
+        return main(argv)
+    except SystemExit as exc:
+        return int(exc.code or 0)
+
+
+def load_quietly(name: str) -> rd.Robot:
+    """Load without the plausibility warnings of the source data (see puma560.yaml)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return rd.load(name)
+
+
+@pytest.fixture(scope="module")
+def trolley_kane() -> rd.EquationsOfMotion:
+    return rd.derive(rd.load("trolley_pendulum"), "kane")
+
+
+@pytest.fixture(scope="module")
+def puma_ne() -> rd.EquationsOfMotion:
+    return rd.derive(load_quietly("puma560"), "newton_euler")
+
+
+# ----------------------------------------------------------------------------------------------
+# command line
+# ----------------------------------------------------------------------------------------------
+
+
+def test_list_shows_builtins(capsys):
+    assert run(["list"]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"^puma560\s+6\s+RRRRRR", out, re.M)
+    assert re.search(r"^trolley_pendulum\s+2\s+PR", out, re.M)
+
+
+def test_show_prints_joint_and_link_tables(capsys):
+    assert run(["show", "planar_2r"]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"^1\s+q1\s+revolute\s+dh\s+a=l1 alpha=0 d=0 theta=0", out, re.M)
+    assert re.search(r"^2\s+q2\s+revolute\s+dh\s+a=l2", out, re.M)
+    assert re.search(r"^1\s+link1\s+m1\s+\(-l1/2, 0, 0\)", out, re.M)
+    assert "gravity: (0, -g, 0)" in out
+    assert re.search(r"^g\s+9\.81$", out, re.M)
+
+
+def test_derive_text_is_the_textbook_form(capsys):
+    assert run(["derive", "trolley_pendulum", "--method", "kane", "--format", "text"]) == 0
+    out = capsys.readouterr().out
+    assert "cos(q2)" in out
+    # seed eqs. 2.46-2.47 solved for the joint forces
+    assert "tau1 = (M + m)*qdd1 + l*m*qdd2*cos(q2)/2 - l*m*qd2**2*sin(q2)/2" in out
+    assert "M11 = M + m" in out  # sin^2 + cos^2 simplified away
+    assert out.startswith("# robodyn")
+
+
+def test_derive_json_parses(capsys):
+    assert run(["derive", "trolley_pendulum", "--format", "json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["robot"] == "trolley_pendulum" and doc["dof"] == 2
+    assert len(doc["M"]) == 2 and all(len(row) == 2 for row in doc["M"])
+    assert len(doc["C"]) == 2 and len(doc["g"]) == 2 and len(doc["tau"]) == 2
+    assert set(doc["op_counts"]) == {"tau", "M", "g"}
+    m, length, q2 = sp.symbols("m l q2")
+    assert sp.simplify(sp.sympify(doc["M"][0][1]) - m * length * sp.cos(q2) / 2) == 0
+
+
+def test_derive_writes_file(tmp_path, capsys):
+    target = tmp_path / "trolley.tex"
+    assert run(["derive", "trolley_pendulum", "--format", "latex", "-o", str(target)]) == 0
+    assert capsys.readouterr().out == ""
+    assert r"\end{document}" in target.read_text()
+
+
+def test_check_planar_2r_agrees(capsys):
+    assert run(["check", "planar_2r", "--samples", "5"]) == 0
+    captured = capsys.readouterr()
+    assert "the three formulations agree" in captured.out
+    assert re.search(r"newton_euler vs lagrange\s+\S+\s+\S+\s+\S+\s+yes\s+ok", captured.out)
+    assert "deriving kane..." in captured.err
+
+
+def test_agreement_flags_a_difference():
+    assert not Agreement("a", "b", {"M": 1e-6, "g": 0.0, "tau": 0.0}).ok
+    assert not Agreement("a", "b", {"M": 0.0, "g": 0.0, "tau": 0.0}, symbolic=False).ok
+    assert Agreement("a", "b", {"M": 1e-15, "g": 0.0, "tau": 0.0}, symbolic=True).ok
+
+
+def test_unknown_robot_exits_2(capsys):
+    assert run(["show", "no_such_robot"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "no_such_robot" in err and "Traceback" not in err
+
+
+def test_negative_mass_exits_2_naming_the_field(tmp_path, capsys):
+    path = tmp_path / "bad_arm.yaml"
+    path.write_text(NEGATIVE_MASS)
+    assert run(["derive", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "bad_arm.yaml" in err and "mass" in err
+
+
+def test_bad_option_exits_2(capsys):
+    assert run(["derive", "planar_2r", "--method", "hamilton"]) == 2
+    assert "hamilton" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv", [[], ["derive"], ["check"], ["demo"]])
+def test_help_has_examples(argv, capsys):
+    assert run([*argv, "--help"]) == 0
+    out = capsys.readouterr().out
+    assert "usage: robodyn" in out and "example" in out
+
+
+@pytest.mark.slow
+def test_demo_writes_report(tmp_path, capsys):
+    assert run(["demo", "-o", str(tmp_path), "--samples", "3"]) == 0
+    out = capsys.readouterr().out
+    assert str(tmp_path / "report.html") in out
+    names = {p.name for p in tmp_path.iterdir()}
+    assert {"report.html", "comparison.csv", "comparison.md", "puma560_newton_euler.txt",
+            "puma560_equations.tex", "trolley_pendulum.tex"} <= names
+    assert {f"puma560_{m}.json" for m in ("newton_euler", "lagrange", "kane")} <= names
+    with (tmp_path / "comparison.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["method"] for r in rows] == ["newton_euler", "lagrange", "kane"]
+    assert all(float(r["derivation_time_s"]) > 0 and int(r["tau_multiplications"]) > 0
+               for r in rows)
+    page = (tmp_path / "report.html").read_text()
+    assert page.startswith("<!DOCTYPE html>") and "<math" in page and "<script" not in page
+    assert "http://" not in page and "https://" not in page  # opens without network
+    assert "the three formulations agree" in page
+
+
+# ----------------------------------------------------------------------------------------------
+# renderers
+# ----------------------------------------------------------------------------------------------
+
+
+def test_latex_is_a_complete_document(trolley_kane):
+    tex = render_latex(trolley_kane)
+    assert tex.startswith("% robodyn")
+    assert r"\documentclass" in tex and r"\usepackage{amsmath}" in tex
+    assert tex.count(r"\begin{document}") == 1 and tex.rstrip().endswith(r"\end{document}")
+    assert tex.count(r"\begin{align*}") == tex.count(r"\end{align*}") == 4
+    assert r"\ddot{q}_{1}" in tex and r"\dot{q}_{2}" in tex and r"\cos {q_{2}}" in tex
+    assert "trolley\\_pendulum" in tex  # escaped in text
+
+
+def test_text_of_large_arm_is_recursive(puma_ne):
+    text = render_text(puma_ne)
+    lines = text.splitlines()
+    assert any(line.startswith("w2_") or line.startswith("wp2_") for line in lines)
+    assert sum(line.startswith("tau") for line in lines) == 6
+    assert any(line.startswith("M11 = ") for line in lines)
+    assert any(line.startswith("x0 = ") for line in lines)
+    assert "recursive Newton-Euler" in text
+
+
+def test_text_of_large_arm_from_kane_says_where_the_recursion_comes_from():
+    text = render_text(rd.derive(load_quietly("puma560"), "kane"))
+    assert "derived with newton_euler for this listing" in text
+
+
+def test_latex_of_large_arm(puma_ne):
+    tex = render_latex(puma_ne)
+    assert r"\allowdisplaybreaks" in tex and tex.rstrip().endswith(r"\end{document}")
+    assert r"\tau_{6} &=" in tex
+    assert r"\\" + "\n  &\\quad" in tex  # long entries are broken over lines
+
+
+def test_json_recursive_entries_evaluate(trolley_kane):
+    doc = json.loads(render_json(trolley_kane))
+    assert doc["subexpressions"] == [] and doc["method"] == "kane"
+    assert doc["q"] == ["q1", "q2"] and doc["parameters"]["l"] == 1.0
+
+
+def test_mathml_fragment(trolley_kane):
+    frag = render_mathml(trolley_kane)
+    assert frag.count("<math") == 4 and "&#x00A8;" in frag  # double dot of qdd
+
+
+def test_render_is_fast_for_the_puma(puma_ne):
+    start = time.perf_counter()
+    render_text(puma_ne)
+    render_latex(puma_ne)
+    assert time.perf_counter() - start < 20
