@@ -78,7 +78,10 @@ def test_random_chain_matches_pinocchio(tmp_path, seed):
     eom = rd.derive(robot, method="newton_euler")
     model = pin.buildModelFromUrdf(str(path))
     data = model.createData()
-    f_m, f_g, f_tau = evaluator(eom, eom.M), evaluator(eom, eom.g), evaluator(eom, eom.tau_rigid)
+    # the recursive forms (their expansion is checked on the built-in robots)
+    f_m = program_evaluator(eom, eom.M_rigid_form)
+    f_g = program_evaluator(eom, eom.g_form)
+    f_tau = program_evaluator(eom, eom.program)
     f_fk = evaluator(eom, eom.fk)
     for _ in range(4):
         q, qd, qdd = rng.uniform(-2, 2, n), rng.uniform(-2, 2, n), rng.uniform(-2, 2, n)
