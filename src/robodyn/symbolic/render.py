@@ -116,25 +116,25 @@ def _rate_order(dep: sp.Expr, qd: Sequence[sp.Symbol], qdd: Sequence[sp.Symbol])
     return group, sp.default_sort_key(dep)
 
 
-def _chop(expr: sp.Expr, rel: float = 1e-12) -> sp.Expr:
-    """Replace floats below ``rel`` times the largest float in ``expr`` by zero."""
-    floats = list(expr.atoms(sp.Float))
-    if not floats:
-        return expr
-    scale = max(abs(float(f)) for f in floats)
-    small = {f: sp.Integer(0) for f in floats if abs(float(f)) < rel * scale}
+def _chop(expr: sp.Expr, threshold: float) -> sp.Expr:
+    """Replace floats smaller than ``threshold`` in magnitude by zero."""
+    small = {f: sp.Integer(0) for f in expr.atoms(sp.Float) if abs(float(f)) < threshold}
     return sp.sympify(expr.xreplace(small)) if small else expr
 
 
-def _tidy(expr: sp.Expr, qd: Sequence[sp.Symbol], qdd: Sequence[sp.Symbol]) -> Terms:
-    """Textbook form: terms grouped by products of the rates, each coefficient simplified."""
+def _tidy(expr: sp.Expr, qd: Sequence[sp.Symbol], qdd: Sequence[sp.Symbol],
+          threshold: float = 0.0) -> Terms:
+    """Textbook form: terms grouped by products of the rates, each coefficient simplified.
+
+    Floats below ``threshold`` (round-off) are dropped.
+    """
     groups: dict[sp.Expr, sp.Expr] = {}
-    for term in sp.Add.make_args(sp.expand(sp.sympify(expr))):
+    for term in sp.Add.make_args(_chop(sp.expand(sp.sympify(expr)), threshold)):
         coeff, dep = term.as_independent(*qd, *qdd, as_Add=False)
         groups[dep] = groups.get(dep, sp.Integer(0)) + coeff
     terms = []
     for dep in sorted(groups, key=lambda d: _rate_order(d, qd, qdd)):
-        coeff = _chop(sp.factor_terms(sp.trigsimp(groups[dep])))
+        coeff = _chop(sp.factor_terms(sp.trigsimp(groups[dep])), threshold)
         if coeff != 0:
             terms.append((coeff, dep))
     return terms
@@ -146,9 +146,14 @@ def _split(expr: sp.Expr) -> Terms:
 
 
 def _textbook(eom: EquationsOfMotion) -> dict[str, list[list[Terms]]]:
-    """M, C (n x n), g and tau (n x 1) of a small arm in textbook form."""
+    """M, C (n x n), g and tau (n x 1) of a small arm in textbook form.
+
+    Round-off: floats below 1e-12 of the largest float of the expanded matrix are dropped.
+    """
     def tidy(mat: sp.MatrixBase) -> list[list[Terms]]:
-        return [[_tidy(mat[i, j], eom.qd, eom.qdd) for j in range(mat.cols)]
+        floats = sp.ImmutableMatrix(mat).applyfunc(sp.expand).atoms(sp.Float)
+        threshold = 1e-12 * max((abs(float(f)) for f in floats), default=0.0)
+        return [[_tidy(mat[i, j], eom.qd, eom.qdd, threshold) for j in range(mat.cols)]
                 for i in range(mat.rows)]
 
     return {"M": tidy(eom.M), "C": tidy(eom.C), "g": tidy(eom.g), "tau": tidy(eom.tau)}
@@ -553,11 +558,16 @@ def render_json(eom: EquationsOfMotion) -> str:
         texts = {key: [[_join(_term_texts(t, _j, ("(", ")*"))) for t in row] for row in mat]
                  for key, mat in parts.items()}
     else:
-        flat = list(eom.M) + list(eom.C) + list(eom.g) + list(eom.tau)
-        subs, reduced = _cse(flat, _used_names(eom))
-        it = iter(_j(e) for e in reduced)
-        texts = {key: [[next(it) for _ in range(n if key in ("M", "C") else 1)] for _ in range(n)]
-                 for key in _ENTRY_NAMES}
+        # one CSE per quantity: a joint CSE of all four can take many minutes on a 7-joint arm
+        # (SymPy compares large equal-but-distinct subtrees), separate ones take seconds
+        names = _fresh_names("x", _used_names(eom))
+        subs, texts = [], {}
+        for key in _ENTRY_NAMES:
+            mat = getattr(eom, key)
+            block, reduced = sp.cse(list(mat), symbols=names, order="none")
+            subs += block
+            it = iter(_j(e) for e in reduced)
+            texts[key] = [[next(it) for _ in range(mat.cols)] for _ in range(mat.rows)]
     doc = {
         "robot": eom.robot.name,
         "method": eom.method,
