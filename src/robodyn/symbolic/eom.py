@@ -14,6 +14,7 @@ from typing import Literal
 import sympy as sp
 
 from robodyn.robot.model import Robot
+from robodyn.symbolic import crba
 from robodyn.symbolic import kane as kane_mod
 from robodyn.symbolic import lagrange as lagrange_mod
 from robodyn.symbolic import newton_euler as ne
@@ -251,7 +252,7 @@ def derive(robot: Robot, method: Method = "newton_euler", *,
         forms = []
         for build in (
             lambda rec: ne.inverse_dynamics(robot, q, qd, qdd, rec, inertials=inertials),
-            lambda rec: ne.mass_matrix(robot, q, rec, inertials),
+            lambda rec: crba.mass_matrix(robot, q, rec, inertials),
             lambda rec: ne.gravity_torque(robot, q, rec, inertials),
         ):
             rec = Recorder(reserved)

@@ -271,27 +271,6 @@ def inverse_dynamics(robot: Robot, q: Sequence[sp.Expr], qd: Sequence[sp.Expr],
     return sp.ImmutableMatrix([rec.scalar(t, f"tau{i + 1}") for i, t in enumerate(taus)])
 
 
-def mass_matrix(robot: Robot, q: Sequence[sp.Expr], rec: Recorder,
-                inertials: Sequence[LinkInertial] | None = None) -> sp.ImmutableMatrix:
-    """Rigid-body joint-space inertia matrix by n Newton-Euler passes, shape (n, n).
-
-    Column j is the inverse dynamics with ``qdd = e_j``, zero velocity and no gravity.
-    """
-    n = robot.dof
-    m = sp.zeros(n, n)
-    prefix = rec.prefix
-    for j in range(n):
-        unit = [sp.Integer(1) if k == j else sp.Integer(0) for k in range(n)]
-        rec.prefix = f"{prefix}m{j + 1}_"
-        col = inverse_dynamics(robot, q, [0] * n, unit, rec, with_gravity=False,
-                               inertials=inertials)
-        # M_ij = M_ji: keep the upper triangle of each column
-        for i in range(j + 1):
-            m[i, j] = m[j, i] = col[i]
-    rec.prefix = prefix
-    return sp.ImmutableMatrix(m)
-
-
 def gravity_torque(robot: Robot, q: Sequence[sp.Expr], rec: Recorder,
                    inertials: Sequence[LinkInertial] | None = None) -> sp.ImmutableMatrix:
     """Gravity load ``g(q)``: torques that hold the arm still, shape (n, 1)."""
