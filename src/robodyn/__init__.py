@@ -5,8 +5,11 @@ Public API::
     import robodyn as rd
     robot = rd.load("puma560")
     eom = rd.derive(robot, method="newton_euler")   # or "lagrange", "kane"
+    model = rd.compile_model(robot)                  # generated C, loaded in-process
+    model.inverse_dynamics(q, qd, qdd)               # (n,) or (N, n)
 """
 
+from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.load import builtin_names, load
 from robodyn.robot.model import Drive, Friction, Joint, Link, Robot
 from robodyn.symbolic.eom import EquationsOfMotion, derive
@@ -17,8 +20,10 @@ __all__ = [
     "Friction",
     "Joint",
     "Link",
+    "Model",
     "Robot",
     "builtin_names",
+    "compile_model",
     "derive",
     "load",
 ]

@@ -13,6 +13,7 @@ import sympy as sp
 
 from robodyn import spatial as S
 from robodyn.robot.model import Joint, Robot
+from robodyn.symbolic.program import Recorder
 
 
 def joint_symbols(n: int) -> tuple[tuple[sp.Symbol, ...], tuple[sp.Symbol, ...], tuple[sp.Symbol, ...]]:
@@ -61,16 +62,28 @@ class Kinematics:
     end_effector: sp.ImmutableMatrix
 
 
-def forward_kinematics(robot: Robot, q: Sequence[sp.Expr]) -> Kinematics:
-    """Poses of every link frame, joint frame and the tool in the world frame."""
+def forward_kinematics(robot: Robot, q: Sequence[sp.Expr], rec: Recorder | None = None) -> Kinematics:
+    """Poses of every link frame, joint frame and the tool in the world frame.
+
+    With a :class:`~robodyn.symbolic.program.Recorder` every pose entry becomes an intermediate
+    variable (``T3_14``: link 3, row 1, column 4), which keeps the cost linear in the joint count.
+    """
+    def keep(mat: sp.MatrixBase, name: str) -> sp.ImmutableMatrix:
+        return sp.ImmutableMatrix(mat) if rec is None else rec.matrix(mat, name)
+
     t = sp.ImmutableMatrix(robot.base)
     links, joints = [], []
-    for joint, qi in zip(robot.joints, q, strict=True):
-        jf = sp.ImmutableMatrix(t * joint.pre)
+    for k, (joint, qi) in enumerate(zip(robot.joints, q, strict=True), start=1):
+        # T_joint = T_{i-1} pre_i
+        jf = keep(t * joint.pre, f"Tj{k}")
         joints.append(jf)
-        t = sp.ImmutableMatrix(jf * motion(joint, qi) * joint.post)
+        cos_q = sin_q = None
+        if rec is not None and joint.type == "revolute":
+            cos_q, sin_q = rec.scalar(sp.cos(qi), f"c{k}"), rec.scalar(sp.sin(qi), f"s{k}")
+        # T_i = T_joint motion(q_i) post_i
+        t = keep(jf * motion(joint, qi, cos_q, sin_q) * joint.post, f"T{k}")
         links.append(t)
-    return Kinematics(tuple(links), tuple(joints), sp.ImmutableMatrix(t * robot.tool))
+    return Kinematics(tuple(links), tuple(joints), keep(t * robot.tool, "Ttool"))
 
 
 def joint_axes_world(robot: Robot, kin: Kinematics) -> list[sp.ImmutableMatrix]:

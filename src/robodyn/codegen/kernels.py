@@ -1,0 +1,279 @@
+"""The functions every code generator emits, as language-neutral straight-line programs.
+
+A :class:`Kernel` is one generated function: named array arguments in, named arrays out, and a
+body of scalar assignments (after parameter folding and common-subexpression elimination). The
+printers of :mod:`robodyn.codegen` only translate kernels; what is computed is decided here.
+
+Kernels (``n`` joints, all arrays row-major)::
+
+    inverse_dynamics(q, qd, qdd) -> tau (n)       M qdd + C qd + g + friction (rotor included)
+    mass_matrix(q)               -> M (n, n)      composite-rigid-body algorithm + G^2 J_m
+    gravity(q)                   -> g (n)
+    coriolis(q, qd)              -> c (n)         C(q, qd) qd
+    forward_dynamics(q, qd, tau) -> qdd (n)       Cholesky of M, unrolled: no general inverse
+    state_derivative(x, u)       -> xd (2 n)      x = [q; qd], u = tau
+    forward_kinematics(q)        -> T (4, 4)      end-effector pose in the base frame
+    jacobian(q)                  -> J (6, n)      [v; omega] of the tool origin, base frame
+    regressor(q, qd, qdd)        -> Y (n, 15 n)   Y @ params == tau
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import sympy as sp
+
+from robodyn.codegen import optimize as opt
+from robodyn.robot.model import Robot
+from robodyn.symbolic import crba
+from robodyn.symbolic import newton_euler as ne
+from robodyn.symbolic.kinematics import end_effector_jacobian, forward_kinematics, joint_symbols
+from robodyn.symbolic.program import Recorder
+from robodyn.symbolic.regressor import friction_columns, reflected_rotor_inertia, regressor
+
+
+@dataclass(frozen=True)
+class Argument:
+    """A named array argument of a kernel.
+
+    Attributes
+    ----------
+    name : str
+        Array name in the generated code (``q``, ``tau``, ``M``).
+    shape : tuple of int
+        ``(n,)`` or ``(rows, cols)``; stored row-major (C, NumPy) or indexed ``(i, j)``.
+    entries : tuple of Expr
+        Row-major entries: the scalar symbols an input is unpacked into, or the expressions an
+        output is assigned from.
+    """
+
+    name: str
+    shape: tuple[int, ...]
+    entries: tuple[sp.Expr, ...]
+
+    @property
+    def size(self) -> int:
+        """Number of scalars."""
+        out = 1
+        for d in self.shape:
+            out *= d
+        return out
+
+
+@dataclass(frozen=True)
+class Kernel:
+    """One generated function: ``outputs = f(inputs)`` through a straight-line ``body``.
+
+    Attributes
+    ----------
+    name : str
+    summary : str
+        One line for the generated docstring/comment.
+    inputs, outputs : tuple of Argument
+    body : tuple of (Symbol, Expr)
+        Scalar assignments in evaluation order.
+    """
+
+    name: str
+    summary: str
+    inputs: tuple[Argument, ...]
+    outputs: tuple[Argument, ...]
+    body: tuple[tuple[sp.Symbol, sp.Expr], ...]
+
+    @property
+    def locals(self) -> tuple[sp.Symbol, ...]:
+        """Every scalar the body assigns."""
+        return tuple(s for s, _ in self.body)
+
+
+@dataclass(frozen=True)
+class KernelSet:
+    """All kernels of one robot with numeric parameters.
+
+    Attributes
+    ----------
+    robot_name : str
+    description_hash : str
+        Hash of the robot description the code was generated from.
+    dof : int
+    parameters : tuple of (str, float)
+        The parameter values folded into the code.
+    kernels : tuple of Kernel
+    """
+
+    robot_name: str
+    description_hash: str
+    dof: int
+    parameters: tuple[tuple[str, float], ...]
+    kernels: tuple[Kernel, ...]
+
+    def __getitem__(self, name: str) -> Kernel:
+        for k in self.kernels:
+            if k.name == name:
+                return k
+        raise KeyError(f"no kernel named {name!r}; have {', '.join(k.name for k in self.kernels)}")
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Kernel names in generation order."""
+        return tuple(k.name for k in self.kernels)
+
+
+KERNEL_NAMES = ("inverse_dynamics", "mass_matrix", "gravity", "coriolis", "forward_dynamics",
+                "state_derivative", "forward_kinematics", "jacobian", "regressor")
+
+
+def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
+                  names: Sequence[str] = KERNEL_NAMES) -> KernelSet:
+    """Straight-line programs of every generated function for ``robot``.
+
+    Parameters
+    ----------
+    robot : Robot
+    parameters : mapping of str to float, optional
+        Overrides of the robot's parameter defaults (every named parameter must end up numeric).
+    names : sequence of str
+        Which kernels to build (default: all of :data:`KERNEL_NAMES`).
+
+    Returns
+    -------
+    KernelSet
+    """
+    unknown = [k for k in (parameters or {}) if k not in robot.parameters]
+    if unknown:
+        raise ValueError(f"robot {robot.name!r} has no parameter(s) {', '.join(unknown)}; "
+                         f"it has {', '.join(robot.parameters) or 'none'}")
+    merged = {**robot.parameters, **(parameters or {})}
+    values = {sp.Symbol(k, real=True): float(v) for k, v in merged.items()}
+    n = robot.dof
+    q, qd, qdd = joint_symbols(n)
+    u = sp.symbols(f"u1:{n + 1}", real=True)
+    inputs = {"q": _arg("q", q), "qd": _arg("qd", qd), "qdd": _arg("qdd", qdd), "tau": _arg("tau", u)}
+    reserved = {s.name for s in (*q, *qd, *qdd, *u)} | set(merged) | set(KERNEL_NAMES)
+    reserved |= {"q", "qd", "qdd", "tau", "M", "g", "c", "T", "J", "Y", "xd", "u", "qdd_out"}
+
+    def fd_outputs(rec: Recorder) -> list[sp.Expr]:
+        return _forward_dynamics(robot, q, qd, u, rec)
+
+    builders: dict[str, tuple[str, tuple[Argument, ...], str, tuple[int, ...],
+                              Callable[[Recorder], Sequence[sp.Expr]]]] = {
+        "inverse_dynamics": (
+            "Inverse dynamics tau = M(q) qdd + C(q, qd) qd + g(q) + friction(qd), N m or N",
+            (inputs["q"], inputs["qd"], inputs["qdd"]), "tau", (n,),
+            lambda rec: list(_tau_full(robot, q, qd, qdd, rec))),
+        "mass_matrix": (
+            "Joint-space inertia matrix M(q) including reflected rotor inertia",
+            (inputs["q"],), "M", (n, n),
+            lambda rec: list(_mass_matrix(robot, q, rec))),
+        "gravity": (
+            "Gravity load g(q): the joint torques that hold the arm still",
+            (inputs["q"],), "g", (n,),
+            lambda rec: list(ne.gravity_torque(robot, q, rec))),
+        "coriolis": (
+            "Coriolis and centrifugal torques C(q, qd) qd",
+            (inputs["q"], inputs["qd"]), "c", (n,),
+            lambda rec: list(ne.inverse_dynamics(robot, q, qd, [0] * n, rec, with_gravity=False))),
+        "forward_dynamics": (
+            "Forward dynamics qdd = M^-1 (tau - C qd - g - friction) by Cholesky of M",
+            (inputs["q"], inputs["qd"], inputs["tau"]), "qdd", (n,), fd_outputs),
+        "state_derivative": (
+            "State derivative xd = [qd; qdd] of x = [q; qd] under joint torques u",
+            (_arg("x", (*q, *qd)), _arg("u", u)), "xd", (2 * n,),
+            lambda rec: [*qd, *fd_outputs(rec)]),
+        "forward_kinematics": (
+            "Pose of the end effector (tool frame) in the base frame, 4x4 homogeneous",
+            (inputs["q"],), "T", (4, 4),
+            lambda rec: list(forward_kinematics(robot, q, rec).end_effector)),
+        "jacobian": (
+            "Geometric Jacobian [v; omega] of the tool origin in the base frame",
+            (inputs["q"],), "J", (6, n),
+            lambda rec: list(end_effector_jacobian(robot, forward_kinematics(robot, q, rec)))),
+        "regressor": (
+            "Regressor Y(q, qd, qdd) with Y @ params == tau (15 parameters per joint)",
+            (inputs["q"], inputs["qd"], inputs["qdd"]), "Y", (n, 15 * n),
+            lambda rec: list(regressor(robot, q, qd, qdd, rec))),
+    }
+    kernels = []
+    for name in names:
+        if name not in builders:
+            raise ValueError(f"unknown kernel {name!r}; choose from {', '.join(KERNEL_NAMES)}")
+        summary, ins, out_name, shape, build = builders[name]
+        rec = Recorder(reserved)
+        outs = build(rec)
+        body, outs = opt.fold_parameters(rec.assignments, outs, values)
+        body, outs = opt.eliminate_common_subexpressions(body, outs)
+        rename = opt.safe_names(body, reserved)
+        if rename:
+            body = [(rename.get(s, s), e.xreplace(rename)) for s, e in body]
+            outs = [sp.sympify(o).xreplace(rename) for o in outs]
+        kernels.append(Kernel(name, summary, ins, (Argument(out_name, shape, tuple(outs)),),
+                              tuple(body)))
+    params = tuple((k, float(v)) for k, v in sorted(merged.items()))
+    return KernelSet(robot.name, robot.description_hash, n, params, tuple(kernels))
+
+
+def _arg(name: str, symbols: Sequence[sp.Symbol]) -> Argument:
+    return Argument(name, (len(symbols),), tuple(symbols))
+
+
+def _friction(robot: Robot, qd: Sequence[sp.Expr]) -> list[sp.Expr]:
+    out = []
+    for joint, qdj in zip(robot.joints, qd, strict=True):
+        fr = joint.friction
+        coeffs = (fr.viscous, fr.coulomb_positive, fr.coulomb_negative, fr.offset)
+        # tau_f = Fv qd + Fc+ H(qd) - Fc- H(-qd) + offset
+        out.append(sum((c * col for c, col in zip(coeffs, friction_columns(qdj), strict=True)),
+                       sp.Integer(0)))
+    return out
+
+
+def _tau_full(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Expr], qdd: Sequence[sp.Expr],
+              rec: Recorder) -> list[sp.Expr]:
+    rigid = ne.inverse_dynamics(robot, q, qd, qdd, rec)
+    fric = _friction(robot, qd)
+    # tau = tau_rigid + G^2 J_m qdd + tau_f
+    return [rigid[j] + reflected_rotor_inertia(robot, j) * qdd[j] + fric[j] for j in range(robot.dof)]
+
+
+def _mass_matrix(robot: Robot, q: Sequence[sp.Symbol], rec: Recorder) -> sp.Matrix:
+    m = sp.Matrix(crba.mass_matrix(robot, q, rec))
+    for j in range(robot.dof):
+        # M_jj += G_j^2 J_m,j
+        m[j, j] += reflected_rotor_inertia(robot, j)
+    return m
+
+
+def _forward_dynamics(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
+                      tau: Sequence[sp.Symbol], rec: Recorder) -> list[sp.Expr]:
+    """qdd by an unrolled Cholesky factorisation ``M = L L^T`` and two triangular solves."""
+    n = robot.dof
+    m = _mass_matrix(robot, q, rec)
+    # b = tau - (C qd + g + friction): inverse dynamics at qdd = 0
+    rec.prefix = "h_"
+    bias = _tau_full(robot, q, qd, [0] * n, rec)
+    rec.prefix = ""
+    b = [rec.scalar(tau[j] - bias[j], f"b{j + 1}") for j in range(n)]
+    lower: dict[tuple[int, int], sp.Expr] = {}
+    inv_diag: list[sp.Expr] = []
+    for j in range(n):
+        # L_jj = sqrt(M_jj - sum_k L_jk^2)
+        d = m[j, j] - sum((lower[j, k] ** 2 for k in range(j)), sp.Integer(0))
+        ljj = rec.scalar(sp.sqrt(d), f"L{j + 1}_{j + 1}")
+        inv_diag.append(rec.scalar(1 / ljj, f"iL{j + 1}"))
+        lower[j, j] = ljj
+        for i in range(j + 1, n):
+            # L_ij = (M_ij - sum_k L_ik L_jk) / L_jj
+            s = m[i, j] - sum((lower[i, k] * lower[j, k] for k in range(j)), sp.Integer(0))
+            lower[i, j] = rec.scalar(s * inv_diag[j], f"L{i + 1}_{j + 1}")
+    y: list[sp.Expr] = []
+    for i in range(n):
+        # L y = b
+        y.append(rec.scalar((b[i] - sum((lower[i, k] * y[k] for k in range(i)), sp.Integer(0)))
+                            * inv_diag[i], f"y{i + 1}"))
+    x: list[sp.Expr] = [sp.Integer(0)] * n
+    for i in reversed(range(n)):
+        # L^T qdd = y
+        x[i] = rec.scalar((y[i] - sum((lower[k, i] * x[k] for k in range(i + 1, n)), sp.Integer(0)))
+                          * inv_diag[i], f"qddot{i + 1}")
+    return x

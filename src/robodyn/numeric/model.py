@@ -1,0 +1,327 @@
+"""``compile_model``: a robot's generated kernels, loaded in-process behind batched NumPy calls.
+
+Array rules (DESIGN.md): one state is ``(n,)``, a batch is ``(N, n)``; results are ``(n,)``,
+``(n, n)``, ``(4, 4)`` for one state and gain a leading ``N`` for a batch, whatever the values.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import os
+import sys
+import tempfile
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import ModuleType
+from typing import Literal
+
+import numpy as np
+
+from robodyn.codegen.build import CompiledLibrary, cache_dir, compile_library
+from robodyn.codegen.c import CPrinter
+from robodyn.codegen.kernels import KernelSet, build_kernels
+from robodyn.codegen.python import PythonPrinter
+from robodyn.robot.model import Robot
+
+Backend = Literal["c", "numpy"]
+_PREFIX = "rd_"
+
+
+@dataclass(frozen=True)
+class Model:
+    """Numeric dynamics and kinematics of one robot with fixed parameter values.
+
+    Built by :func:`compile_model`. Every method accepts one state ``(n,)`` or a batch ``(N, n)``.
+
+    Attributes
+    ----------
+    robot : Robot
+    backend : {"c", "numpy"}
+    kernels : KernelSet
+        The generated programs (printable in any language by :mod:`robodyn.codegen`).
+    """
+
+    robot: Robot
+    backend: str
+    kernels: KernelSet = field(repr=False)
+    _impl: CompiledLibrary | ModuleType = field(repr=False, compare=False)
+
+    @property
+    def dof(self) -> int:
+        """Number of joints n."""
+        return self.kernels.dof
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        """The parameter values compiled into the model."""
+        return dict(self.kernels.parameters)
+
+    # --- public kernels ------------------------------------------------------------------------
+    def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """Joint torques ``tau = M qdd + C qd + g + friction``, shape like ``q`` (N m or N)."""
+        return self._call("inverse_dynamics", q, qd, qdd)
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """Joint-space inertia (rotor inertia included), (n, n) or (N, n, n)."""
+        return self._call("mass_matrix", q)
+
+    def gravity(self, q: np.ndarray) -> np.ndarray:
+        """Gravity load ``g(q)``: the torques that hold the arm still, shape like ``q``."""
+        return self._call("gravity", q)
+
+    def coriolis(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """Coriolis and centrifugal torques ``C(q, qd) qd``, shape like ``q``."""
+        return self._call("coriolis", q, qd)
+
+    def forward_dynamics(self, q: np.ndarray, qd: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """Joint accelerations ``qdd = M^-1 (tau - C qd - g - friction)``, shape like ``q``."""
+        return self._call("forward_dynamics", q, qd, tau)
+
+    def state_derivative(self, x: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """``[qd, qdd]`` of the state ``x = [q, qd]``, (2 n,) or (N, 2 n)."""
+        return self._call("state_derivative", x, tau)
+
+    def forward_kinematics(self, q: np.ndarray) -> np.ndarray:
+        """End-effector pose in the base frame, (4, 4) or (N, 4, 4)."""
+        return self._call("forward_kinematics", q)
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """Geometric Jacobian ``[v; omega]`` of the tool origin, base frame, (6, n) or (N, 6, n)."""
+        return self._call("jacobian", q)
+
+    def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """Regressor ``Y`` with ``Y @ params == tau``, (n, 15 n) or (N, n, 15 n)."""
+        return self._call("regressor", q, qd, qdd)
+
+    def integrate(self, x0: np.ndarray, steps: int, dt: float, method: str = "rk4", *,
+                  feedforward: np.ndarray | None = None, reference: np.ndarray | None = None,
+                  gain: np.ndarray | None = None, integral_gain: np.ndarray | None = None,
+                  mode: str = "feedback", tau_limit: np.ndarray | None = None,
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """Fixed-step trajectory with a sampled state-feedback law, in one call.
+
+        At step k the torque is held over the step (a digital controller at the integration
+        rate); ``e = reference[k] - x``::
+
+            "feedback":         tau = feedforward[k] + gain e + integral_gain * integral(e_q dt)
+            "gravity":          the same + g(q)
+            "computed_torque":  tau = M(q) (feedforward[k] + gain e) + C qd + g + friction
+
+        then clipped to ``+-tau_limit``.
+
+        Parameters
+        ----------
+        x0 : (2 n,)
+            Initial ``[q, qd]``.
+        steps : int
+        dt : float
+            Step (s).
+        method : {"rk4", "semi_implicit"}
+            Classical RK4, or semi-implicit (symplectic) Euler.
+        feedforward : (steps, n), optional
+            Torques, or accelerations under "computed_torque".
+        reference : (steps, 2 n), optional
+            Desired ``[q, qd]`` per step.
+        gain : (n, 2 n), optional
+            State-feedback gain (``[Kp, Kd]`` for PD, an LQR gain, ...).
+        integral_gain : (n,), optional
+        mode : {"feedback", "gravity", "computed_torque"}
+        tau_limit : (n,), optional
+            Actuator limits (N m or N), positive.
+
+        Returns
+        -------
+        x : (steps + 1, 2 n)
+            States, ``x[0] = x0``.
+        tau : (steps, n)
+            Applied torques.
+
+        Raises
+        ------
+        FloatingPointError
+            When the state stops being finite (the step is named).
+        """
+        n, nx = self.dof, 2 * self.dof
+        methods = {"rk4": 0, "semi_implicit": 1}
+        modes = {"feedback": 0, "gravity": 1, "computed_torque": 2}
+        if method not in methods:
+            raise ValueError(f"unknown fixed-step method {method!r}; choose {', '.join(methods)}")
+        if mode not in modes:
+            raise ValueError(f"unknown controller mode {mode!r}; choose {', '.join(modes)}")
+        arrays = {
+            "x0": (x0, (nx,)), "feedforward": (feedforward, (steps, n)),
+            "reference": (reference, (steps, nx)), "gain": (gain, (n, nx)),
+            "integral_gain": (integral_gain, (n,)), "tau_limit": (tau_limit, (n,)),
+        }
+        checked: dict[str, np.ndarray | None] = {}
+        for key, (val, shape) in arrays.items():
+            if val is None:
+                checked[key] = None
+                continue
+            arr = np.ascontiguousarray(val, dtype=np.float64)
+            if arr.shape != shape:
+                raise ValueError(f"integrate: {key} must have shape {shape}, got {arr.shape}")
+            checked[key] = arr
+        x_out = np.empty((steps + 1, nx))
+        tau_out = np.empty((steps, n))
+        if isinstance(self._impl, ModuleType):
+            status = _integrate_numpy(self, steps, dt, methods[method], modes[mode], checked, x_out,
+                                      tau_out)
+        else:
+            ffi = self._impl.ffi
+            ptr = {k: (ffi.NULL if v is None else ffi.from_buffer("double[]", v))
+                   for k, v in checked.items()}
+            status = self._impl.lib.rd_simulate(
+                steps, float(dt), methods[method], ptr["x0"], ptr["feedforward"], ptr["reference"],
+                ptr["gain"], ptr["integral_gain"], modes[mode], ptr["tau_limit"],
+                ffi.from_buffer("double[]", x_out), ffi.from_buffer("double[]", tau_out))
+        if status:
+            raise FloatingPointError(f"the simulated state stopped being finite at step {status - 1} "
+                                     f"(t = {(status - 1) * dt:g} s); reduce dt or check the inputs")
+        return x_out, tau_out
+
+    # --- plumbing ------------------------------------------------------------------------------
+    def _call(self, name: str, *arrays: np.ndarray) -> np.ndarray:
+        kernel = self.kernels[name]
+        batch_shape: tuple[int, ...] | None = None
+        args = []
+        for spec, value in zip(kernel.inputs, arrays, strict=True):
+            arr = np.asarray(value, dtype=np.float64)
+            width = spec.shape[0]
+            if arr.ndim not in (1, 2) or arr.shape[-1] != width:
+                raise ValueError(f"{name}: {spec.name} must have shape ({width},) or (N, {width}), "
+                                 f"got {arr.shape}")
+            if batch_shape is None:
+                batch_shape = arr.shape[:-1]
+            elif arr.shape[:-1] != batch_shape:
+                raise ValueError(f"{name}: {spec.name} has shape {arr.shape}, but the first "
+                                 f"argument's batch shape is {batch_shape}")
+            args.append(arr)
+        assert batch_shape is not None
+        out_shape = batch_shape + kernel.outputs[0].shape
+        if isinstance(self._impl, ModuleType):
+            return getattr(self._impl, name)(*args).reshape(out_shape)
+        ffi, lib = self._impl.ffi, self._impl.lib
+        # C-contiguous float64 inputs are passed without a copy
+        args = [np.ascontiguousarray(a) for a in args]
+        out = np.empty(out_shape)
+        ptrs = [ffi.from_buffer("double[]", a) for a in args]
+        out_ptr = ffi.from_buffer("double[]", out)
+        if batch_shape:
+            getattr(lib, f"{_PREFIX}{name}_batch")(batch_shape[0], *ptrs, out_ptr)
+        else:
+            getattr(lib, f"{_PREFIX}{name}")(*ptrs, out_ptr)
+        return out
+
+
+def compile_model(robot: Robot, backend: Backend = "c", *,
+                  parameters: Mapping[str, float] | None = None) -> Model:
+    """Generate, compile (cached) and load the numeric model of ``robot``.
+
+    Parameters
+    ----------
+    robot : Robot
+    backend : {"c", "numpy"}
+        "c": generated C99 compiled with the system compiler into the cache (see
+        :func:`robodyn.codegen.build.cache_dir`), called through cffi. "numpy": the generated
+        NumPy module, no compiler needed.
+    parameters : mapping of str to float, optional
+        Values overriding the robot's parameter defaults.
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    CompilerNotFoundError
+        With ``backend="c"`` and no C compiler (the message names the NumPy fallback).
+    """
+    if backend not in ("c", "numpy"):
+        raise ValueError(f"unknown backend {backend!r}; choose 'c' (compiled) or 'numpy'")
+    kset = _kernels_cached(robot, parameters)
+    if backend == "c":
+        printer = CPrinter(_PREFIX)
+        impl: CompiledLibrary | ModuleType = compile_library(
+            printer.source(kset), printer.declarations(kset))
+    else:
+        impl = _load_python(PythonPrinter().module(kset))
+    return Model(robot, backend, kset, impl)
+
+
+_KERNEL_MEMO: dict[tuple[str, tuple], KernelSet] = {}
+
+
+def _kernels_cached(robot: Robot, parameters: Mapping[str, float] | None) -> KernelSet:
+    """Kernels are deterministic in (description, parameters): derive them once per process."""
+    key = (robot.description_hash, tuple(sorted((parameters or {}).items())))
+    if key not in _KERNEL_MEMO:
+        _KERNEL_MEMO[key] = build_kernels(robot, parameters)
+    return _KERNEL_MEMO[key]
+
+
+def _load_python(source: str) -> ModuleType:
+    """Import generated NumPy code from a cached file (written atomically)."""
+    digest = hashlib.sha256(source.encode()).hexdigest()[:24]
+    path = cache_dir() / f"rd_{digest}.py"
+    if not path.exists():
+        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".py.tmp")
+        with os.fdopen(fd, "w") as fh:
+            fh.write(source)
+        os.replace(tmp, path)
+    name = f"robodyn_generated_{digest}"
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.spec_from_file_location(name, path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    sys.modules[name] = module
+    return module
+
+
+__all__ = ["Model", "compile_model"]
+
+
+def _integrate_numpy(model: Model, steps: int, dt: float, method: int, mode: int,
+                     a: dict[str, np.ndarray | None], x_out: np.ndarray, tau_out: np.ndarray) -> int:
+    """The NumPy twin of the generated C ``simulate`` (same law, same steps); returns its status."""
+    n = model.dof
+    x = a["x0"].copy()
+    x_out[0] = x
+    integ = np.zeros(n)
+    zero = np.zeros(n)
+    for k in range(steps):
+        # e = reference_k - x
+        e = (a["reference"][k] if a["reference"] is not None else 0.0) - x
+        integ += np.broadcast_to(e, (2 * n,))[:n] * dt
+        v = a["feedforward"][k].copy() if a["feedforward"] is not None else np.zeros(n)
+        if a["gain"] is not None:
+            v += a["gain"] @ np.broadcast_to(e, (2 * n,))
+        if a["integral_gain"] is not None:
+            v += a["integral_gain"] * integ
+        if mode == 2:
+            # tau = M(q) v + (C qd + g + friction)
+            tau = model.mass_matrix(x[:n]) @ v + model.inverse_dynamics(x[:n], x[n:], zero)
+        else:
+            tau = v
+        if mode == 1:
+            tau = tau + model.gravity(x[:n])
+        if a["tau_limit"] is not None:
+            tau = np.clip(tau, -a["tau_limit"], a["tau_limit"])
+        f = model.state_derivative
+        if method == 0:
+            k1 = f(x, tau)
+            k2 = f(x + 0.5 * dt * k1, tau)
+            k3 = f(x + 0.5 * dt * k2, tau)
+            k4 = f(x + dt * k3, tau)
+            x = x + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        else:
+            qd = x[n:] + dt * f(x, tau)[n:]
+            x = np.concatenate([x[:n] + dt * qd, qd])
+        if not np.all(np.isfinite(x)):
+            return k + 1
+        x_out[k + 1] = x
+        tau_out[k] = tau
+    return 0
