@@ -124,6 +124,25 @@ KERNEL_NAMES = ("inverse_dynamics", "mass_matrix", "gravity", "coriolis", "forwa
                 "state_derivative", "forward_kinematics", "jacobian", "regressor")
 
 
+def kernel_signature(name: str, n: int) -> tuple[tuple[tuple[str, int], ...], tuple[int, ...]]:
+    """``((input name, width), ...), output shape`` of kernel ``name`` for ``n`` joints."""
+    q, qd, qdd, tau = ("q", n), ("qd", n), ("qdd", n), ("tau", n)
+    table: dict[str, tuple[tuple[tuple[str, int], ...], tuple[int, ...]]] = {
+        "inverse_dynamics": ((q, qd, qdd), (n,)),
+        "mass_matrix": ((q,), (n, n)),
+        "gravity": ((q,), (n,)),
+        "coriolis": ((q, qd), (n,)),
+        "forward_dynamics": ((q, qd, tau), (n,)),
+        "state_derivative": ((("x", 2 * n), ("u", n)), (2 * n,)),
+        "forward_kinematics": ((q,), (4, 4)),
+        "jacobian": ((q,), (6, n)),
+        "regressor": ((q, qd, qdd), (n, 15 * n)),
+    }
+    if name not in table:
+        raise ValueError(f"unknown kernel {name!r}; choose from {', '.join(KERNEL_NAMES)}")
+    return table[name]
+
+
 def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
                   names: Sequence[str] = KERNEL_NAMES) -> KernelSet:
     """Straight-line programs of every generated function for ``robot``.

@@ -13,6 +13,8 @@ import sys
 import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
 from types import ModuleType
 from typing import Literal
 
@@ -20,7 +22,7 @@ import numpy as np
 
 from robodyn.codegen.build import CompiledLibrary, cache_dir, compile_library
 from robodyn.codegen.c import CPrinter
-from robodyn.codegen.kernels import KernelSet, build_kernels
+from robodyn.codegen.kernels import KernelSet, build_kernels, kernel_signature
 from robodyn.codegen.python import PythonPrinter
 from robodyn.robot.model import Robot
 
@@ -28,7 +30,7 @@ Backend = Literal["c", "numpy"]
 _PREFIX = "rd_"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Model:
     """Numeric dynamics and kinematics of one robot with fixed parameter values.
 
@@ -38,24 +40,29 @@ class Model:
     ----------
     robot : Robot
     backend : {"c", "numpy"}
-    kernels : KernelSet
-        The generated programs (printable in any language by :mod:`robodyn.codegen`).
+    parameter_values : tuple of (str, float)
+        The parameter values compiled in.
     """
 
     robot: Robot
     backend: str
-    kernels: KernelSet = field(repr=False)
+    parameter_values: tuple[tuple[str, float], ...]
     _impl: CompiledLibrary | ModuleType = field(repr=False, compare=False)
 
     @property
     def dof(self) -> int:
         """Number of joints n."""
-        return self.kernels.dof
+        return self.robot.dof
 
     @property
     def parameters(self) -> dict[str, float]:
         """The parameter values compiled into the model."""
-        return dict(self.kernels.parameters)
+        return dict(self.parameter_values)
+
+    @cached_property
+    def kernels(self) -> KernelSet:
+        """The generated programs (printable in any language by :mod:`robodyn.codegen`)."""
+        return _kernels_cached(self.robot, self.parameters)
 
     # --- public kernels ------------------------------------------------------------------------
     def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
@@ -183,23 +190,22 @@ class Model:
 
     # --- plumbing ------------------------------------------------------------------------------
     def _call(self, name: str, *arrays: np.ndarray) -> np.ndarray:
-        kernel = self.kernels[name]
+        inputs, result_shape = kernel_signature(name, self.dof)
         batch_shape: tuple[int, ...] | None = None
         args = []
-        for spec, value in zip(kernel.inputs, arrays, strict=True):
+        for (arg_name, width), value in zip(inputs, arrays, strict=True):
             arr = np.asarray(value, dtype=np.float64)
-            width = spec.shape[0]
             if arr.ndim not in (1, 2) or arr.shape[-1] != width:
-                raise ValueError(f"{name}: {spec.name} must have shape ({width},) or (N, {width}), "
+                raise ValueError(f"{name}: {arg_name} must have shape ({width},) or (N, {width}), "
                                  f"got {arr.shape}")
             if batch_shape is None:
                 batch_shape = arr.shape[:-1]
             elif arr.shape[:-1] != batch_shape:
-                raise ValueError(f"{name}: {spec.name} has shape {arr.shape}, but the first "
+                raise ValueError(f"{name}: {arg_name} has shape {arr.shape}, but the first "
                                  f"argument's batch shape is {batch_shape}")
             args.append(arr)
         assert batch_shape is not None
-        out_shape = batch_shape + kernel.outputs[0].shape
+        out_shape = batch_shape + result_shape
         if isinstance(self._impl, ModuleType):
             return getattr(self._impl, name)(*args).reshape(out_shape)
         ffi, lib = self._impl.ffi, self._impl.lib
@@ -240,14 +246,49 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
     """
     if backend not in ("c", "numpy"):
         raise ValueError(f"unknown backend {backend!r}; choose 'c' (compiled) or 'numpy'")
-    kset = _kernels_cached(robot, parameters)
+    unknown = [k for k in (parameters or {}) if k not in robot.parameters]
+    if unknown:
+        raise ValueError(f"robot {robot.name!r} has no parameter(s) {', '.join(unknown)}; "
+                         f"it has {', '.join(robot.parameters) or 'none'}")
+    values = {k: float(v) for k, v in {**robot.parameters, **(parameters or {})}.items()}
+    # generated sources are cached by (description, parameter values, generator source)
+    key = hashlib.sha256(repr((robot.description_hash, sorted(values.items()), backend,
+                               _generator_hash())).encode()).hexdigest()[:24]
+    directory = cache_dir()
     if backend == "c":
-        printer = CPrinter(_PREFIX)
-        impl: CompiledLibrary | ModuleType = compile_library(
-            printer.source(kset), printer.declarations(kset))
+        src, decl = directory / f"rd_model_{key}.c", directory / f"rd_model_{key}.cdef"
+        if not (src.exists() and decl.exists()):
+            kset = _kernels_cached(robot, values)
+            printer = CPrinter(_PREFIX)
+            _write_atomic(decl, printer.declarations(kset))
+            _write_atomic(src, printer.source(kset))
+        impl: CompiledLibrary | ModuleType = compile_library(src.read_text(), decl.read_text())
     else:
-        impl = _load_python(PythonPrinter().module(kset))
-    return Model(robot, backend, kset, impl)
+        path = directory / f"rd_model_{key}.py"
+        if not path.exists():
+            _write_atomic(path, PythonPrinter().module(_kernels_cached(robot, values)))
+        impl = _import_file(path, f"robodyn_generated_{key}")
+    return Model(robot, backend, tuple(sorted(values.items())), impl)
+
+
+def _generator_hash() -> str:
+    """Hash of the source files that decide what is generated (cache invalidation)."""
+    import robodyn.codegen as codegen_pkg
+    import robodyn.symbolic as symbolic_pkg
+
+    digest = hashlib.sha256()
+    for pkg in (codegen_pkg, symbolic_pkg):
+        for path in sorted(Path(pkg.__file__).parent.glob("*.py")):
+            digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` so that readers see the old file or the whole new one."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+    with os.fdopen(fd, "w") as fh:
+        fh.write(text)
+    os.replace(tmp, path)
 
 
 _KERNEL_MEMO: dict[tuple[str, tuple], KernelSet] = {}
@@ -261,16 +302,8 @@ def _kernels_cached(robot: Robot, parameters: Mapping[str, float] | None) -> Ker
     return _KERNEL_MEMO[key]
 
 
-def _load_python(source: str) -> ModuleType:
-    """Import generated NumPy code from a cached file (written atomically)."""
-    digest = hashlib.sha256(source.encode()).hexdigest()[:24]
-    path = cache_dir() / f"rd_{digest}.py"
-    if not path.exists():
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".py.tmp")
-        with os.fdopen(fd, "w") as fh:
-            fh.write(source)
-        os.replace(tmp, path)
-    name = f"robodyn_generated_{digest}"
+def _import_file(path: Path, name: str) -> ModuleType:
+    """Import a generated NumPy module (once per process)."""
     if name in sys.modules:
         return sys.modules[name]
     spec = importlib.util.spec_from_file_location(name, path)

@@ -1,0 +1,192 @@
+"""Compiled models: C and NumPy backends against the symbolic equations and Pinocchio."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import warnings
+
+import numpy as np
+import pytest
+
+import robodyn as rd
+from robodyn.codegen.build import CompilerNotFoundError
+from robodyn.symbolic.regressor import reflected_rotor_inertia
+from tests.numeric_eval import evaluator, program_evaluator
+from tests.urdf_chains import pin_q, random_urdf
+
+ROBOTS = ["puma560", "puma560_akb", "aa300", "planar_2r", "trolley_double_pendulum", "kinova_gen3"]
+
+
+def load_quiet(name):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return rd.load(name)
+
+
+@pytest.fixture(scope="module", params=ROBOTS)
+def compiled(request):
+    robot = load_quiet(request.param)
+    eom = rd.derive(robot, method="newton_euler")
+    return robot, eom, rd.compile_model(robot), rd.compile_model(robot, backend="numpy")
+
+
+def states(n, count=5, seed=3):
+    rng = np.random.default_rng(seed)
+    return rng.uniform(-2, 2, (count, n)), rng.uniform(-2, 2, (count, n)), rng.uniform(-2, 2, (count, n))
+
+
+def close(a, b, rtol=1e-10):
+    """Relative agreement, scaled by the largest entry (torques mix N m and N)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    scale = max(1.0, float(np.abs(b).max()))
+    np.testing.assert_allclose(a, b, rtol=0, atol=rtol * scale)
+
+
+def test_backends_agree_with_the_symbolic_equations(compiled):
+    robot, eom, c_model, np_model = compiled
+    n = robot.dof
+    f_m = program_evaluator(eom, eom.M_rigid_form)
+    f_g = program_evaluator(eom, eom.g_form)
+    f_rigid = program_evaluator(eom, eom.program)
+    f_fric = evaluator(eom, eom.friction)
+    f_fk = evaluator(eom, eom.fk)
+    f_jac = evaluator(eom, eom.jacobian)
+    rotor = np.diag([float(reflected_rotor_inertia(robot, j).xreplace(eom.numeric())) for j in range(n)])
+    qs, qds, qdds = states(n)
+    batch = {m: (m.inverse_dynamics(qs, qds, qdds), m.mass_matrix(qs), m.gravity(qs),
+                 m.coriolis(qs, qds), m.forward_kinematics(qs), m.jacobian(qs))
+             for m in (c_model, np_model)}
+    for k, (q, qd, qdd) in enumerate(zip(qs, qds, qdds, strict=True)):
+        m_ref = f_m(q) + rotor
+        g_ref = f_g(q).ravel()
+        tau_ref = f_rigid(q, qd, qdd).ravel() + rotor @ qdd + f_fric(q, qd).ravel()
+        c_ref = f_rigid(q, qd, np.zeros(n)).ravel() - g_ref
+        for model in (c_model, np_model):
+            tau, mm, g, c, fk, jac = (out[k] for out in batch[model])
+            close(tau, tau_ref)
+            close(mm, m_ref)
+            close(g, g_ref)
+            close(c, c_ref)
+            close(fk, f_fk(q))
+            close(jac, f_jac(q))
+            # one state gives the same numbers as the batch, with the batch axis dropped
+            close(model.inverse_dynamics(q, qd, qdd), tau)
+            assert model.mass_matrix(q).shape == (n, n)
+
+
+def test_forward_dynamics_inverts_inverse_dynamics(compiled):
+    robot, eom, c_model, np_model = compiled
+    n = robot.dof
+    qs, qds, qdds = states(n, seed=5)
+    for model in (c_model, np_model):
+        tau = model.inverse_dynamics(qs, qds, qdds)
+        close(model.forward_dynamics(qs, qds, tau), qdds, rtol=1e-9)
+        # and against a general solve of M qdd = tau - h
+        h = model.inverse_dynamics(qs, qds, np.zeros_like(qs))
+        ref = np.linalg.solve(model.mass_matrix(qs), (tau - h)[..., None])[..., 0]
+        close(model.forward_dynamics(qs, qds, tau), ref, rtol=1e-9)
+        xd = model.state_derivative(np.hstack([qs, qds]), tau)
+        close(xd[:, :n], qds)
+        close(xd[:, n:], qdds, rtol=1e-9)
+
+
+def test_regressor_reproduces_inverse_dynamics(compiled):
+    robot, eom, c_model, np_model = compiled
+    params = np.array(eom.params.xreplace(eom.numeric()), dtype=float).ravel()
+    qs, qds, qdds = states(robot.dof, seed=7)
+    # friction columns are discontinuous at qd = 0: the random states never hit it
+    for model in (c_model, np_model):
+        close(model.regressor(qs, qds, qdds) @ params, model.inverse_dynamics(qs, qds, qdds))
+
+
+def test_published_puma560_values_from_the_compiled_model():
+    model = rd.compile_model(load_quiet("puma560"))
+    qn = np.array([0, np.pi / 4, -np.pi, 0, np.pi / 4, 0])
+    np.testing.assert_allclose(model.gravity(qn), [0, 31.6399, 6.0351, 0, 0.0283, 0], atol=5e-4)
+    np.testing.assert_allclose(model.mass_matrix(qn)[0], [3.6594, -0.4044, 0.1006, -0.0025, 0, 0],
+                               atol=5e-4)
+
+
+pin = pytest.importorskip("pinocchio")
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_random_chains_match_pinocchio(tmp_path, seed):
+    rng = np.random.default_rng(100 + seed)
+    n = int(rng.integers(2, 7))
+    path = tmp_path / f"chain{seed}.urdf"
+    path.write_text(random_urdf(rng, n))
+    robot = rd.load(path)
+    model = rd.compile_model(robot)
+    pmodel = pin.buildModelFromUrdf(str(path))
+    data = pmodel.createData()
+    qs, qds, qdds = (rng.uniform(-2, 2, (4, n)) for _ in range(3))
+    taus = model.inverse_dynamics(qs, qds, qdds)
+    qdd_fd = model.forward_dynamics(qs, qds, taus)
+    poses = model.forward_kinematics(qs)
+    for k in range(4):
+        pq = pin_q(pmodel, qs[k])
+        close(taus[k], pin.rnea(pmodel, data, pq, qds[k], qdds[k]), rtol=1e-9)
+        close(model.mass_matrix(qs[k]), pin.crba(pmodel, data, pq), rtol=1e-9)
+        close(model.gravity(qs[k]), pin.computeGeneralizedGravity(pmodel, data, pq), rtol=1e-9)
+        close(qdd_fd[k], pin.aba(pmodel, data, pq, qds[k], taus[k]), rtol=1e-8)
+        pin.forwardKinematics(pmodel, data, pq)
+        # the URDF has no tool: the end effector is the last link frame
+        close(poses[k], data.oMi[pmodel.njoints - 1].homogeneous, rtol=1e-9)
+
+
+def test_parameters_override_the_defaults():
+    robot = load_quiet("trolley_pendulum")
+    base = rd.compile_model(robot)
+    heavier = rd.compile_model(robot, parameters={"m": 2 * robot.parameters["m"]})
+    q = np.array([0.1, 0.4])
+    assert not np.allclose(base.gravity(q), heavier.gravity(q))
+    # the pendulum's gravity torque is m g l sin(theta): linear in m
+    np.testing.assert_allclose(heavier.gravity(q)[1], 2 * base.gravity(q)[1], rtol=1e-12)
+    with pytest.raises(ValueError, match="no parameter"):
+        rd.compile_model(robot, parameters={"nonexistent": 1.0})
+
+
+def test_bad_shapes_and_backend_are_clear_errors():
+    model = rd.compile_model(load_quiet("planar_2r"))
+    with pytest.raises(ValueError, match=r"q must have shape \(2,\) or \(N, 2\)"):
+        model.mass_matrix(np.zeros(3))
+    with pytest.raises(ValueError, match="batch shape"):
+        model.inverse_dynamics(np.zeros((4, 2)), np.zeros((3, 2)), np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="unknown backend"):
+        rd.compile_model(load_quiet("planar_2r"), backend="fortran")
+
+
+def test_missing_compiler_names_the_numpy_fallback(tmp_path, monkeypatch):
+    monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path))
+    monkeypatch.setenv("PATH", str(tmp_path))
+    monkeypatch.delenv("CC", raising=False)
+    with pytest.raises(CompilerNotFoundError, match="backend='numpy'"):
+        rd.compile_model(load_quiet("planar_2r"))
+    # the fallback itself works without a compiler
+    model = rd.compile_model(load_quiet("planar_2r"), backend="numpy")
+    assert model.mass_matrix(np.zeros(2)).shape == (2, 2)
+
+
+def test_cache_is_reused_and_safe_across_processes(tmp_path):
+    env = {**os.environ, "ROBODYN_CACHE": str(tmp_path)}
+    script = ("import warnings, numpy as np, robodyn as rd; warnings.simplefilter('ignore');"
+              "m = rd.compile_model(rd.load('planar_2r'));"
+              "print(repr(float(m.gravity(np.array([0.3, 0.2]))[0])))")
+    # two processes compiling the same model into an empty cache at the same time
+    procs = [subprocess.Popen([sys.executable, "-c", script], env=env, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    outs = [p.communicate(timeout=300) for p in procs]
+    assert all(p.returncode == 0 for p in procs), [o[1] for o in outs]
+    assert outs[0][0] == outs[1][0]
+    libraries = sorted(tmp_path.glob("rd_*.so"))
+    assert len(libraries) == 1
+    stamp = libraries[0].stat().st_mtime_ns
+    # a third run finds everything in the cache and compiles nothing
+    third = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True,
+                           timeout=300, check=True)
+    assert third.stdout == outs[0][0]
+    assert libraries[0].stat().st_mtime_ns == stamp
+    assert not list(tmp_path.glob(".build-*"))
