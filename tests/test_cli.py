@@ -12,7 +12,8 @@ import pytest
 import sympy as sp
 
 import robodyn as rd
-from robodyn.cli import Agreement, main
+from robodyn.cli import main
+from robodyn.report.agreement import Agreement
 from robodyn.symbolic.render import render_json, render_latex, render_mathml, render_text
 
 NEGATIVE_MASS = """\

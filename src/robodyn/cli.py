@@ -8,79 +8,38 @@ description, unwritable output), 130 interrupted.
 from __future__ import annotations
 
 import argparse
-import csv
-import html
-import io
 import sys
 import textwrap
-import time
 import warnings
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
-from dataclasses import dataclass
-from datetime import UTC, datetime
+from collections.abc import Sequence
 from pathlib import Path
 
-import numpy as np
 import sympy as sp
 
 import robodyn as rd
+from robodyn.report.agreement import (
+    AGREEMENT_HEADERS,
+    COUNT_HEADERS,
+    TOLERANCE,
+    agreement,
+    agreement_rows,
+    count_rows,
+    derive_all,
+)
+from robodyn.report.demo import run_demo
+from robodyn.report.text import err as _err
+from robodyn.report.text import progress as _progress
+from robodyn.report.text import table as _table
 from robodyn.robot.errors import DescriptionError
 from robodyn.symbolic.eom import METHODS
-from robodyn.symbolic.render import render_json, render_latex, render_mathml, render_text
+from robodyn.symbolic.render import render_json, render_latex, render_text
 
-#: Relative difference above which two formulations are reported as disagreeing.
-TOLERANCE = 1e-9
-
-_QUANTITIES = ("M", "g", "tau")
 _RENDERERS = {"text": render_text, "latex": render_latex, "json": render_json}
 
 
 # ----------------------------------------------------------------------------------------------
 # small helpers
 # ----------------------------------------------------------------------------------------------
-
-
-def _err(*args: object) -> None:
-    print(*args, file=sys.stderr, flush=True)
-
-
-@contextmanager
-def _progress(label: str) -> Iterator[None]:
-    """``label... 2.1 s`` on stderr around a long step."""
-    print(f"{label}...", end=" ", file=sys.stderr, flush=True)
-    start = time.perf_counter()
-    try:
-        yield
-    finally:
-        print(f"{time.perf_counter() - start:.1f} s", file=sys.stderr, flush=True)
-
-
-def _table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
-    """Plain aligned text table; numbers right-aligned, text left-aligned."""
-    cells = [[str(c) for c in headers]] + [[str(c) for c in row] for row in rows]
-    numeric = [bool(rows) and all(_is_number(r[k]) for r in rows) for k in range(len(headers))]
-    widths = [max(len(r[k]) for r in cells) for k in range(len(headers))]
-
-    def line(row: list[str]) -> str:
-        return "  ".join(c.rjust(w) if num else c.ljust(w)
-                         for c, w, num in zip(row, widths, numeric, strict=True)).rstrip()
-
-    rule = "  ".join("-" * w for w in widths)
-    return "\n".join([line(cells[0]), rule] + [line(r) for r in cells[1:]])
-
-
-def _is_number(value: object) -> bool:
-    """A number, or the text of one (right-aligned in tables)."""
-    if isinstance(value, bool):
-        return False
-    if isinstance(value, int | float | np.floating):
-        return True
-    try:
-        float(str(value))
-    except ValueError:
-        return False
-    return True
 
 
 def _fmt(expr: object) -> str:
@@ -110,160 +69,6 @@ def _write(text: str, target: str | None) -> None:
     else:
         Path(target).write_text(text, encoding="utf-8")
         _err(f"wrote {target}")
-
-
-# ----------------------------------------------------------------------------------------------
-# agreement of the formulations
-# ----------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Agreement:
-    """Largest relative difference of M, g and tau between two formulations.
-
-    Attributes
-    ----------
-    first, second : str
-        Method names.
-    relative : dict[str, float]
-        ``max over states of max|a - b| / max(max|a|, max|b|)`` per quantity ("M", "g", "tau").
-    symbolic : bool or None
-        Whether every simplified difference is zero (None: not checked).
-    """
-
-    first: str
-    second: str
-    relative: dict[str, float]
-    symbolic: bool | None = None
-
-    @property
-    def ok(self) -> bool:
-        """Within :data:`TOLERANCE` (and symbolically equal where checked)."""
-        return max(self.relative.values()) <= TOLERANCE and self.symbolic is not False
-
-
-def _evaluator(eom: rd.EquationsOfMotion) -> Callable[..., dict[str, np.ndarray]]:
-    """``f(q, qd, qdd) -> {"M": (n, n), "g": (n,), "tau": (n,)}`` at the default parameters.
-
-    One ``sympy.cse`` (which walks shared subtrees once) runs before ``lambdify``, which is
-    handed only the reduced expressions: its own passes walk every expression as a tree, which
-    takes minutes on the (heavily shared) Lagrange expressions of a 6-joint arm.
-    """
-    n = eom.dof
-    values = eom.numeric()
-    params = list(values)
-    exprs = list(eom.M) + list(eom.g) + list(eom.tau)
-    replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_x"), order="none")
-    fn = sp.lambdify([eom.q, eom.qd, eom.qdd, params], reduced, modules="numpy",
-                     cse=lambda _: (replacements, reduced))
-    args = [values[p] for p in params]
-
-    def call(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> dict[str, np.ndarray]:
-        out = np.asarray(fn(q, qd, qdd, args), dtype=float)
-        return {"M": out[: n * n].reshape(n, n), "g": out[n * n: n * n + n],
-                "tau": out[n * n + n:]}
-
-    return call
-
-
-def _states(n: int, count: int, seed: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    rng = np.random.default_rng(seed)
-    return [(rng.uniform(-np.pi, np.pi, n), rng.uniform(-2, 2, n), rng.uniform(-3, 3, n))
-            for _ in range(count)]
-
-
-def _symbolically_equal(a: rd.EquationsOfMotion, b: rd.EquationsOfMotion) -> bool:
-    for name in _QUANTITIES:
-        diff = sp.Matrix(getattr(a, name)) - sp.Matrix(getattr(b, name))
-        if any(sp.simplify(sp.expand(e)) != 0 for e in diff):
-            return False
-    return True
-
-
-def agreement(eoms: Sequence[rd.EquationsOfMotion], samples: int = 20, seed: int = 0,
-              symbolic: bool = False) -> list[Agreement]:
-    """Compare every pair of formulations on random states (and symbolically if asked).
-
-    Parameters
-    ----------
-    eoms : sequence of EquationsOfMotion
-        Equations of one robot by different methods.
-    samples : int
-        Number of random states (q in [-pi, pi], qd in [-2, 2], qdd in [-3, 3]).
-    seed : int
-        Seed of the random states.
-    symbolic : bool
-        Also check that the simplified differences are zero (small arms only: slow).
-
-    Returns
-    -------
-    list of Agreement
-        One per pair, in the order of ``eoms``.
-    """
-    n = eoms[0].dof
-    states = _states(n, samples, seed)
-    values: dict[str, dict[str, list[np.ndarray]]] = {}
-    for eom in eoms:
-        with _progress(f"evaluating {eom.method} on {samples} states"):
-            func = _evaluator(eom)
-            results = [func(*s) for s in states]
-            values[eom.method] = {k: [r[k] for r in results] for k in _QUANTITIES}
-    out = []
-    for i, a in enumerate(eoms):
-        for b in eoms[i + 1:]:
-            rel = {}
-            for k in _QUANTITIES:
-                worst = 0.0
-                for va, vb in zip(values[a.method][k], values[b.method][k], strict=True):
-                    scale = max(np.max(np.abs(va)), np.max(np.abs(vb)))
-                    diff = np.max(np.abs(va - vb))
-                    worst = max(worst, diff / scale if scale > 0 else diff)
-                rel[k] = float(worst)
-            same = None
-            if symbolic:
-                with _progress(f"simplifying {a.method} - {b.method}"):
-                    same = _symbolically_equal(a, b)
-            out.append(Agreement(a.method, b.method, rel, same))
-    return out
-
-
-def _derive_all(robot: rd.Robot) -> list[rd.EquationsOfMotion]:
-    eoms = []
-    for method in METHODS:
-        with _progress(f"deriving {method}"):
-            eoms.append(rd.derive(robot, method))
-    for eom in eoms:
-        with _progress(f"counting operations of {eom.method} (after CSE)"):
-            eom.op_counts()
-    return eoms
-
-
-_COUNT_HEADERS = ("method", "derive [s]", "tau +", "tau *", "tau fn", "M +", "M *", "M fn",
-                  "g +", "g *", "g fn")
-
-
-def _count_rows(eoms: Sequence[rd.EquationsOfMotion]) -> list[list[object]]:
-    rows = []
-    for eom in eoms:
-        counts = eom.op_counts()
-        row: list[object] = [eom.method, f"{eom.derivation_time:.3f}"]
-        for key in ("tau", "M", "g"):
-            ops = counts[key]
-            row += [ops.additions, ops.multiplications, ops.functions]
-        rows.append(row)
-    return rows
-
-
-def _agreement_rows(results: Sequence[Agreement]) -> list[list[object]]:
-    rows = []
-    for r in results:
-        sym = {None: "-", True: "yes", False: "NO"}[r.symbolic]
-        rows.append([f"{r.first} vs {r.second}"] + [f"{r.relative[k]:.1e}" for k in _QUANTITIES]
-                    + [sym, "ok" if r.ok else "DISAGREE"])
-    return rows
-
-
-_AGREEMENT_HEADERS = ("pair", "M", "g", "tau", "symbolic", "result")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -333,175 +138,20 @@ def _cmd_derive(args: argparse.Namespace) -> int:
 def _cmd_check(args: argparse.Namespace) -> int:
     robot = rd.load(args.robot)
     print(f"{robot.name}: {robot.dof} joints ({_types(robot)}), {robot.source}")
-    eoms = _derive_all(robot)
+    eoms = derive_all(robot)
     results = agreement(eoms, args.samples, args.seed, symbolic=robot.dof <= 2)
     print("\nderivation time and operations after common-subexpression elimination")
-    print(_table(_COUNT_HEADERS, _count_rows(eoms)))
+    print(_table(COUNT_HEADERS, count_rows(eoms)))
     print(f"\nagreement: max relative difference over {args.samples} random states "
           f"(tolerance {TOLERANCE:g})")
-    print(_table(_AGREEMENT_HEADERS, _agreement_rows(results)))
+    print(_table(AGREEMENT_HEADERS, agreement_rows(results)))
     ok = all(r.ok for r in results)
     print("\nresult: " + ("the three formulations agree" if ok else "the formulations DISAGREE"))
     return 0 if ok else 1
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    out = Path(args.output)
-    out.mkdir(parents=True, exist_ok=True)
-    robot = rd.load("puma560")
-    eoms = _derive_all(robot)
-    results = agreement(eoms, args.samples, args.seed)
-    by_method = {e.method: e for e in eoms}
-    with _progress("writing puma560_newton_euler.txt"):
-        (out / "puma560_newton_euler.txt").write_text(render_text(by_method["newton_euler"]))
-    for eom in eoms:
-        with _progress(f"writing puma560_{eom.method}.json"):
-            (out / f"puma560_{eom.method}.json").write_text(render_json(eom))
-    with _progress("writing puma560_equations.tex"):
-        (out / "puma560_equations.tex").write_text(render_latex(by_method["newton_euler"]))
-    trolley = rd.load("trolley_pendulum")
-    with _progress("deriving trolley_pendulum (kane) and checking eqs. 2.46-2.47"):
-        teom = rd.derive(trolley, "kane")
-        closed = _trolley_closed_form_ok(teom)
-        (out / "trolley_pendulum.tex").write_text(render_latex(teom))
-    counts = _count_rows(eoms)
-    csv_text = io.StringIO()
-    writer = csv.writer(csv_text, lineterminator="\n")
-    writer.writerow(["method", "derivation_time_s"] + [
-        f"{k}_{op}" for k in ("tau", "M", "g")
-        for op in ("additions", "multiplications", "functions")])
-    writer.writerows(counts)
-    (out / "comparison.csv").write_text(csv_text.getvalue())
-    (out / "comparison.md").write_text(_markdown(robot, counts, results, args.samples))
-    page = _html_page(robot, counts, results, args.samples, teom, closed,
-                                 render_mathml(teom), render_latex(teom), render_text(teom))
-    (out / "report.html").write_text(page, encoding="utf-8")
-    print(_table(_COUNT_HEADERS, counts))
-    print()
-    print(_table(_AGREEMENT_HEADERS, _agreement_rows(results)))
-    print("\ntrolley pendulum (kane) equals the seed's eqs. 2.46-2.47: "
-          + ("yes" if closed else "NO"))
-    print(f"wrote {', '.join(sorted(p.name for p in out.iterdir()))} in {out}")
-    print(f"report: {(out / 'report.html').resolve()}")
-    return 0 if all(r.ok for r in results) and closed else 1
-
-
-# ----------------------------------------------------------------------------------------------
-# demo outputs
-# ----------------------------------------------------------------------------------------------
-
-
-def _trolley_closed_form_ok(eom: rd.EquationsOfMotion) -> bool:
-    """tau of the trolley pendulum equals the seed's eqs. 2.46-2.47 (solved for F and tau)."""
-    big_m, m, length, g = (sp.Symbol(k, real=True) for k in ("M", "m", "l", "g"))
-    q2 = eom.q[1]
-    x_dd, th_dd, th_d = eom.qdd[0], eom.qdd[1], eom.qd[1]
-    half = m * length / 2
-    closed = [
-        # (2.46): F = (M + m) x'' + (m l/2) cos(theta) theta'' - (m l/2) sin(theta) theta'^2
-        (big_m + m) * x_dd + half * sp.cos(q2) * th_dd - half * sp.sin(q2) * th_d**2,
-        # (2.47): 0 = (m g l/2) sin(theta) - (m l/2) cos(theta) x'' - (m l^2/3) theta'' - tau
-        half * sp.cos(q2) * x_dd + m * length**2 / 3 * th_dd - half * g * sp.sin(q2),
-    ]
-    return all(sp.simplify(eom.tau[k] - closed[k]) == 0 for k in range(2))
-
-
-_CSV_NOTE = ("tau, M, g: additions (+), multiplications (*) and function calls (fn) after "
-             "common-subexpression elimination (tau in its recursive form where there is one)")
-
-
-def _markdown(robot: rd.Robot, counts: list[list[object]], results: Sequence[Agreement],
-              samples: int) -> str:
-    def md_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> list[str]:
-        out = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
-        return out + ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
-
-    lines = [f"# Efficiency of the formulations: {robot.name}", "",
-             f"robodyn {rd.__version__}; description sha256 `{robot.description_hash}`.", "",
-             f"Derivation time (s) and {_CSV_NOTE}.", ""]
-    lines += md_table(_COUNT_HEADERS, counts)
-    lines += ["", f"## Agreement (max relative difference over {samples} random states, "
-              f"tolerance {TOLERANCE:g})", ""]
-    lines += md_table(_AGREEMENT_HEADERS, _agreement_rows(results))
-    return "\n".join(lines) + "\n"
-
-
-_CSS = """
-body { font-family: system-ui, sans-serif; max-width: 70rem; margin: 2rem auto; padding: 0 1rem;
-       color: #222; line-height: 1.45; }
-h1 { font-size: 1.6rem; border-bottom: 2px solid #345; padding-bottom: .3rem; }
-h2 { font-size: 1.25rem; margin-top: 2rem; color: #234; }
-h4 { margin: 1rem 0 .2rem; }
-table { border-collapse: collapse; margin: .5rem 0; font-variant-numeric: tabular-nums; }
-th, td { border: 1px solid #bbc; padding: .25rem .6rem; }
-th { background: #e8edf3; }
-td.num { text-align: right; }
-.ok { color: #176117; font-weight: 600; }
-.bad { color: #a01010; font-weight: 600; }
-pre { background: #f5f6f8; padding: .6rem; overflow-x: auto; font-size: .85rem; }
-math { font-size: 1.1rem; }
-.meta { color: #555; font-size: .9rem; }
-"""
-
-
-def _html_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
-    head = "".join(f"<th>{html.escape(str(h))}</th>" for h in headers)
-    body = []
-    for row in rows:
-        cells = []
-        for c in row:
-            text = html.escape(str(c))
-            if text in ("ok", "yes"):
-                cells.append(f'<td class="ok">{text}</td>')
-            elif text in ("DISAGREE", "NO"):
-                cells.append(f'<td class="bad">{text}</td>')
-            else:
-                cells.append(f'<td class="num">{text}</td>' if _is_number(c)
-                             else f"<td>{text}</td>")
-        body.append("<tr>" + "".join(cells) + "</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
-
-
-def _html_page(robot: rd.Robot, counts: list[list[object]], results: Sequence[Agreement],
-               samples: int, trolley: rd.EquationsOfMotion, closed_ok: bool, mathml: str,
-               latex: str, text: str) -> str:
-    ok = all(r.ok for r in results)
-    verdict = ('<span class="ok">the three formulations agree</span>' if ok
-               else '<span class="bad">the formulations disagree</span>')
-    closed = ('<span class="ok">yes</span>' if closed_ok else '<span class="bad">no</span>')
-    stamp = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8">
-<title>robodyn report: {html.escape(robot.name)}</title>
-<style>{_CSS}</style></head>
-<body>
-<h1>robodyn: equations of motion of the {html.escape(robot.name)}, three ways</h1>
-<p class="meta">robodyn {html.escape(rd.__version__)}, {stamp}. Source
-<code>{html.escape(robot.source)}</code>, description sha256
-<code>{robot.description_hash}</code>.</p>
-
-<h2>Efficiency of the formulations</h2>
-<p>Derivation time in seconds, and {html.escape(_CSV_NOTE)}.</p>
-{_html_table(_COUNT_HEADERS, counts)}
-
-<h2>Agreement</h2>
-<p>Largest relative difference of M(q), g(q) and the full inverse dynamics tau between each pair
-of formulations over {samples} random states (q in [&minus;&pi;, &pi;], qd in [&minus;2, 2],
-qdd in [&minus;3, 3]); tolerance {TOLERANCE:g}. Result: {verdict}.</p>
-{_html_table(_AGREEMENT_HEADERS, _agreement_rows(results))}
-
-<h2>Trolley pendulum (the seed's worked example), Kane's method</h2>
-<p>q<sub>1</sub> = x (trolley position, prismatic), q<sub>2</sub> = &theta; (rod angle from the
-upward vertical). tau<sub>1</sub> is the driving force F of eq. 2.46, tau<sub>2</sub> the
-torque that eq. 2.47 sets to zero. Equal to eqs. 2.46&ndash;2.47 after simplification: {closed}.
-Derived in {trolley.derivation_time:.3f} s.</p>
-{mathml}
-<details><summary>Plain text (<code>robodyn derive trolley_pendulum --method kane</code>)
-</summary><pre>{html.escape(text)}</pre></details>
-<details><summary>LaTeX source (<code>trolley_pendulum.tex</code>)</summary>
-<pre>{html.escape(latex)}</pre></details>
-</body></html>
-"""
+    return run_demo(args.output, args.samples, args.seed)
 
 
 # ----------------------------------------------------------------------------------------------

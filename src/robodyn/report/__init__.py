@@ -1,0 +1,1 @@
+"""Reports: agreement and efficiency tables, the demo pipeline and its HTML page."""

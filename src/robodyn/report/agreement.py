@@ -1,0 +1,167 @@
+"""Agreement of the three formulations on random states, and the efficiency table."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+import robodyn as rd
+from robodyn.report.text import progress as _progress
+from robodyn.symbolic.eom import METHODS
+
+#: Relative difference above which two formulations are reported as disagreeing.
+TOLERANCE = 1e-9
+
+_QUANTITIES = ("M", "g", "tau")
+
+
+@dataclass(frozen=True)
+class Agreement:
+    """Largest relative difference of M, g and tau between two formulations.
+
+    Attributes
+    ----------
+    first, second : str
+        Method names.
+    relative : dict[str, float]
+        ``max over states of max|a - b| / max(max|a|, max|b|)`` per quantity ("M", "g", "tau").
+    symbolic : bool or None
+        Whether every simplified difference is zero (None: not checked).
+    """
+
+    first: str
+    second: str
+    relative: dict[str, float]
+    symbolic: bool | None = None
+
+    @property
+    def ok(self) -> bool:
+        """Within :data:`TOLERANCE` (and symbolically equal where checked)."""
+        return max(self.relative.values()) <= TOLERANCE and self.symbolic is not False
+
+
+def _evaluator(eom: rd.EquationsOfMotion) -> Callable[..., dict[str, np.ndarray]]:
+    """``f(q, qd, qdd) -> {"M": (n, n), "g": (n,), "tau": (n,)}`` at the default parameters.
+
+    One ``sympy.cse`` (which walks shared subtrees once) runs before ``lambdify``, which is
+    handed only the reduced expressions: its own passes walk every expression as a tree, which
+    takes minutes on the (heavily shared) Lagrange expressions of a 6-joint arm.
+    """
+    n = eom.dof
+    values = eom.numeric()
+    params = list(values)
+    exprs = list(eom.M) + list(eom.g) + list(eom.tau)
+    replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_x"), order="none")
+    fn = sp.lambdify([eom.q, eom.qd, eom.qdd, params], reduced, modules="numpy",
+                     cse=lambda _: (replacements, reduced))
+    args = [values[p] for p in params]
+
+    def call(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> dict[str, np.ndarray]:
+        out = np.asarray(fn(q, qd, qdd, args), dtype=float)
+        return {"M": out[: n * n].reshape(n, n), "g": out[n * n: n * n + n],
+                "tau": out[n * n + n:]}
+
+    return call
+
+
+def _states(n: int, count: int, seed: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    rng = np.random.default_rng(seed)
+    return [(rng.uniform(-np.pi, np.pi, n), rng.uniform(-2, 2, n), rng.uniform(-3, 3, n))
+            for _ in range(count)]
+
+
+def _symbolically_equal(a: rd.EquationsOfMotion, b: rd.EquationsOfMotion) -> bool:
+    for name in _QUANTITIES:
+        diff = sp.Matrix(getattr(a, name)) - sp.Matrix(getattr(b, name))
+        if any(sp.simplify(sp.expand(e)) != 0 for e in diff):
+            return False
+    return True
+
+
+def agreement(eoms: Sequence[rd.EquationsOfMotion], samples: int = 20, seed: int = 0,
+              symbolic: bool = False) -> list[Agreement]:
+    """Compare every pair of formulations on random states (and symbolically if asked).
+
+    Parameters
+    ----------
+    eoms : sequence of EquationsOfMotion
+        Equations of one robot by different methods.
+    samples : int
+        Number of random states (q in [-pi, pi], qd in [-2, 2], qdd in [-3, 3]).
+    seed : int
+        Seed of the random states.
+    symbolic : bool
+        Also check that the simplified differences are zero (small arms only: slow).
+
+    Returns
+    -------
+    list of Agreement
+        One per pair, in the order of ``eoms``.
+    """
+    n = eoms[0].dof
+    states = _states(n, samples, seed)
+    values: dict[str, dict[str, list[np.ndarray]]] = {}
+    for eom in eoms:
+        with _progress(f"evaluating {eom.method} on {samples} states"):
+            func = _evaluator(eom)
+            results = [func(*s) for s in states]
+            values[eom.method] = {k: [r[k] for r in results] for k in _QUANTITIES}
+    out = []
+    for i, a in enumerate(eoms):
+        for b in eoms[i + 1:]:
+            rel = {}
+            for k in _QUANTITIES:
+                worst = 0.0
+                for va, vb in zip(values[a.method][k], values[b.method][k], strict=True):
+                    scale = max(np.max(np.abs(va)), np.max(np.abs(vb)))
+                    diff = np.max(np.abs(va - vb))
+                    worst = max(worst, diff / scale if scale > 0 else diff)
+                rel[k] = float(worst)
+            same = None
+            if symbolic:
+                with _progress(f"simplifying {a.method} - {b.method}"):
+                    same = _symbolically_equal(a, b)
+            out.append(Agreement(a.method, b.method, rel, same))
+    return out
+
+
+def derive_all(robot: rd.Robot) -> list[rd.EquationsOfMotion]:
+    eoms = []
+    for method in METHODS:
+        with _progress(f"deriving {method}"):
+            eoms.append(rd.derive(robot, method))
+    for eom in eoms:
+        with _progress(f"counting operations of {eom.method} (after CSE)"):
+            eom.op_counts()
+    return eoms
+
+
+COUNT_HEADERS = ("method", "derive [s]", "tau +", "tau *", "tau fn", "M +", "M *", "M fn",
+                  "g +", "g *", "g fn")
+
+
+def count_rows(eoms: Sequence[rd.EquationsOfMotion]) -> list[list[object]]:
+    rows = []
+    for eom in eoms:
+        counts = eom.op_counts()
+        row: list[object] = [eom.method, f"{eom.derivation_time:.3f}"]
+        for key in ("tau", "M", "g"):
+            ops = counts[key]
+            row += [ops.additions, ops.multiplications, ops.functions]
+        rows.append(row)
+    return rows
+
+
+def agreement_rows(results: Sequence[Agreement]) -> list[list[object]]:
+    rows = []
+    for r in results:
+        sym = {None: "-", True: "yes", False: "NO"}[r.symbolic]
+        rows.append([f"{r.first} vs {r.second}"] + [f"{r.relative[k]:.1e}" for k in _QUANTITIES]
+                    + [sym, "ok" if r.ok else "DISAGREE"])
+    return rows
+
+
+AGREEMENT_HEADERS = ("pair", "M", "g", "tau", "symbolic", "result")
