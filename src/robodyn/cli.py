@@ -150,6 +150,28 @@ def _cmd_check(args: argparse.Namespace) -> int:
     return 0 if ok else 1
 
 
+def _cmd_codegen(args: argparse.Namespace) -> int:
+    from robodyn.codegen.emit import generate
+
+    robot = rd.load(args.robot)
+    with _progress(f"generating {args.lang} for {robot.name}"):
+        paths = generate(robot, args.lang, Path(args.output))
+    for path in paths:
+        print(path)
+    return 0
+
+
+def _cmd_export(args: argparse.Namespace) -> int:
+    from robodyn.export.mjcf import to_mjcf
+    from robodyn.export.urdf import to_urdf
+
+    robot = rd.load(args.robot)
+    writer = {"urdf": to_urdf, "mjcf": to_mjcf}[args.format]
+    text = writer(robot)
+    _write(text, args.output)
+    return 0
+
+
 def _cmd_demo(args: argparse.Namespace) -> int:
     return run_demo(args.output, args.samples, args.seed)
 
@@ -227,6 +249,36 @@ def _parser() -> argparse.ArgumentParser:
                    help="number of random states (default: %(default)s)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     p.set_defaults(func=_cmd_check)
+
+    p = sub.add_parser("codegen", help="generate simulation code (C, Python, MATLAB, Fortran, ...)",
+                       formatter_class=fmt,
+                       description="Generate inverse dynamics, mass matrix, Coriolis, gravity, "
+                                   "forward dynamics (Cholesky), forward kinematics, Jacobian, "
+                                   "regressor and the ODE right-hand side as source files, with "
+                                   "common subexpressions eliminated and the description's "
+                                   "parameter values folded in.",
+                       epilog="examples:\n  robodyn codegen puma560 --lang c -o gen/\n"
+                              "  robodyn codegen my_arm.yaml --lang octave -o gen/matlab")
+    p.add_argument("robot", metavar="ROBOT", help=_ROBOT_HELP)
+    p.add_argument("--lang", required=True,
+                   choices=("c", "python", "octave", "fortran", "julia", "latex", "mex"),
+                   help="target language (c also writes a standalone simulator; mex writes the "
+                        "MATLAB/Octave gateway and a Level-2 S-function)")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="output directory")
+    p.set_defaults(func=_cmd_codegen)
+
+    p = sub.add_parser("export", help="write a robot as URDF or MuJoCo MJCF",
+                       formatter_class=fmt,
+                       description="Export a description (parameters at their defaults) to URDF "
+                                   "or MuJoCo MJCF. What a format cannot hold (e.g. asymmetric "
+                                   "Coulomb friction, rotor inertia in URDF) is named in a "
+                                   "warning.",
+                       epilog="examples:\n  robodyn export puma560 --format urdf -o puma560.urdf\n"
+                              "  robodyn export aa300 --format mjcf -o aa300.xml")
+    p.add_argument("robot", metavar="ROBOT", help=_ROBOT_HELP)
+    p.add_argument("--format", required=True, choices=("urdf", "mjcf"), help="output format")
+    p.add_argument("-o", "--output", metavar="FILE", help="output file (default: stdout)")
+    p.set_defaults(func=_cmd_export)
 
     p = sub.add_parser("demo", help="PUMA 560 three ways: files, comparison and HTML report",
                        formatter_class=fmt,
