@@ -12,6 +12,7 @@ Public API::
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.load import builtin_names, load
 from robodyn.robot.model import Drive, Friction, Joint, Link, Robot
+from robodyn.simulate import Trajectory, simulate
 from robodyn.symbolic.eom import EquationsOfMotion, derive
 
 __all__ = [
@@ -22,9 +23,11 @@ __all__ = [
     "Link",
     "Model",
     "Robot",
+    "Trajectory",
     "builtin_names",
     "compile_model",
     "derive",
     "load",
+    "simulate",
 ]
 __version__ = "0.1.0"

@@ -125,7 +125,8 @@ class Model:
         dt : float
             Step (s).
         method : {"rk4", "semi_implicit"}
-            Classical RK4, or semi-implicit (symplectic) Euler.
+            Classical RK4, or semi-implicit Euler (velocity first, then position with the new
+            velocity: symplectic only while M is constant, first order in general).
         feedforward : (steps, n), optional
             Torques, or accelerations under "computed_torque".
         reference : (steps, 2 n), optional

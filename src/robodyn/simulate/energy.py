@@ -1,0 +1,85 @@
+"""Potential energy and link-frame positions of a compiled model, from its symbolic kinematics.
+
+The compiled :class:`~robodyn.numeric.model.Model` has no energy kernel, so the potential energy
+is built once per robot (and parameter values) from the symbolic forward kinematics::
+
+    V(q) = - sum_i m_i g . p_ci(q)
+
+with ``p_ci`` the centre of mass of link ``i`` in the world frame and ``g`` the gravity vector.
+It is exact (no quadrature) and consistent with the model's gravity load: ``dV/dq = g(q)``, the
+torque that holds the arm still (checked in the tests). The expression is turned into a NumPy
+function by ``sympy.lambdify`` and memoised.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import sympy as sp
+
+from robodyn import spatial as S
+from robodyn.numeric.model import Model
+from robodyn.symbolic.kinematics import forward_kinematics, joint_symbols
+
+_MEMO: dict[tuple, Callable[..., object]] = {}
+
+
+def _key(model: Model, what: str) -> tuple:
+    return (what, model.robot.description_hash, tuple(sorted(model.parameters.items())))
+
+
+def _values(model: Model) -> dict[sp.Symbol, float]:
+    return {sp.Symbol(k, real=True): float(v) for k, v in model.parameters.items()}
+
+
+def potential_energy(model: Model, q: np.ndarray) -> np.ndarray:
+    """Gravitational potential energy ``V(q) = -sum_i m_i g . p_ci`` (J), () for (n,), (N,) for (N, n).
+
+    The zero of ``V`` is at the world origin's height.
+    """
+    key = _key(model, "V")
+    if key not in _MEMO:
+        qs, _, _ = joint_symbols(model.dof)
+        kin = forward_kinematics(model.robot, qs)
+        v = sp.Integer(0)
+        for link, t in zip(model.robot.links, kin.links, strict=True):
+            # p_c = R_i c_i + o_i
+            p_c = S.rotation(t) * link.com + S.translation(t)
+            # V -= m g . p_c
+            v -= link.mass * (model.robot.gravity.T * p_c)[0, 0]
+        _MEMO[key] = sp.lambdify(qs, v.xreplace(_values(model)), modules="numpy", cse=True)
+    q = _states(model, q)
+    out = np.asarray(_MEMO[key](*q.T), dtype=float)
+    return np.broadcast_to(out, q.shape[:-1]).copy()
+
+
+def frame_origins(model: Model, q: np.ndarray) -> np.ndarray:
+    """World positions of the base, every link frame origin and the tool point (m).
+
+    Returns
+    -------
+    (n + 2, 3) for one state, (N, n + 2, 3) for a batch: a stick figure of the arm.
+    """
+    key = _key(model, "points")
+    if key not in _MEMO:
+        qs, _, _ = joint_symbols(model.dof)
+        kin = forward_kinematics(model.robot, qs)
+        frames = (sp.ImmutableMatrix(model.robot.base),) + kin.links + (kin.end_effector,)
+        pts = sp.Matrix([list(S.translation(f)) for f in frames]).xreplace(_values(model))
+        _MEMO[key] = sp.lambdify(qs, pts, modules="numpy", cse=True)
+    q = _states(model, q)
+    fn = _MEMO[key]
+    if q.ndim == 1:
+        return np.asarray(fn(*q), dtype=float)
+    return np.stack([np.asarray(fn(*row), dtype=float) for row in q])
+
+
+def _states(model: Model, q: np.ndarray) -> np.ndarray:
+    q = np.asarray(q, dtype=float)
+    if q.ndim not in (1, 2) or q.shape[-1] != model.dof:
+        raise ValueError(f"q must have shape ({model.dof},) or (N, {model.dof}), got {q.shape}")
+    return q
+
+
+__all__ = ["frame_origins", "potential_energy"]
