@@ -22,6 +22,7 @@ from robodyn.report.agreement import (
     count_rows,
     derive_all,
 )
+from robodyn.report.simulation_sections import simulation_sections
 from robodyn.report.text import is_number, progress, table
 from robodyn.symbolic.render import render_json, render_latex, render_mathml, render_text
 
@@ -55,8 +56,10 @@ def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
     writer.writerows(counts)
     (out / "comparison.csv").write_text(csv_text.getvalue())
     (out / "comparison.md").write_text(_markdown(robot, counts, results, samples))
+    sections, sim_ok = simulation_sections(robot, out)
     page = _html_page(robot, counts, results, samples, teom, closed,
-                                 render_mathml(teom), render_latex(teom), render_text(teom))
+                      render_mathml(teom), render_latex(teom), render_text(teom))
+    page = page.replace("</body></html>", sections + "\n</body></html>")
     (out / "report.html").write_text(page, encoding="utf-8")
     print(table(COUNT_HEADERS, counts))
     print()
@@ -65,7 +68,8 @@ def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
           + ("yes" if closed else "NO"))
     print(f"wrote {', '.join(sorted(p.name for p in out.iterdir()))} in {out}")
     print(f"report: {(out / 'report.html').resolve()}")
-    return 0 if all(r.ok for r in results) and closed else 1
+    print("chapter 3 (computed torque, balance): " + ("ok" if sim_ok else "FAILED"))
+    return 0 if all(r.ok for r in results) and closed and sim_ok else 1
 
 
 def _trolley_closed_form_ok(eom: rd.EquationsOfMotion) -> bool:
