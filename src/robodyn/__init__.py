@@ -9,6 +9,7 @@ Public API::
     model.inverse_dynamics(q, qd, qdd)               # (n,) or (N, n)
 """
 
+from robodyn.calibrate import Calibration, calibrate
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.load import builtin_names, load
 from robodyn.robot.model import Drive, Friction, Joint, Link, Robot
@@ -16,6 +17,7 @@ from robodyn.simulate import Trajectory, simulate
 from robodyn.symbolic.eom import EquationsOfMotion, derive
 
 __all__ = [
+    "Calibration",
     "Drive",
     "EquationsOfMotion",
     "Friction",
@@ -25,6 +27,7 @@ __all__ = [
     "Robot",
     "Trajectory",
     "builtin_names",
+    "calibrate",
     "compile_model",
     "derive",
     "load",

@@ -1,0 +1,236 @@
+"""Calibration data in (CSV) and the calibrated description out (YAML, URDF, report).
+
+Calibration CSV: a header row, then one row per measured pose; lines starting with ``#`` are
+comments. Columns (any order, extra columns ignored):
+
+* one per joint, named as the robot's joints (``q1`` ... for the built-in PUMA 560), in rad (m
+  for prismatic joints);
+* ``x``, ``y``, ``z``: the measured target position in the instrument frame, m;
+* optional ``qw``, ``qx``, ``qy``, ``qz``: the measured target orientation as a unit quaternion;
+* optional ``sigma``: the standard uncertainty of that pose's coordinates, m.
+
+Every error names the file, and the row (1-based line number in the file) and column where it
+is.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from robodyn.calibrate.result import Calibration
+from robodyn.robot.model import Robot
+
+__all__ = ["CalibrationData", "read_calibration_csv", "read_table", "write_calibration"]
+
+
+def read_table(path: str | Path, required: Sequence[str], *, optional: Sequence[str] = (),
+               text_columns: Sequence[str] = ()) -> dict[str, list]:
+    """Columns of a CSV file with a header row, as lists (numbers as floats).
+
+    Parameters
+    ----------
+    path : str or Path
+    required : sequence of str
+        Columns that must be present.
+    optional : sequence of str
+        Columns read when present.
+    text_columns : sequence of str
+        Columns kept as text.
+
+    Raises
+    ------
+    FileNotFoundError, ValueError
+        Missing file, no header, a missing column, a short row, a value that is not a finite
+        number: the message names the file, the line and the column.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"{path}: no such file")
+    with path.open(newline="", encoding="utf-8") as fh:
+        lines = [(k + 1, line) for k, line in enumerate(fh)
+                 if line.strip() and not line.lstrip().startswith("#")]
+    if not lines:
+        raise ValueError(f"{path}: empty file (a header row and data rows are needed)")
+    rows = list(csv.reader([text for _, text in lines]))
+    header = [h.strip() for h in rows[0]]
+    where = {name: k for k, name in enumerate(header)}
+    missing = [c for c in required if c not in where]
+    if missing:
+        raise ValueError(f"{path}: line {lines[0][0]}: missing column(s) {', '.join(missing)} "
+                         f"(the header has {', '.join(header)})")
+    if len(rows) < 2:
+        raise ValueError(f"{path}: no data rows after the header")
+    wanted = list(required) + [c for c in optional if c in where]
+    out: dict[str, list] = {c: [] for c in wanted}
+    for (lineno, _), row in zip(lines[1:], rows[1:], strict=True):
+        for c in wanted:
+            k = where[c]
+            if k >= len(row):
+                raise ValueError(f"{path}: line {lineno}: column {c!r} is missing ({len(row)} values, "
+                                 f"{len(header)} columns)")
+            text = row[k].strip()
+            if c in text_columns:
+                out[c].append(text)
+                continue
+            try:
+                value = float(text)
+            except ValueError:
+                raise ValueError(f"{path}: line {lineno}, column {c!r}: {text!r} is not a number") from None
+            if not math.isfinite(value):
+                raise ValueError(f"{path}: line {lineno}, column {c!r}: {text} is not a finite number")
+            out[c].append(value)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class CalibrationData:
+    """Measured poses read from a file.
+
+    Attributes
+    ----------
+    q : numpy.ndarray, shape (N, n)
+    points : numpy.ndarray, shape (N, 3)
+    orientations : numpy.ndarray or None, shape (N, 3, 3)
+    sigma : numpy.ndarray or None, shape (N,)
+    source : str
+    """
+
+    q: np.ndarray
+    points: np.ndarray
+    orientations: np.ndarray | None
+    sigma: np.ndarray | None
+    source: str
+
+
+def _quaternion_matrix(w, x, y, z) -> np.ndarray:
+    """Rotation matrices of unit quaternions (arrays of shape (N,)), shape (N, 3, 3)."""
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+    ], 1)
+
+
+def read_calibration_csv(path: str | Path, robot: Robot) -> CalibrationData:
+    """Read measured poses for ``robot`` from a calibration CSV (module docstring)."""
+    joints = list(robot.joint_names)
+    table = read_table(path, joints + ["x", "y", "z"], optional=["qw", "qx", "qy", "qz", "sigma"])
+    q = np.column_stack([table[j] for j in joints])
+    points = np.column_stack([table[c] for c in ("x", "y", "z")])
+    orientations = None
+    quat = [c for c in ("qw", "qx", "qy", "qz") if c in table]
+    if quat and len(quat) != 4:
+        raise ValueError(f"{path}: orientation needs all of qw, qx, qy, qz (found {', '.join(quat)})")
+    if quat:
+        qq = np.column_stack([table[c] for c in ("qw", "qx", "qy", "qz")])
+        norm = np.linalg.norm(qq, axis=1)
+        bad = np.flatnonzero(np.abs(norm - 1) > 1e-3)
+        if bad.size:
+            raise ValueError(f"{path}: data row {bad[0] + 1}: quaternion (qw, qx, qy, qz) has norm "
+                             f"{norm[bad[0]]:.6g}, not 1")
+        qq = qq / norm[:, None]
+        orientations = _quaternion_matrix(*qq.T)
+    sigma = None
+    if "sigma" in table:
+        sigma = np.array(table["sigma"])
+        bad = np.flatnonzero(~(sigma > 0))
+        if bad.size:
+            raise ValueError(f"{path}: data row {bad[0] + 1}, column 'sigma': must be positive")
+    return CalibrationData(q, points, orientations, sigma, str(path))
+
+
+def write_calibration_csv(path: str | Path, robot: Robot, q: np.ndarray, points: np.ndarray) -> None:
+    """Write poses in the calibration CSV format (for tests and simulated data)."""
+    with Path(path).open("w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow([*robot.joint_names, "x", "y", "z"])
+        for qi, pi in zip(q, points, strict=True):
+            w.writerow([repr(float(v)) for v in (*qi, *pi)])
+
+
+def _report_data(cal: Calibration) -> dict:
+    """The report as plain data (SI units)."""
+    return {
+        "robot": cal.robot.name,
+        "model": cal.model.name,
+        "initial": cal.initial,
+        "loss": cal.loss,
+        "poses": cal.pose_count,
+        "sigma_m": cal.sigma,
+        "variance_factor": cal.variance_factor,
+        "converged": cal.converged,
+        "message": cal.message,
+        "before_m": cal.before.__dict__,
+        "after_m": cal.after.__dict__,
+        "parameters": [p.__dict__ for p in cal.parameters],
+        "unidentifiable": [
+            {"name": u.name, "value": u.value, "kind": u.kind, "reason": u.reason,
+             "combination": [list(c) for c in u.combination]}
+            for u in cal.unidentifiable
+        ],
+        "observability": cal.observability.as_dict(),
+        "residuals_m": np.asarray(cal.residuals).tolist(),
+    }
+
+
+def write_calibration(cal: Calibration, out_dir: str | Path, *,
+                      stem: str | None = None) -> dict[str, Path | None]:
+    """Write the calibrated description and a report into ``out_dir``.
+
+    Files: ``<stem>.yaml`` (robodyn description, :func:`robodyn.robot.yaml_writer.dump_yaml`),
+    ``<stem>.urdf`` (:func:`robodyn.export.urdf.to_urdf`, when that exporter is available),
+    ``<stem>_report.txt`` (:meth:`Calibration.summary`), ``<stem>_report.json`` (the same as
+    data, with the residuals) and ``<stem>_residuals.csv``.
+
+    Returns
+    -------
+    dict
+        Paths by kind (``"yaml"``, ``"urdf"``, ``"report"``, ``"json"``, ``"residuals"``); ``"urdf"``
+        is None when no URDF writer is available (``"note"`` then says so).
+    """
+    from robodyn.robot.yaml_writer import dump_yaml
+
+    out = Path(out_dir)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OSError(f"{out}: cannot create the output directory: {exc}") from None
+    stem = stem or cal.robot.name
+    paths: dict[str, Path | None] = {}
+    paths["yaml"] = out / f"{stem}.yaml"
+    paths["yaml"].write_text(dump_yaml(cal.robot), encoding="utf-8")
+    try:
+        from robodyn.export.urdf import to_urdf
+    except ImportError:
+        to_urdf = None
+    if to_urdf is not None:
+        import warnings
+
+        from robodyn.robot.errors import DescriptionWarning
+
+        paths["urdf"] = out / f"{stem}.urdf"
+        with warnings.catch_warnings():
+            # drive data and gravity direction are kept in the YAML; URDF cannot hold them
+            warnings.simplefilter("ignore", DescriptionWarning)
+            to_urdf(cal.robot, paths["urdf"])
+    else:
+        paths["urdf"] = None  # no URDF exporter in this installation: YAML only
+    paths["report"] = out / f"{stem}_report.txt"
+    paths["report"].write_text(cal.summary() + "\n", encoding="utf-8")
+    paths["json"] = out / f"{stem}_report.json"
+    paths["json"].write_text(json.dumps(_report_data(cal), indent=1) + "\n", encoding="utf-8")
+    paths["residuals"] = out / f"{stem}_residuals.csv"
+    with paths["residuals"].open("w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(["pose", "dx", "dy", "dz", "distance"])
+        for k, r in enumerate(np.asarray(cal.residuals)):
+            w.writerow([k, repr(float(r[0])), repr(float(r[1])), repr(float(r[2])),
+                        repr(float(np.linalg.norm(r)))])
+    return paths

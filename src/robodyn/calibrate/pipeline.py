@@ -1,0 +1,439 @@
+"""``calibrate``: kinematic calibration from measured target positions, end to end.
+
+Steps (each a function of its own module):
+
+1. the nominal geometry of the robot (:mod:`~robodyn.calibrate.nominal`);
+2. the instrument placement and target offset for the nominal kinematics: rigid registration of
+   the nominal predictions onto the measurements (Kabsch, alternated with a linear solve for the
+   target offset), refined by least squares on those 6 + 3 parameters only. Its residuals are
+   the "before" errors;
+3. the initial estimate: the nominal model so placed, or circle-point analysis
+   (:mod:`~robodyn.calibrate.circle_point`);
+4. identifiability (:mod:`~robodyn.calibrate.identifiability`): the parameters no pose set can
+   identify (found on random poses at the initial estimate), then those this pose set cannot;
+5. weighted Levenberg-Marquardt on all poses (:mod:`~robodyn.calibrate.solve`);
+6. the calibrated robot (:mod:`~robodyn.calibrate.to_robot`) and the result.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+
+import numpy as np
+
+from robodyn.calibrate.circle_point import CirclePointResult, circle_point
+from robodyn.calibrate.identifiability import (
+    Unidentifiable,
+    describe,
+    independent_columns,
+    observability,
+)
+from robodyn.calibrate.kinematics import hom, inv
+from robodyn.calibrate.models import MODELS, ErrorModel, build_model, model_frames
+from robodyn.calibrate.nominal import RobotGeometry, default_frame0, robot_geometry
+from robodyn.calibrate.result import Calibration, ErrorStats, Parameter
+from robodyn.calibrate.solve import LOSSES, fit
+from robodyn.calibrate.to_robot import calibrated_robot
+from robodyn.robot.model import Robot
+
+__all__ = ["calibrate", "check_data", "compensate", "identifiable_parameters", "inverse_kinematics",
+           "nominal_placement", "random_configurations", "validate"]
+
+#: Threshold of :func:`~robodyn.calibrate.identifiability.independent_columns`.
+RANK_TOL = 1e-7
+
+
+def _array(name: str, value, shape_text: str) -> np.ndarray:
+    try:
+        a = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be a numeric array of shape {shape_text}: {exc}") from None
+    bad = np.argwhere(~np.isfinite(a))
+    if bad.size:
+        row = int(bad[0][0])
+        col = f", column {int(bad[0][1])}" if bad.shape[1] > 1 else ""
+        raise ValueError(f"{name} has NaN or infinite values ({len(bad)} entries; first at row {row}{col})")
+    return a
+
+
+def check_data(robot: Robot, q, points, orientations=None, sigma=5e-5,
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray]:
+    """Validate calibration data; returns arrays q (N, n), points (N, 3), orientations, sigma (N, 3).
+
+    Raises
+    ------
+    ValueError
+        On wrong shapes, mismatched lengths, NaN or infinite values, non-rotations, bad sigma.
+    """
+    n = robot.dof
+    q = _array("q", q, f"(N, {n})")
+    points = _array("points", points, "(N, 3)")
+    if q.ndim != 2 or q.shape[1] != n:
+        raise ValueError(f"q must have shape (N, {n}) for {robot.name}'s {n} joints "
+                         f"({', '.join(robot.joint_names)}); got {q.shape}")
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise ValueError(f"points must have shape (N, 3); got {points.shape}")
+    if len(q) != len(points):
+        raise ValueError(f"mismatched lengths: q has {len(q)} poses but points has {len(points)}")
+    if orientations is not None:
+        orientations = _array("orientations", orientations, "(N, 3, 3)")
+        if orientations.shape != (len(q), 3, 3):
+            raise ValueError(f"orientations must have shape ({len(q)}, 3, 3); got {orientations.shape}")
+        err = np.abs(orientations @ np.swapaxes(orientations, 1, 2) - np.eye(3)).max(axis=(1, 2))
+        det = np.linalg.det(orientations)
+        bad = np.flatnonzero((err > 1e-6) | (det < 0))
+        if bad.size:
+            raise ValueError(f"orientations[{bad[0]}] is not a rotation matrix ({bad.size} such rows)")
+    s = _array("sigma", sigma, "scalar, (N,) or (N, 3)")
+    if s.ndim == 1:
+        s = s[:, None]
+    try:
+        s = np.broadcast_to(s, points.shape).copy()
+    except ValueError:
+        raise ValueError(f"sigma must be a scalar, (N,) or (N, 3) for N = {len(points)}; "
+                         f"got shape {np.shape(sigma)}") from None
+    if not np.all(s > 0):
+        raise ValueError("sigma must be positive")
+    return q, points, orientations, s
+
+
+def random_configurations(robot: Robot, count: int, rng: np.random.Generator | int = 0) -> np.ndarray:
+    """Uniformly random joint readings within the joint limits, shape (count, n).
+
+    Joints without limits range over ``[-pi, pi]`` (revolute) or ``[-0.5, 0.5]`` m (prismatic).
+    """
+    rng = np.random.default_rng(rng)
+    subs = robot.defaults()
+    lo, hi = [], []
+    for j in robot.joints:
+        default = (-math.pi, math.pi) if j.type == "revolute" else (-0.5, 0.5)
+        lower = float(j.lower.xreplace(subs)) if j.lower is not None else default[0]
+        upper = float(j.upper.xreplace(subs)) if j.upper is not None else default[1]
+        lo.append(lower)
+        hi.append(upper)
+    return rng.uniform(lo, hi, size=(count, robot.dof))
+
+
+def _rows(model: ErrorModel, params: np.ndarray, q: np.ndarray, weights: np.ndarray,
+          rot_weight: float) -> np.ndarray:
+    """Weighted identification Jacobian, shape (N * r, P)."""
+    jac = model.evaluate(params, q).jac_param
+    j = jac[:, :3] * weights[:, :, None]
+    if model.orientation:
+        j = np.concatenate((j, jac[:, 3:] * rot_weight), axis=1)
+    return j.reshape(-1, model.n_params)
+
+
+def nominal_placement(geometry: RobotGeometry, q: np.ndarray, points: np.ndarray,
+              orientations: np.ndarray | None, sigma: np.ndarray, sigma_rot: float,
+              ) -> tuple[np.ndarray, np.ndarray, ErrorModel, np.ndarray]:
+    """Instrument placement and target for the nominal kinematics ("before" calibration).
+
+    Returns the robot world frame in the instrument frame (4, 4), the before residuals (N, 3),
+    and the placed nominal DH model with its fitted parameters.
+    """
+    nominal = build_model("dh", geometry)
+    p = nominal.initial.copy()
+    tool = [nominal.index(f"tool.{a}") for a in "xyz"]
+    offset = p[tool].copy()
+    p[tool] = 0.0
+    ev = nominal.evaluate(p, q, derivatives=False)  # last model frame, world
+    rn, on = ev.rotation, ev.position
+    x = np.eye(4)
+    for _ in range(50):
+        y = rn @ offset + on
+        x = _kabsch(y, points)
+        # linear target offset: (R R_n) p = points - t - R o_n
+        a = (x[:3, :3] @ rn).reshape(-1, 3)
+        b = (points - x[:3, 3] - on @ x[:3, :3].T).ravel()
+        new, *_ = np.linalg.lstsq(a, b, rcond=None)
+        if np.linalg.norm(new - offset) < 1e-12:
+            offset = new
+            break
+        offset = new
+    r_tool = np.eye(3)
+    if orientations is not None:
+        # tool rotation in the last frame: the rotation nearest mean_k (R_x R_n,k)^T R_measured,k
+        u, _, vt = np.linalg.svd(np.einsum("kji,kjl->il", x[:3, :3] @ rn, orientations))
+        r_tool = u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
+    zero = nominal.evaluate(p, np.zeros((1, geometry.dof)), derivatives=False)
+    target = x @ hom(zero.rotation[0] @ r_tool, zero.rotation[0] @ offset + zero.position[0])
+    placed = build_model("dh", geometry, base=x, target=target, orientation=orientations is not None)
+    p0 = placed.initial.copy()
+    names = [f"base.{a}" for a in ("x", "y", "z", "rx", "ry", "rz")] + [f"tool.{a}" for a in "xyz"]
+    if orientations is not None:
+        names += [f"tool.r{a}" for a in "xyz"]
+    cand = [placed.index(name) for name in names]
+    rot_weight = 1.0 / sigma_rot if orientations is not None else 0.0
+    jac = _rows(placed, p0, q, 1.0 / sigma, rot_weight)[:, cand]
+    free = [cand[k] for k in independent_columns(jac, range(len(cand)), RANK_TOL)]
+    res = fit(placed, p0, free, q, points, sigma=sigma, orientations=orientations, sigma_rot=sigma_rot)
+    frame0, _, _ = model_frames(placed, res.params)
+    world = frame0 @ inv(default_frame0(geometry))
+    return world, res.residuals, placed, res.params
+
+
+def _kabsch(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Rigid transform (4, 4) minimising ``sum |R a_k + t - b_k|^2`` for point sets (N, 3)."""
+    ca, cb = a.mean(axis=0), b.mean(axis=0)
+    h = (a - ca).T @ (b - cb)
+    u, _, vt = np.linalg.svd(h)
+    d = np.diag([1.0, 1.0, np.sign(np.linalg.det(vt.T @ u.T))])
+    r = vt.T @ d @ u.T
+    return hom(r, cb - r @ ca)
+
+
+def identifiable_parameters(robot: Robot, model: ErrorModel, params: np.ndarray, q: np.ndarray,
+                            weights: np.ndarray | float = 1.0, rot_weight: float = 1.0,
+                            ) -> tuple[list[int], list[Unidentifiable]]:
+    """Identifiable parameters of ``model`` for the poses ``q``, and the reasons for the others.
+
+    Structure first: random poses within the joint limits, unit weights, at ``params``; then the
+    given poses with ``weights`` (1 / sigma, scalar or (N, 3)) and ``rot_weight`` (1 / sigma_rot).
+
+    Returns
+    -------
+    free : list of int
+        Indices of the identifiable parameters, in the model's priority order.
+    unidentifiable : list of Unidentifiable
+    """
+    weights = np.broadcast_to(np.asarray(weights, dtype=float), (len(q), 3))
+    qr = random_configurations(robot, max(3 * model.n_params, 60), rng=12345)
+    ones = np.ones((len(qr), 3))
+    js = _rows(model, params, qr, ones, 1.0)
+    kept_s = independent_columns(js, model.priority, RANK_TOL)
+    drop_s = [k for k in model.priority if k not in kept_s]
+    out = [Unidentifiable(model.names[k], float(params[k]), "structural", combo,
+                          f"{text}, whatever the poses")
+           for k, (combo, text) in zip(drop_s, describe(js, model.names, kept_s, drop_s), strict=True)]
+    jd = _rows(model, params, q, weights, rot_weight)
+    order = [k for k in model.priority if k in kept_s]
+    kept_d = independent_columns(jd, order, RANK_TOL)
+    drop_d = [k for k in order if k not in kept_d]
+    still = [robot.joint_names[j] for j in range(robot.dof) if np.ptp(q[:, j]) <= 1e-9]
+    note = f"; joint(s) {', '.join(still)} take a single value in every pose" if still else ""
+    for k, (combo, text) in zip(drop_d, describe(jd, model.names, kept_d, drop_d), strict=True):
+        out.append(Unidentifiable(model.names[k], float(params[k]), "pose set", combo,
+                                  f"{text} on this pose set (a richer pose set would identify it){note}"))
+    return sorted(kept_d, key=model.priority.index), out
+
+
+def calibrate(
+    robot: Robot,
+    q,
+    points,
+    model: str = "s-model",
+    *,
+    sigma: float | np.ndarray = 5e-5,
+    loss: str = "linear",
+    initial: str = "nominal",
+    circle_data: Sequence[tuple[np.ndarray, np.ndarray]] | None = None,
+    orientations=None,
+    sigma_rot: float = 1e-4,
+    loss_scale: float = 3.0,
+    parallel_tol: float = math.radians(1.0),
+    max_nfev: int | None = None,
+) -> Calibration:
+    """Identify a robot's kinematics from measured target positions.
+
+    Parameters
+    ----------
+    robot : Robot
+        The nominal robot.
+    q : array_like, shape (N, n)
+        Joint readings at the measured poses, rad (m for prismatic joints).
+    points : array_like, shape (N, 3)
+        Measured target positions in the instrument's frame, m. The instrument-to-base transform
+        and the target's offset on the last link are unknown and estimated.
+    model : {"s-model", "hayati", "dh", "poe"}
+        The error model (:mod:`robodyn.calibrate.models`).
+    sigma : float or array_like, shape (N,) or (N, 3)
+        Standard uncertainty of each measured coordinate, m (0.05 mm by default).
+    loss : {"linear", "huber", "soft_l1", "cauchy", "arctan"}
+        Robust loss (on weighted residuals, in units of sigma, scaled by ``loss_scale``).
+    initial : {"nominal", "circle-point"}
+        Start from the nominal geometry, or from circle-point analysis of ``circle_data``.
+    circle_data : sequence of (q, points), optional
+        One data set per joint that moves only that joint (see
+        :func:`robodyn.calibrate.circle_point.circle_point`); used for the initial estimate only.
+    orientations : array_like, shape (N, 3, 3), optional
+        Measured target orientations in the instrument frame (then the target's orientation is
+        estimated too).
+    sigma_rot : float
+        Standard uncertainty of a measured orientation, rad.
+    loss_scale : float
+    parallel_tol : float
+        Nominal consecutive axes closer than this to parallel (rad) get Hayati's link.
+    max_nfev : int, optional
+        Most residual evaluations of the final fit.
+
+    Returns
+    -------
+    Calibration
+
+    Raises
+    ------
+    ValueError
+        On bad input: shapes, lengths, NaN, unknown options, too few poses for the identifiable
+        parameters, a circle-point set in which its joint never moved.
+    """
+    if model not in MODELS:
+        raise ValueError(f"unknown error model {model!r}; choose one of {', '.join(MODELS)}")
+    if loss not in LOSSES:
+        raise ValueError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
+    if initial not in ("nominal", "circle-point"):
+        raise ValueError(f"initial must be 'nominal' or 'circle-point', got {initial!r}")
+    if initial == "circle-point" and circle_data is None:
+        raise ValueError("initial='circle-point' needs circle_data: one (q, points) set per joint")
+    q, points, orientations, sig = check_data(robot, q, points, orientations, sigma)
+    geometry = robot_geometry(robot)
+    oriented = orientations is not None
+    world, before_res, placed, placed_params = nominal_placement(geometry, q, points, orientations, sig,
+                                                          sigma_rot)
+    target = model_frames(placed, placed_params)[2]
+    cp: CirclePointResult | None = None
+    if initial == "circle-point":
+        cp = circle_point(geometry, circle_data, parallel_tol=parallel_tol)
+        t0 = target.copy()
+        t0[:3, 3] = cp.target
+        em = build_model(model, geometry, base=cp.registration, lines=(cp.points, cp.directions),
+                         target=t0, orientation=oriented, parallel_tol=parallel_tol)
+    else:
+        em = build_model(model, geometry, base=world, target=target, orientation=oriented,
+                         parallel_tol=parallel_tol)
+    weights = 1.0 / sig
+    rot_weight = 1.0 / sigma_rot if oriented else 0.0
+    free, unid = identifiable_parameters(robot, em, em.initial, q, weights, rot_weight)
+    rows = q.shape[0] * (6 if oriented else 3)
+    n_struct = em.n_params - sum(u.kind == "structural" for u in unid)
+    if rows <= n_struct:
+        per = 6 if oriented else 3
+        raise ValueError(
+            f"too few poses: {len(q)} poses give {rows} equations for {n_struct} identifiable "
+            f"parameters of the {model} model of {robot.name}; at least {n_struct // per + 1} poses "
+            "are needed (several times more for a useful calibration)"
+        )
+    res = fit(em, em.initial, free, q, points, sigma=sig, orientations=orientations,
+              sigma_rot=sigma_rot, loss=loss, loss_scale=loss_scale, max_nfev=max_nfev)
+    if not res.success:
+        warnings.warn(f"calibration of {robot.name} did not converge: {res.message}", RuntimeWarning,
+                      stacklevel=2)
+    std = np.sqrt(np.diag(res.covariance))
+    parameters = tuple(
+        Parameter(em.names[k], float(res.params[k]), float(s), float(em.initial[k]), em.units[k])
+        for k, s in zip(res.free, std, strict=True)
+    )
+    jac = em.evaluate(res.params, q).jac_param[:, : 6 if oriented else 3][:, :, res.free]
+    obs = observability(jac.reshape(-1, len(res.free)), len(q))
+    return Calibration(
+        robot=calibrated_robot(robot, geometry, em, res.params),
+        model=em,
+        params=res.params,
+        parameters=parameters,
+        covariance=res.covariance,
+        unidentifiable=tuple(unid),
+        residuals=res.residuals,
+        rotation_residuals=res.rotation_residuals,
+        before_residuals=before_res,
+        before=ErrorStats.from_residuals(before_res),
+        after=ErrorStats.from_residuals(res.residuals),
+        observability=obs,
+        variance_factor=res.variance_factor,
+        pose_count=len(q),
+        sigma=float(np.mean(sig)),
+        loss=loss,
+        initial=initial,
+        nfev=res.nfev,
+        converged=res.success,
+        message=res.message,
+        circle_point=cp,
+        before_robot=calibrated_robot(robot, geometry, placed, placed_params, name=f"{robot.name}_placed"),
+    )
+
+
+def validate(calibration: Calibration, q, points) -> ErrorStats:
+    """Error statistics of the calibrated model on other (held-out) poses.
+
+    Parameters
+    ----------
+    calibration : Calibration
+    q : array_like, shape (N, n)
+    points : array_like, shape (N, 3)
+        Measured target positions, instrument frame, m.
+    """
+    q, points, _, _ = check_data(calibration.robot, q, points)
+    return ErrorStats.from_residuals(points - calibration.predict(q))
+
+
+def compensate(
+    calibration: Calibration,
+    points,
+    q_seed,
+    *,
+    frame: str = "instrument",
+    tol: float = 1e-10,
+    max_iter: int = 100,
+) -> np.ndarray:
+    """Corrected joint targets that put the target on desired points (calibrated inverse kinematics).
+
+    From ``q_seed`` (typically the nominal controller's joint solution), Newton steps with the
+    minimum-norm (pseudo-inverse) joint correction, so redundant degrees of freedom change as
+    little as possible.
+
+    Parameters
+    ----------
+    calibration : Calibration
+    points : array_like, shape (M, 3)
+        Desired target positions, m.
+    q_seed : array_like, shape (M, n)
+    frame : {"instrument", "base"}
+        Frame of ``points``: the instrument's, or the robot's chain base frame.
+    tol : float
+        Position tolerance, m.
+    max_iter : int
+
+    Returns
+    -------
+    numpy.ndarray, shape (M, n)
+
+    Raises
+    ------
+    ValueError
+        If a point is out of reach (no convergence from its seed).
+    """
+    q, pts, _, _ = check_data(calibration.robot, q_seed, points)
+    if frame == "base":
+        b = calibration.base()
+        pts = pts @ b[:3, :3].T + b[:3, 3]
+    elif frame != "instrument":
+        raise ValueError(f"frame must be 'instrument' or 'base', got {frame!r}")
+    return inverse_kinematics(calibration.model, calibration.params, pts, q, tol=tol, max_iter=max_iter)
+
+
+def inverse_kinematics(model: ErrorModel, params: np.ndarray, points: np.ndarray, q_seed: np.ndarray,
+                       *, tol: float = 1e-10, max_iter: int = 100) -> np.ndarray:
+    """Readings (M, n) that put the model's target on ``points`` (M, 3), from ``q_seed`` (M, n).
+
+    Newton steps with the minimum-norm (pseudo-inverse) joint correction.
+
+    Raises
+    ------
+    ValueError
+        If a point is not reached within ``tol`` (m).
+    """
+    q = np.array(q_seed, dtype=float)
+    for _ in range(max_iter):
+        ev = model.evaluate(params, q)
+        err = points - ev.position
+        if np.all(np.linalg.norm(err, axis=1) < tol):
+            return q
+        # dq = J^+ e (minimum-norm step)
+        q += np.einsum("mij,mj->mi", np.linalg.pinv(ev.jac_joint[:, :3], rcond=1e-10), err)
+    err = np.linalg.norm(points - model.evaluate(params, q, derivatives=False).position, axis=1)
+    bad = np.flatnonzero(err >= tol)
+    if bad.size:
+        raise ValueError(f"compensate: {bad.size} point(s) not reached (first: index {bad[0]}, "
+                         f"{err[bad[0]] * 1e3:.3g} mm away); out of reach or a poor seed")
+    return q
