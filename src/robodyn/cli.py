@@ -1,8 +1,11 @@
 """``robodyn`` command line: parse, call the public API, print.
 
-Subcommands: ``list``, ``show``, ``derive``, ``check`` and ``demo`` (``robodyn --help``).
-Exit codes: 0 success, 1 the formulations disagree, 2 bad input (unknown robot, invalid
-description, unwritable output), 130 interrupted.
+Subcommands: ``list``, ``show``, ``derive``, ``check``, ``codegen``, ``export``, ``simulate``,
+``calibrate``, ``iso9283`` and ``demo`` (``robodyn --help``); the last three of those before
+``demo`` live in :mod:`robodyn.cli_workflows`.
+Exit codes: 0 success; 1 the formulations disagree (check, demo) or the calibration did not
+converge (calibrate); 2 bad input (unknown robot, invalid description, unreadable data, unwritable
+output); 130 interrupted.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ from pathlib import Path
 import sympy as sp
 
 import robodyn as rd
+from robodyn.cli_workflows import add_parsers
 from robodyn.report.agreement import (
     AGREEMENT_HEADERS,
     COUNT_HEADERS,
@@ -187,14 +191,18 @@ def _parser() -> argparse.ArgumentParser:
     fmt = argparse.RawDescriptionHelpFormatter
     parser = argparse.ArgumentParser(
         prog="robodyn", formatter_class=fmt,
-        description="Symbolic equations of motion of serial robot manipulators: derive them by "
-                    "Newton-Euler, Lagrange or Kane, print them, and check the formulations "
-                    "against each other.",
+        description="Equations of motion of serial robot manipulators: derive them by "
+                    "Newton-Euler, Lagrange or Kane and check the formulations against each "
+                    "other; generate simulation code, simulate with controllers, export to "
+                    "URDF/MJCF; calibrate the kinematics from measured end-effector positions.",
         epilog="examples:\n"
                "  robodyn list\n"
                "  robodyn show puma560\n"
                "  robodyn derive trolley_pendulum --method kane --format latex -o trolley.tex\n"
                "  robodyn check planar_2r --samples 50\n"
+               "  robodyn codegen puma560 --lang c -o gen/\n"
+               "  robodyn simulate puma560 --controller computed-torque --target 0.5 -o sim/\n"
+               "  robodyn calibrate puma560 --data poses.csv -o calib/\n"
                "  robodyn demo -o out\n\n"
                "Run 'robodyn COMMAND --help' for the options of a command.")
     parser.add_argument("--version", action="version", version=f"robodyn {rd.__version__}")
@@ -279,6 +287,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--format", required=True, choices=("urdf", "mjcf"), help="output format")
     p.add_argument("-o", "--output", metavar="FILE", help="output file (default: stdout)")
     p.set_defaults(func=_cmd_export)
+
+    add_parsers(sub, fmt, _ROBOT_HELP)
 
     p = sub.add_parser("demo", help="PUMA 560 three ways: files, comparison and HTML report",
                        formatter_class=fmt,

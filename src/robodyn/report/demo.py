@@ -22,8 +22,10 @@ from robodyn.report.agreement import (
     count_rows,
     derive_all,
 )
+from robodyn.report.html import CSS as _CSS
+from robodyn.report.html import html_table
 from robodyn.report.simulation_sections import simulation_sections
-from robodyn.report.text import is_number, progress, table
+from robodyn.report.text import progress, table
 from robodyn.symbolic.render import render_json, render_latex, render_mathml, render_text
 
 
@@ -57,6 +59,8 @@ def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
     (out / "comparison.csv").write_text(csv_text.getvalue())
     (out / "comparison.md").write_text(_markdown(robot, counts, results, samples))
     sections, sim_ok = simulation_sections(robot, out)
+    cal_section, cal_ok = _calibration_section(out)
+    sections += "\n" + cal_section
     page = _html_page(robot, counts, results, samples, teom, closed,
                       render_mathml(teom), render_latex(teom), render_text(teom))
     page = page.replace("</body></html>", sections + "\n</body></html>")
@@ -69,7 +73,24 @@ def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
     print(f"wrote {', '.join(sorted(p.name for p in out.iterdir()))} in {out}")
     print(f"report: {(out / 'report.html').resolve()}")
     print("chapter 3 (computed torque, balance): " + ("ok" if sim_ok else "FAILED"))
-    return 0 if all(r.ok for r in results) and closed and sim_ok else 1
+    print("chapter 4 (calibration study, held-out error within 1.3x the noise): "
+          + ("ok" if cal_ok else "FAILED"))
+    return 0 if all(r.ok for r in results) and closed and sim_ok and cal_ok else 1
+
+
+def _calibration_section(out: Path) -> tuple[str, bool]:
+    """Run the PUMA 560 calibration study into ``out/calibration``; (HTML section, all ok)."""
+    from robodyn.calibrate.simulate_study import puma_study
+    from robodyn.report.calibration_report import study_section
+
+    with progress("PUMA 560 calibration study (DH, Hayati, S-model, POE; 2 tracker noises)"):
+        study = puma_study(out / "calibration")
+    (out / "calibration" / "study.txt").write_text(study.table() + "\n\n"
+                                                   + "\n".join(study.notes) + "\n")
+    # every model but standard DH from the nominal start must explain all but the noise
+    ok = all(c.test_after.rms < 1.3 * c.sigma * 3**0.5 for c in study.cases
+             if (c.model, c.initial) != ("dh", "nominal"))
+    return study_section(study, "calibration"), ok
 
 
 def _trolley_closed_form_ok(eom: rd.EquationsOfMotion) -> bool:
@@ -105,42 +126,6 @@ def _markdown(robot: rd.Robot, counts: list[list[object]], results: Sequence[Agr
               f"tolerance {TOLERANCE:g})", ""]
     lines += mdtable(AGREEMENT_HEADERS, agreement_rows(results))
     return "\n".join(lines) + "\n"
-
-
-_CSS = """
-body { font-family: system-ui, sans-serif; max-width: 70rem; margin: 2rem auto; padding: 0 1rem;
-       color: #222; line-height: 1.45; }
-h1 { font-size: 1.6rem; border-bottom: 2px solid #345; padding-bottom: .3rem; }
-h2 { font-size: 1.25rem; margin-top: 2rem; color: #234; }
-h4 { margin: 1rem 0 .2rem; }
-table { border-collapse: collapse; margin: .5rem 0; font-variant-numeric: tabular-nums; }
-th, td { border: 1px solid #bbc; padding: .25rem .6rem; }
-th { background: #e8edf3; }
-td.num { text-align: right; }
-.ok { color: #176117; font-weight: 600; }
-.bad { color: #a01010; font-weight: 600; }
-pre { background: #f5f6f8; padding: .6rem; overflow-x: auto; font-size: .85rem; }
-math { font-size: 1.1rem; }
-.meta { color: #555; font-size: .9rem; }
-"""
-
-
-def html_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
-    head = "".join(f"<th>{html.escape(str(h))}</th>" for h in headers)
-    body = []
-    for row in rows:
-        cells = []
-        for c in row:
-            text = html.escape(str(c))
-            if text in ("ok", "yes"):
-                cells.append(f'<td class="ok">{text}</td>')
-            elif text in ("DISAGREE", "NO"):
-                cells.append(f'<td class="bad">{text}</td>')
-            else:
-                cells.append(f'<td class="num">{text}</td>' if is_number(c)
-                             else f"<td>{text}</td>")
-        body.append("<tr>" + "".join(cells) + "</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
 
 
 def _html_page(robot: rd.Robot, counts: list[list[object]], results: Sequence[Agreement],

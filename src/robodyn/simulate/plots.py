@@ -17,6 +17,8 @@ from robodyn.numeric.model import Model  # noqa: E402
 if TYPE_CHECKING:
     from robodyn.simulate.aa300_study import AA300Study
     from robodyn.simulate.balance import BalanceResult
+    from robodyn.simulate.simulation import Trajectory
+    from robodyn.simulate.trajectory import JointTrajectory
 
 
 def _shade(ax, study: AA300Study) -> None:
@@ -151,4 +153,45 @@ def balance_figure(result: BalanceResult, path: Path) -> Path:
     return path
 
 
-__all__ = ["aa300_animation", "aa300_figures", "balance_figure"]
+def trajectory_figure(sim: Trajectory, names: tuple[str, ...], path: Path,
+                      reference: JointTrajectory | None = None) -> Path:
+    """Positions (with the reference, dashed), velocities, torques and energy of a simulation.
+
+    Parameters
+    ----------
+    sim : Trajectory
+    names : tuple of str, length n
+        Joint names for the legends.
+    path : Path
+        PNG file to write.
+    reference : JointTrajectory, optional
+        The planned motion, drawn dashed over the positions.
+
+    Returns
+    -------
+    Path
+    """
+    fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True)
+    for j, name in enumerate(names):
+        (line,) = axes[0].plot(sim.t, sim.q[:, j], lw=1.2, label=name)
+        if reference is not None:
+            axes[0].plot(sim.t, reference.at(sim.t)[0][:, j], "--", lw=0.9, color=line.get_color())
+        axes[1].plot(sim.t, sim.qd[:, j], lw=1.0)
+        axes[2].plot(sim.t, sim.tau[:, j], lw=1.0)
+    axes[0].set_ylabel("q (rad, m)")
+    axes[0].legend(fontsize=7, ncols=min(len(names), 7))
+    axes[1].set_ylabel("qd (rad/s, m/s)")
+    axes[2].set_ylabel("tau (N m, N)")
+    axes[3].plot(sim.t, sim.energy - sim.energy[0], label="E - E(0)")
+    axes[3].plot(sim.t, sim.kinetic, lw=0.8, label="kinetic")
+    axes[3].set_ylabel("energy (J)")
+    axes[3].legend(fontsize=7)
+    axes[3].set_xlabel("t (s)")
+    fig.suptitle(f"{sim.robot}: {sim.method}, dt = {sim.dt:g} s, controller {sim.controller}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+__all__ = ["aa300_animation", "aa300_figures", "balance_figure", "trajectory_figure"]

@@ -1,0 +1,302 @@
+"""``robodyn simulate``, ``robodyn calibrate`` and ``robodyn iso9283``: parsers and commands.
+
+Kept apart from :mod:`robodyn.cli` (which registers them) so that each file stays short; like the
+rest of the command line, these only parse, call the public API and print.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+
+import robodyn as rd
+from robodyn.report.text import err, progress, table
+
+__all__ = ["add_parsers"]
+
+
+def _floats(text: str) -> np.ndarray:
+    """A comma-separated list of numbers (``0,0.5,-1``); an argparse type."""
+    try:
+        return np.array([float(v) for v in text.replace(" ", "").split(",") if v], dtype=float)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
+
+
+def _vector(value: np.ndarray | None, n: int, option: str, default: float = 0.0) -> np.ndarray:
+    if value is None:
+        return np.full(n, default)
+    if value.size == 1:
+        return np.full(n, float(value[0]))
+    if value.size != n:
+        raise ValueError(f"{option}: expected 1 or {n} comma-separated values (one per joint), "
+                         f"got {value.size}")
+    return value
+
+
+# ----------------------------------------------------------------------------------------------
+# simulate
+# ----------------------------------------------------------------------------------------------
+
+
+def _controller(args: argparse.Namespace, model: rd.Model, q0: np.ndarray):
+    """The controller and the planned reference (None for a passive run)."""
+    from robodyn.simulate.controllers import PD, PID, ComputedTorque, GravityCompensation
+    from robodyn.simulate.trajectory import quintic
+
+    n = model.dof
+    if args.controller == "none":
+        if args.target is not None:
+            raise ValueError("--target needs a controller (--controller pd|pid|gravity|computed-torque)")
+        return None, None
+    target = _vector(args.target, n, "--target") if args.target is not None else q0
+    move = args.move_time if args.move_time is not None else 0.5 * args.duration
+    if not 0 < move <= args.duration:
+        raise ValueError(f"--move-time: must be in (0, duration = {args.duration:g}] s, got {move:g}")
+    plan = quintic(q0, target, move, dt=args.dt)
+    kp = _vector(args.kp, n, "--kp")
+    kd = _vector(args.kd, n, "--kd")
+    if args.controller == "computed-torque":
+        return ComputedTorque(plan, kp=kp, kd=kd), plan
+    if args.controller == "pd":
+        return PD(kp, kd, plan), plan
+    if args.controller == "pid":
+        return PID(kp, _vector(args.ki, n, "--ki"), kd, plan), plan
+    return GravityCompensation(kp, kd, plan), plan
+
+
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    from robodyn.simulate.plots import trajectory_figure
+
+    robot = rd.load(args.robot)
+    n = robot.dof
+    q0 = _vector(args.q0, n, "--q0")
+    qd0 = _vector(args.qd0, n, "--qd0")
+    out = Path(args.output)
+    out.mkdir(parents=True, exist_ok=True)
+    with progress(f"compiling {robot.name} ({args.backend} backend)"):
+        model = rd.compile_model(robot, backend=args.backend)
+    if args.controller == "computed-torque" and args.kp is None:
+        args.kp, args.kd = np.array([400.0]), np.array([40.0])
+    if args.kp is None:
+        args.kp = np.array([100.0])
+    if args.kd is None:
+        args.kd = np.array([20.0])
+    controller, plan = _controller(args, model, q0)
+    limit = _vector(args.tau_limit, n, "--tau-limit") if args.tau_limit is not None else None
+    with progress(f"simulating {args.duration:g} s at dt = {args.dt:g} s ({args.method})"):
+        sim = rd.simulate(model, q0, qd0, args.duration, args.dt, method=args.method,
+                          controller=controller, tau_limit=limit)
+    names = robot.joint_names
+    csv_path = out / f"{robot.name}_simulation.csv"
+    with csv_path.open("w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(["t", *(f"q_{j}" for j in names), *(f"qd_{j}" for j in names),
+                    *(f"qdd_{j}" for j in names), *(f"tau_{j}" for j in names), "energy"])
+        for k in range(len(sim.t)):
+            w.writerow([repr(float(v)) for v in (sim.t[k], *sim.q[k], *sim.qd[k], *sim.qdd[k],
+                                                 *sim.tau[k], sim.energy[k])])
+    with progress("plotting"):
+        fig = trajectory_figure(sim, names, out / f"{robot.name}_simulation.png", plan)
+    rows = [[j, f"{sim.q[-1, k]:.6g}", f"{np.abs(sim.qd[:, k]).max():.4g}",
+             f"{np.abs(sim.tau[:, k]).max():.4g}"] for k, j in enumerate(names)]
+    headers = ["joint", "final q", "max |qd|", "max |tau|"]
+    if plan is not None:
+        err_track = np.abs(sim.q - plan.at(sim.t)[0]).max(axis=0)
+        headers.append("max |q - q_ref|")
+        for row, e in zip(rows, err_track, strict=True):
+            row.append(f"{e:.3g}")
+    print(table(headers, rows))
+    print(f"{len(sim.t) - 1} steps, {sim.evaluations} right-hand-side evaluations; energy "
+          f"{sim.energy[0]:.6g} J -> {sim.energy[-1]:.6g} J"
+          + (f" (relative drift {sim.energy_drift:.3g})" if controller is None else ""))
+    print(f"wrote {csv_path} and {fig}")
+    return 0
+
+
+# ----------------------------------------------------------------------------------------------
+# calibrate
+# ----------------------------------------------------------------------------------------------
+
+
+def _cmd_calibrate(args: argparse.Namespace) -> int:
+    from robodyn.calibrate.io import read_calibration_csv, write_calibration
+    from robodyn.calibrate.pipeline import validate
+    from robodyn.report.calibration_report import calibration_html
+
+    robot = rd.load(args.robot)
+    data = read_calibration_csv(args.data, robot)
+    circle = None
+    if args.circle:
+        if len(args.circle) != robot.dof:
+            raise ValueError(f"--circle: give one file per joint in chain order ({robot.dof} for "
+                             f"{robot.name}), got {len(args.circle)}")
+        circle = []
+        for path in args.circle:
+            d = read_calibration_csv(path, robot)
+            circle.append((d.q, d.points))
+    sigma = data.sigma if data.sigma is not None else args.sigma * 1e-3
+    with progress(f"calibrating {robot.name} from {len(data.q)} poses ({args.model} model)"):
+        cal = rd.calibrate(robot, data.q, data.points, args.model, sigma=sigma, loss=args.loss,
+                           initial="circle-point" if circle else "nominal", circle_data=circle,
+                           orientations=data.orientations)
+    validation = None
+    if args.validate:
+        held = read_calibration_csv(args.validate, robot)
+        stats = validate(cal, held.q, held.points)
+        validation = (Path(args.validate).name, held.points - cal.predict(held.q))
+    stem = args.stem or f"{robot.name}_calibrated"
+    paths = write_calibration(cal, args.output, stem=stem)
+    paths["html"] = calibration_html(cal, Path(args.output) / f"{stem}_report.html",
+                                     source=str(args.data), validation=validation)
+    print(cal.summary())
+    if validation is not None:
+        print(f"\nheld-out ({args.validate}): {stats.text()}")
+    print()
+    for kind, path in paths.items():
+        if path is not None:
+            print(f"wrote {kind:<9} {path}")
+    if not cal.converged:
+        err("robodyn: warning: the least-squares solver did not converge")
+        return 1
+    return 0
+
+
+# ----------------------------------------------------------------------------------------------
+# iso9283
+# ----------------------------------------------------------------------------------------------
+
+
+def _cmd_iso9283(args: argparse.Namespace) -> int:
+    from robodyn.calibrate.io import read_table
+    from robodyn.calibrate.iso9283 import overshoot_stabilisation, pose_characteristics_from_csv
+
+    if args.data is None and args.approach is None:
+        raise ValueError("give a CSV of repeated poses (DATA) and/or --approach FILE.csv")
+    if args.data is not None:
+        pc = pose_characteristics_from_csv(args.data)
+        print(f"ISO 9283 pose accuracy and repeatability, {args.data} ({pc.cycles} cycles)")
+        print(pc.text())
+    if args.approach is not None:
+        t = read_table(args.approach, ["t", "x", "y", "z"])
+        x = np.column_stack([t[c] for c in ("x", "y", "z")])
+        attained = _vector(args.attained, 3, "--attained") if args.attained is not None else None
+        ov = overshoot_stabilisation(np.asarray(t["t"]), x, band=args.band * 1e-3, attained=attained)
+        stab = (f"{ov.stabilisation_time:.4g} s" if not math.isnan(ov.stabilisation_time)
+                else "not stabilised within the record")
+        over = (f"{ov.overshoot * 1e3:.4f} mm" if not math.isnan(ov.overshoot)
+                else "never within the band")
+        print(f"\nISO 9283 overshoot and stabilisation, {args.approach} (band {args.band:g} mm):")
+        print(f"  attained position   {', '.join(f'{v:.6f}' for v in ov.attained)} m")
+        print(f"  position overshoot  {over}")
+        print(f"  stabilisation time  {stab}")
+    return 0
+
+
+# ----------------------------------------------------------------------------------------------
+# parsers
+# ----------------------------------------------------------------------------------------------
+
+
+def add_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
+    """Register ``simulate``, ``calibrate`` and ``iso9283`` on the ``robodyn`` sub-parsers."""
+    from robodyn.calibrate.models import MODELS
+    from robodyn.simulate.simulation import ADAPTIVE, FIXED_STEP
+
+    p = sub.add_parser(
+        "simulate", help="simulate a robot (passive or under a controller), CSV and plots",
+        formatter_class=fmt,
+        description="Compile the robot's dynamics and simulate it from (q0, qd0): passive, or "
+                    "moving to --target along a quintic path under PD, PID, PD with gravity "
+                    "compensation, or computed torque. Writes ROBOT_simulation.csv (t, q, qd, qdd, "
+                    "tau, energy) and ROBOT_simulation.png (positions with the reference, "
+                    "velocities, torques, energy) into the output folder.",
+        epilog="examples:\n"
+               "  robodyn simulate trolley_double_pendulum --q0 0,0.3,-0.2 --duration 5 -o sim/\n"
+               "  robodyn simulate puma560 --controller computed-torque "
+               "--target 0.8,-0.6,0.9,0.5,-0.7,1 --duration 3 -o sim/\n"
+               "  robodyn simulate planar_2r --method DOP853 --q0 1,0 -o sim/")
+    p.add_argument("robot", metavar="ROBOT", help=robot_help)
+    p.add_argument("--q0", type=_floats, metavar="Q", help="initial positions, rad/m (default 0)")
+    p.add_argument("--qd0", type=_floats, metavar="QD", help="initial velocities (default 0)")
+    p.add_argument("--duration", type=float, default=2.0, metavar="S",
+                   help="simulated time, s (default: %(default)s)")
+    p.add_argument("--dt", type=float, default=1e-3, metavar="S",
+                   help="step and output interval, s (default: %(default)s)")
+    p.add_argument("--method", choices=FIXED_STEP + ADAPTIVE, default="rk4",
+                   help="integrator; rk4 and semi_implicit run inside the generated C "
+                        "(default: %(default)s)")
+    p.add_argument("--controller", default="none",
+                   choices=("none", "pd", "pid", "gravity", "computed-torque"),
+                   help="control law (default: %(default)s, i.e. no actuator torque)")
+    p.add_argument("--target", type=_floats, metavar="Q",
+                   help="final joint positions of a quintic move from q0 (default: hold q0)")
+    p.add_argument("--move-time", type=float, metavar="S",
+                   help="duration of the move, s (default: half of --duration)")
+    p.add_argument("--kp", type=_floats, metavar="K",
+                   help="stiffness per joint (default 100; 400 1/s^2 for computed torque)")
+    p.add_argument("--kd", type=_floats, metavar="K",
+                   help="damping per joint (default 20; 40 1/s for computed torque)")
+    p.add_argument("--ki", type=_floats, metavar="K", help="integral gain (pid; default 0)")
+    p.add_argument("--tau-limit", type=_floats, metavar="T", help="actuator limits, N m or N")
+    p.add_argument("--backend", choices=("c", "numpy"), default="c",
+                   help="compiled C or pure NumPy (default: %(default)s)")
+    p.add_argument("-o", "--output", metavar="DIR", default="sim",
+                   help="output folder (default: %(default)s)")
+    p.set_defaults(func=_cmd_simulate)
+
+    p = sub.add_parser(
+        "calibrate", help="kinematic calibration from measured end-effector positions",
+        formatter_class=fmt,
+        description="Kinematic calibration (Stone's method): fit an error model to measured "
+                    "target positions, with the instrument-to-base transform and the target "
+                    "offset on the last link estimated too. DATA is a CSV with one column per "
+                    "joint (named as in 'robodyn show ROBOT'), x, y, z in metres, and optionally "
+                    "qw, qx, qy, qz (measured orientation) and sigma (m). Writes the calibrated "
+                    "description (YAML and URDF, both readable by robodyn) and a report (text, "
+                    "JSON, residuals CSV, HTML with plots). Exit code 1 if the solver did not "
+                    "converge.",
+        epilog="examples:\n"
+               "  robodyn calibrate puma560 --data poses.csv -o calib/\n"
+               "  robodyn calibrate puma560 --data poses.csv --model hayati --validate held.csv "
+               "-o calib/\n"
+               "  robodyn calibrate puma560 --data poses.csv --circle j1.csv --circle j2.csv ... "
+               "-o calib/")
+    p.add_argument("robot", metavar="ROBOT", help=robot_help)
+    p.add_argument("--data", required=True, metavar="FILE.csv", help="measured poses")
+    p.add_argument("--model", choices=tuple(MODELS), default="s-model",
+                   help="error model (default: %(default)s)")
+    p.add_argument("--sigma", type=float, default=0.05, metavar="MM",
+                   help="measurement standard uncertainty per coordinate, mm, when the CSV has "
+                        "no sigma column (default: %(default)s)")
+    p.add_argument("--loss", choices=("linear", "huber", "soft_l1", "cauchy", "arctan"),
+                   default="linear", help="robust loss (default: %(default)s)")
+    p.add_argument("--circle", action="append", metavar="FILE.csv",
+                   help="circle-point data, one file per joint in chain order (only that joint "
+                        "moves): start from Stone's circle-point estimate instead of the nominal")
+    p.add_argument("--validate", metavar="FILE.csv", help="held-out poses to report errors on")
+    p.add_argument("--stem", help="file name stem (default: ROBOT_calibrated)")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
+    p.set_defaults(func=_cmd_calibrate)
+
+    p = sub.add_parser(
+        "iso9283", help="ISO 9283 pose accuracy, repeatability, overshoot from measurements",
+        formatter_class=fmt,
+        description="ISO 9283 performance characteristics. DATA: a CSV of repeated cycles with "
+                    "columns pose (label), x_cmd, y_cmd, z_cmd (commanded) and x, y, z "
+                    "(attained), m; prints the pose accuracy AP and repeatability RP per pose. "
+                    "--approach: a CSV with t, x, y, z of a measured approach to a pose; prints "
+                    "the position overshoot and the stabilisation time for --band.",
+        epilog="examples:\n  robodyn iso9283 cycles.csv\n"
+               "  robodyn iso9283 --approach approach.csv --band 0.1")
+    p.add_argument("data", metavar="DATA", nargs="?", help="CSV of repeated cycles")
+    p.add_argument("--approach", metavar="FILE.csv", help="measured approach trajectory")
+    p.add_argument("--band", type=float, default=0.1, metavar="MM",
+                   help="stabilisation band, mm (default: %(default)s)")
+    p.add_argument("--attained", type=_floats, metavar="X,Y,Z",
+                   help="the attained pose, m (default: the mean of the last 10 %% of samples)")
+    p.set_defaults(func=_cmd_iso9283)
