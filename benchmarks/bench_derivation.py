@@ -5,7 +5,9 @@ Prints:
   2. PUMA 560 inverse-dynamics operation counts (numeric parameters) beside the published
      SymPyBotics (512 mul, 454 add) and CasADi (295 mul, 210 add) figures.
   3. Lagrange and Kane for the PUMA 560 (targets: under 60 s each).
-  4. Newton-Euler for spatial chains of 6, 12 and 30 joints: time and op count per joint.
+  4. Newton-Euler inverse dynamics for spatial chains of 6, 12 and 30 joints: time and op count
+     per joint (the recursive program alone), and the whole model (tau, M by composite rigid
+     bodies, g) for reference: M has n(n+1)/2 entries, so that part cannot grow linearly.
   5. sympy.physics.mechanics KanesMethod on a 6-link spatial chain with symbolic inertia against
      robodyn's Kane and Newton-Euler on the same chain, in this run (ratio printed).
 
@@ -23,6 +25,9 @@ import robodyn as rd
 from robodyn.robot import placement
 from robodyn.robot.chain import ChainElement, assemble
 from robodyn.robot.model import Link
+from robodyn.symbolic import newton_euler as ne
+from robodyn.symbolic.kinematics import joint_symbols
+from robodyn.symbolic.program import Program, Recorder
 
 SYMPYBOTICS_OPS = (512, 454)  # multiplications, additions: SymPyBotics PUMA inverse dynamics
 CASADI_OPS = (295, 210)  # CasADi graph of PUMA inverse dynamics, numeric parameters
@@ -55,6 +60,15 @@ def spatial_chain(n: int, symbolic: bool) -> rd.Robot:
         elements.append(ChainElement(f"j{k}", "revolute", pre, axis, post, link))
         del length
     return assemble(f"chain{n}", elements, parameters=params)
+
+
+def inverse_dynamics_program(robot: rd.Robot):
+    """The recursive Newton-Euler inverse dynamics of ``robot`` as a pruned Program (as derive)."""
+    n = robot.dof
+    q, qd, qdd = joint_symbols(n)
+    rec = Recorder({s.name for s in q + qd + qdd} | set(robot.parameters))
+    out = ne.inverse_dynamics(robot, q, qd, qdd, rec)
+    return Program(tuple(rec.assignments), out).pruned()
 
 
 def sympy_kanes_method_chain(n: int) -> float:
@@ -133,12 +147,21 @@ def main() -> None:
 
     print("\n== 4. Newton-Euler on spatial chains (numeric inertia): linear growth ==")
     sizes = (6, 12) if args.quick else (6, 12, 30)
+    previous = None
     for n in sizes:
         robot = spatial_chain(n, symbolic=False)
-        e, t = timed(lambda r=robot: rd.derive(r, "newton_euler"))
-        ops = cse_op_count(list(e.program.outputs), e.program.assignments)
-        print(f"n={n:3d}: {t:7.2f} s ({t / n * 1e3:6.1f} ms/joint); tau ops: {ops.multiplications} mul "
-              f"({ops.multiplications / n:.1f}/joint), {ops.additions} add ({ops.additions / n:.1f}/joint)")
+        prog, t = timed(lambda r=robot: inverse_dynamics_program(r))
+        ops = cse_op_count(list(prog.outputs), prog.assignments)
+        _, t_all = timed(lambda r=robot: rd.derive(r, "newton_euler"))
+        print(f"n={n:3d}: inverse dynamics {t:6.2f} s ({t / n * 1e3:5.1f} ms/joint); "
+              f"{ops.multiplications} mul ({ops.multiplications / n:.1f}/joint), {ops.additions} add "
+              f"({ops.additions / n:.1f}/joint); whole model (tau, M, g) {t_all:6.2f} s")
+        if previous is not None:
+            # marginal cost of the joints added since the previous size: constant if linear
+            n0, t0, m0 = previous
+            print(f"        joints {n0 + 1}-{n}: {(t - t0) / (n - n0) * 1e3:5.1f} ms and "
+                  f"{(ops.multiplications - m0) / (n - n0):.1f} mul per added joint")
+        previous = (n, t, ops.multiplications)
 
     print("\n== 5. 6-link spatial chain, symbolic inertia: sympy KanesMethod vs robodyn ==")
     chain = spatial_chain(6, symbolic=True)
