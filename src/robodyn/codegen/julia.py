@@ -19,7 +19,7 @@ from __future__ import annotations
 import sympy as sp
 from sympy.printing.julia import JuliaCodePrinter
 
-from robodyn.codegen.base import GeneratedFile, Printer, identifier
+from robodyn.codegen.base import NATURAL, GeneratedFile, Printer, identifier
 from robodyn.codegen.fortran import float_literal
 from robodyn.codegen.kernels import Argument, Kernel, KernelSet
 
@@ -57,6 +57,7 @@ class JuliaPrinter(Printer):
 
     language = "Julia"
     comment = "#"
+    layout = NATURAL
 
     def __init__(self, prefix: str = "") -> None:
         super().__init__(prefix)

@@ -22,7 +22,7 @@ robodyn's tests exercise it only through a stand-in for the Simulink block objec
 
 from __future__ import annotations
 
-from robodyn.codegen.base import GeneratedFile, identifier, provenance
+from robodyn.codegen.base import NATURAL, GeneratedFile, identifier, provenance
 from robodyn.codegen.kernels import Kernel, KernelSet
 
 
@@ -160,7 +160,7 @@ def sfunction_source(kset: KernelSet) -> str:
         f"  Dialog parameter: x0, the initial state ({2 * n} values, q then qd).",
         f"  Needs the MEX gateway on the path: mex {stem}_mex.c (with {kset.robot_name}.c beside it).",
         "",
-        *provenance(kset, "Simulink Level-2 MATLAB S-function"),
+        *provenance(kset, "Simulink Level-2 MATLAB S-function", NATURAL),
     ]
     return "\n".join([
         f"function {stem}_sfun(block)",

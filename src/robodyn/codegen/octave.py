@@ -15,7 +15,7 @@ from __future__ import annotations
 import sympy as sp
 from sympy.printing.octave import OctaveCodePrinter
 
-from robodyn.codegen.base import GeneratedFile, Printer, identifier, provenance
+from robodyn.codegen.base import NATURAL, GeneratedFile, Printer, identifier, provenance
 from robodyn.codegen.fortran import float_literal
 from robodyn.codegen.kernels import Argument, Kernel, KernelSet
 
@@ -32,6 +32,7 @@ class OctavePrinter(Printer):
 
     language = "MATLAB/Octave"
     comment = "%"
+    layout = NATURAL
     indent = "  "
 
     def __init__(self, prefix: str = "robodyn_") -> None:
@@ -102,7 +103,7 @@ class OctavePrinter(Printer):
         if too_long:
             raise ValueError(f"MATLAB names are at most 63 characters (namelengthmax): "
                              f"{', '.join(too_long)}; pass a shorter prefix to octave_files")
-        self._provenance = [*provenance(kset, self.language),
+        self._provenance = [*provenance(kset, self.language, self.layout),
                             "In this file matrices are indexed naturally, M(i, j, k) (column-major)."]
         return [GeneratedFile(f"{self.prefix}{kernel.name}.m", self.function(kernel))
                 for kernel in kset.kernels]
