@@ -7,8 +7,9 @@ Prints:
      ``mujoco.rollout`` in C) and against the usual Python route, SciPy ``solve_ivp`` over SymPy
      ``lambdify`` of the equations (targets: >= 5x MuJoCo, >= 100x solve_ivp + lambdify); the
      seed's CPU seconds beside ours, for the record.
-  2. PUMA 560 batched kernels on 10^5 states (inverse dynamics, mass matrix, forward dynamics),
-     ns per state, against Pinocchio's rnea / crba / aba looped from Python and
+  2. PUMA 560 batched kernels on 10^5 states (inverse dynamics, mass matrix, gravity, C qd,
+     forward dynamics), ns per state, against Pinocchio's rnea / crba /
+     computeGeneralizedGravity / rnea without gravity at qdd = 0 / aba looped from Python and
      ``rneaInParallel`` / ``abaInParallel``.
   3. Time to generate and compile the PUMA 560 model from scratch (fresh cache).
 
@@ -253,15 +254,29 @@ def bench_puma(quick: bool) -> None:
     ours = {
         "inverse dynamics": best_of(lambda: model.inverse_dynamics(q, qd, qdd), 5),
         "mass matrix": best_of(lambda: model.mass_matrix(q), 5),
+        "gravity": best_of(lambda: model.gravity(q), 5),
+        "coriolis C qd": best_of(lambda: model.coriolis(q, qd), 5),
         "forward dynamics": best_of(lambda: model.forward_dynamics(q, qd, tau), 5),
     }
     pmodel, source = pinocchio_puma(robot)
     pdata = pmodel.createData()
-    # same model? M (rotor inertia included) and g against Pinocchio at a few states
+    # C(q, qd) qd is Pinocchio's RNEA at qdd = 0 without gravity
+    pmodel_c = pin.Model(pmodel)
+    pmodel_c.gravity.linear = np.zeros(3)
+    pdata_c = pmodel_c.createData()
+    zero = np.zeros(6)
+
+    def pin_coriolis(_model, _data, qk, qdk):
+        return pin.rnea(pmodel_c, pdata_c, qk, qdk, zero)
+
+    # same model? M (rotor inertia included), g and C qd against Pinocchio at a few states
     dm = max(np.max(np.abs(pin.crba(pmodel, pdata, q[k]) - model.mass_matrix(q[k]))) for k in range(20))
     dg = max(np.max(np.abs(pin.computeGeneralizedGravity(pmodel, pdata, q[k]) - model.gravity(q[k])))
              for k in range(20))
-    print(f"Pinocchio {pin.__version__} model: {source}; max |M - M_pin| = {dm:.1e}, |g - g_pin| = {dg:.1e}")
+    dc = max(np.max(np.abs(pin_coriolis(None, None, q[k], qd[k]) - model.coriolis(q[k], qd[k])))
+             for k in range(20))
+    print(f"Pinocchio {pin.__version__} model: {source}; max |M - M_pin| = {dm:.1e}, "
+          f"|g - g_pin| = {dg:.1e}, |C qd - (C qd)_pin| = {dc:.1e}")
     loops = min(n_states, 20_000)
 
     def loop(fn, *arrays):
@@ -273,6 +288,8 @@ def bench_puma(quick: bool) -> None:
     theirs = {
         "inverse dynamics": best_of(loop(pin.rnea, q, qd, qdd), 3) * n_states / loops,
         "mass matrix": best_of(loop(pin.crba, q), 3) * n_states / loops,
+        "gravity": best_of(loop(pin.computeGeneralizedGravity, q), 3) * n_states / loops,
+        "coriolis C qd": best_of(loop(pin_coriolis, q, qd), 3) * n_states / loops,
         "forward dynamics": best_of(loop(pin.aba, q, qd, tau), 3) * n_states / loops,
     }
     parallel = {}
