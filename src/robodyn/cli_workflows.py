@@ -90,7 +90,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     limit = _vector(args.tau_limit, n, "--tau-limit") if args.tau_limit is not None else None
     with progress(f"simulating {args.duration:g} s at dt = {args.dt:g} s ({args.method})"):
         sim = rd.simulate(model, q0, qd0, args.duration, args.dt, method=args.method,
-                          controller=controller, tau_limit=limit)
+                          controller=controller, tau_limit=limit, control=args.control)
     names = robot.joint_names
     csv_path = out / f"{robot.name}_simulation.csv"
     with csv_path.open("w", newline="", encoding="utf-8") as fh:
@@ -242,6 +242,10 @@ def add_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> 
     p.add_argument("--kd", type=_floats, metavar="K",
                    help="damping per joint (default 20; 40 1/s for computed torque)")
     p.add_argument("--ki", type=_floats, metavar="K", help="integral gain (pid; default 0)")
+    p.add_argument("--control", choices=("sampled", "continuous"), default="sampled",
+                   help="fixed-step methods: evaluate the law once per step and hold it (a "
+                        "digital controller at 1/dt), or at every RK4 stage (continuous-time) "
+                        "(default: %(default)s)")
     p.add_argument("--tau-limit", type=_floats, metavar="T", help="actuator limits, N m or N")
     p.add_argument("--backend", choices=("c", "numpy"), default="c",
                    help="compiled C or pure NumPy (default: %(default)s)")

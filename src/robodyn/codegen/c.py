@@ -292,94 +292,157 @@ def simulate_signature(prefix: str) -> str:
     """Prototype of the in-C trajectory integrator."""
     return (f"int {prefix}simulate(long steps, double dt, int method, const double *x0, "
             "const double *feedforward, const double *reference, const double *gain, "
-            "const double *integral_gain, int mode, const double *tau_limit, "
+            "const double *integral_gain, int mode, const double *tau_limit, int continuous, "
             "double *x_out, double *tau_out)")
 
 
-def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) -> str:
-    """C source of ``PREFIXsimulate``: fixed-step integration with a sampled controller.
-
-    At every step ``k`` (zero-order hold over the step, as a digital controller running at the
-    integration rate), with ``e = reference_k - x`` (2 n) and ``e_q`` its first n entries::
-
-        mode 0 (feedback):        tau = feedforward_k + gain e + integral_gain * sum(e_q dt)
-        mode 1 (+ gravity):       the same + g(q)
-        mode 2 (computed torque): tau = M(q) (feedforward_k + gain e) + C qd + g + friction
-
-    then clipped to ``+-tau_limit``. ``method`` 0 is classical RK4, 1 semi-implicit (symplectic)
-    Euler. Null pointers mean zero (no feedforward, no reference, no gain, no limit). Returns 0,
-    or k + 1 when the state stopped being finite at step k.
-    """
-    sd = f"{prefix}state_derivative"
+def _law_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) -> list[str]:
+    """``PREFIXcontrol_law``: the torque at one state from row ``row`` of the sampled inputs."""
     lines = [
-        f"/* Integrate {n}-joint dynamics for `steps` steps of `dt` s (see robodyn.codegen.c). */",
-        simulate_signature(prefix) + " {",
+        "/* tau = the control law at state x with the inputs of sample `row` (see simulate). */",
+        f"static void {prefix}control_law(long row, const double *x, const double *integ, "
+        "const double *feedforward, const double *reference, const double *gain, "
+        "const double *integral_gain, int mode, const double *tau_limit, double *tau) {",
         f"    enum {{ N = {n}, NX = {2 * n} }};",
-        "    double x[NX], xt[NX], k1[NX], k2[NX], k3[NX], k4[NX], tau[N], integ[N], e[NX];",
-        "    for (int i = 0; i < NX; ++i) x[i] = x_out[i] = x0[i];",
-        "    for (int i = 0; i < N; ++i) integ[i] = 0.0;",
-        "    for (long k = 0; k < steps; ++k) {",
-        "        /* e = reference_k - x */",
-        "        for (int i = 0; i < NX; ++i) e[i] = (reference ? reference[k * NX + i] : 0.0) - x[i];",
-        "        for (int i = 0; i < N; ++i) integ[i] += e[i] * dt;",
-        "        /* v = feedforward_k + gain e + integral_gain * integral(e_q) */",
-        "        double v[N];",
-        "        for (int i = 0; i < N; ++i) {",
-        "            double s = feedforward ? feedforward[k * N + i] : 0.0;",
-        "            if (gain) for (int j = 0; j < NX; ++j) s += gain[i * NX + j] * e[j];",
-        "            if (integral_gain) s += integral_gain[i] * integ[i];",
-        "            v[i] = s;",
-        "        }",
+        "    double e[NX], v[N];",
+        "    /* e = reference_row - x */",
+        "    for (int i = 0; i < NX; ++i) e[i] = (reference ? reference[row * NX + i] : 0.0) - x[i];",
+        "    /* v = feedforward_row + gain e + integral_gain * integral(e_q) */",
+        "    for (int i = 0; i < N; ++i) {",
+        "        double s = feedforward ? feedforward[row * N + i] : 0.0;",
+        "        if (gain) for (int j = 0; j < NX; ++j) s += gain[i * NX + j] * e[j];",
+        "        if (integral_gain) s += integral_gain[i] * integ[i];",
+        "        v[i] = s;",
+        "    }",
     ]
     if has_mass:
         lines += [
-            "        if (mode == 2) {",
-            "            /* computed torque: tau = M(q) v + (C qd + g + friction) */",
-            "            double m[N * N], h[N], zero[N];",
-            "            for (int i = 0; i < N; ++i) zero[i] = 0.0;",
-            f"            {prefix}mass_matrix(x, m);",
-            f"            {prefix}inverse_dynamics(x, x + N, zero, h);",
-            "            for (int i = 0; i < N; ++i) {",
-            "                double s = h[i];",
-            "                for (int j = 0; j < N; ++j) s += m[i * N + j] * v[j];",
-            "                tau[i] = s;",
-            "            }",
-            "        } else {",
-            "            for (int i = 0; i < N; ++i) tau[i] = v[i];",
+            "    if (mode == 2) {",
+            "        /* computed torque: tau = M(q) v + (C qd + g + friction) */",
+            "        double m[N * N], h[N], zero[N];",
+            "        for (int i = 0; i < N; ++i) zero[i] = 0.0;",
+            f"        {prefix}mass_matrix(x, m);",
+            f"        {prefix}inverse_dynamics(x, x + N, zero, h);",
+            "        for (int i = 0; i < N; ++i) {",
+            "            double s = h[i];",
+            "            for (int j = 0; j < N; ++j) s += m[i * N + j] * v[j];",
+            "            tau[i] = s;",
             "        }",
+            "    } else {",
+            "        for (int i = 0; i < N; ++i) tau[i] = v[i];",
+            "    }",
         ]
     else:
-        lines += ["        for (int i = 0; i < N; ++i) tau[i] = v[i];"]
+        lines += ["    for (int i = 0; i < N; ++i) tau[i] = v[i];"]
     if has_gravity:
         lines += [
-            "        if (mode == 1) {",
-            "            /* gravity compensation: tau += g(q) */",
-            "            double gq[N];",
-            f"            {prefix}gravity(x, gq);",
-            "            for (int i = 0; i < N; ++i) tau[i] += gq[i];",
-            "        }",
+            "    if (mode == 1) {",
+            "        /* gravity compensation: tau += g(q) */",
+            "        double gq[N];",
+            f"        {prefix}gravity(x, gq);",
+            "        for (int i = 0; i < N; ++i) tau[i] += gq[i];",
+            "    }",
         ]
     lines += [
-        "        if (tau_limit) for (int i = 0; i < N; ++i) {",
-        "            if (tau[i] > tau_limit[i]) tau[i] = tau_limit[i];",
-        "            if (tau[i] < -tau_limit[i]) tau[i] = -tau_limit[i];",
-        "        }",
-        "        if (method == 0) {",
-        "            /* RK4: x += dt/6 (k1 + 2 k2 + 2 k3 + k4) */",
+        "    if (tau_limit) for (int i = 0; i < N; ++i) {",
+        "        if (tau[i] > tau_limit[i]) tau[i] = tau_limit[i];",
+        "        if (tau[i] < -tau_limit[i]) tau[i] = -tau_limit[i];",
+        "    }",
+        "}",
+        "",
+    ]
+    return lines
+
+
+def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) -> str:
+    """C source of ``PREFIXsimulate``: fixed-step integration under a state-feedback law.
+
+    The law, with ``e = reference_row - x`` (2 n) and ``e_q`` its first n entries::
+
+        mode 0 (feedback):        tau = feedforward_row + gain e + integral_gain * integral(e_q)
+        mode 1 (+ gravity):       the same + g(q)
+        mode 2 (computed torque): tau = M(q) (feedforward_row + gain e) + C qd + g + friction
+
+    then clipped to ``+-tau_limit``. ``method`` 0 is classical RK4, 1 semi-implicit (symplectic)
+    Euler. With ``continuous`` 0 the law is sampled at the start of every step k (row k) and held
+    over the step, as a digital controller running at the integration rate; the integral is
+    ``dt sum(e_q)`` including the current sample. With ``continuous`` 1 (RK4 only) the law is
+    evaluated at every stage, on the stage's state and time: ``feedforward`` and ``reference``
+    then hold 2 steps + 1 rows sampled every dt/2, and the integral is a further state integrated
+    by the same RK4; this is a continuous-time controller, tracked to the integrator's order.
+    Null pointers mean zero (no feedforward, no reference, no gain, no limit). ``tau_out[k]`` is
+    the law at the start of step k. Returns 0, or k + 1 when the state stopped being finite at
+    step k.
+    """
+    sd = f"{prefix}state_derivative"
+    law = f"{prefix}control_law"
+    args = "feedforward, reference, gain, integral_gain, mode, tau_limit"
+    lines = _law_source(n, prefix, has_gravity, has_mass) + [
+        "/* e_q = q_ref - q at sample `row`: the rate of the error integral. */",
+        f"static void {prefix}error_rate(long row, const double *x, const double *reference, "
+        "double *out) {",
+        f"    for (int i = 0; i < {n}; ++i) out[i] = (reference ? reference[row * {2 * n} + i] : 0.0)"
+        " - x[i];",
+        "}",
+        "",
+        f"/* Integrate {n}-joint dynamics for `steps` steps of `dt` s (see robodyn.codegen.c). */",
+        simulate_signature(prefix) + " {",
+        f"    enum {{ N = {n}, NX = {2 * n} }};",
+        "    double x[NX], xt[NX], k1[NX], k2[NX], k3[NX], k4[NX], tau[N], ts[N], integ[N], zt[N];",
+        "    double r1[N], r2[N], r3[N], r4[N];",
+        "    const int staged = continuous && method == 0;",
+        "    for (int i = 0; i < NX; ++i) x[i] = x_out[i] = x0[i];",
+        "    for (int i = 0; i < N; ++i) integ[i] = 0.0;",
+        "    for (long k = 0; k < steps; ++k) {",
+        "        if (staged) {",
+        "            /* RK4 with the law at every stage (rows 2k, 2k+1, 2k+1, 2k+2 at t, t+dt/2, t+dt)",
+        "               and the error integral z as extra state: z' = e_q */",
+        f"            {law}(2 * k, x, integ, {args}, tau);",
         f"            {sd}(x, tau, k1);",
+        f"            {prefix}error_rate(2 * k, x, reference, r1);",
         "            for (int i = 0; i < NX; ++i) xt[i] = x[i] + 0.5 * dt * k1[i];",
-        f"            {sd}(xt, tau, k2);",
+        "            for (int i = 0; i < N; ++i) zt[i] = integ[i] + 0.5 * dt * r1[i];",
+        f"            {law}(2 * k + 1, xt, zt, {args}, ts);",
+        f"            {sd}(xt, ts, k2);",
+        f"            {prefix}error_rate(2 * k + 1, xt, reference, r2);",
         "            for (int i = 0; i < NX; ++i) xt[i] = x[i] + 0.5 * dt * k2[i];",
-        f"            {sd}(xt, tau, k3);",
+        "            for (int i = 0; i < N; ++i) zt[i] = integ[i] + 0.5 * dt * r2[i];",
+        f"            {law}(2 * k + 1, xt, zt, {args}, ts);",
+        f"            {sd}(xt, ts, k3);",
+        f"            {prefix}error_rate(2 * k + 1, xt, reference, r3);",
         "            for (int i = 0; i < NX; ++i) xt[i] = x[i] + dt * k3[i];",
-        f"            {sd}(xt, tau, k4);",
+        "            for (int i = 0; i < N; ++i) zt[i] = integ[i] + dt * r3[i];",
+        f"            {law}(2 * k + 2, xt, zt, {args}, ts);",
+        f"            {sd}(xt, ts, k4);",
+        f"            {prefix}error_rate(2 * k + 2, xt, reference, r4);",
+        "            /* x += dt/6 (k1 + 2 k2 + 2 k3 + k4), the same for z */",
         "            for (int i = 0; i < NX; ++i)",
         "                x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);",
+        "            for (int i = 0; i < N; ++i)",
+        "                integ[i] += dt / 6.0 * (r1[i] + 2.0 * r2[i] + 2.0 * r3[i] + r4[i]);",
         "        } else {",
-        "            /* semi-implicit Euler: qd += dt qdd(q, qd); q += dt qd (new qd) */",
-        f"            {sd}(x, tau, k1);",
-        "            for (int i = 0; i < N; ++i) x[N + i] += dt * k1[N + i];",
-        "            for (int i = 0; i < N; ++i) x[i] += dt * x[N + i];",
+        "            /* sampled law, held over the step; integral += e_q dt first */",
+        "            const long row = continuous ? 2 * k : k;",
+        f"            {prefix}error_rate(row, x, reference, r1);",
+        "            for (int i = 0; i < N; ++i) integ[i] += r1[i] * dt;",
+        f"            {law}(row, x, integ, {args}, tau);",
+        "            if (method == 0) {",
+        "                /* RK4: x += dt/6 (k1 + 2 k2 + 2 k3 + k4) */",
+        f"                {sd}(x, tau, k1);",
+        "                for (int i = 0; i < NX; ++i) xt[i] = x[i] + 0.5 * dt * k1[i];",
+        f"                {sd}(xt, tau, k2);",
+        "                for (int i = 0; i < NX; ++i) xt[i] = x[i] + 0.5 * dt * k2[i];",
+        f"                {sd}(xt, tau, k3);",
+        "                for (int i = 0; i < NX; ++i) xt[i] = x[i] + dt * k3[i];",
+        f"                {sd}(xt, tau, k4);",
+        "                for (int i = 0; i < NX; ++i)",
+        "                    x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);",
+        "            } else {",
+        "                /* semi-implicit Euler: qd += dt qdd(q, qd); q += dt qd (new qd) */",
+        f"                {sd}(x, tau, k1);",
+        "                for (int i = 0; i < N; ++i) x[N + i] += dt * k1[N + i];",
+        "                for (int i = 0; i < N; ++i) x[i] += dt * x[N + i];",
+        "            }",
         "        }",
         "        for (int i = 0; i < NX; ++i) {",
         "            if (!isfinite(x[i])) return (int)(k + 1);",

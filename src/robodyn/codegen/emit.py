@@ -102,7 +102,8 @@ def simulation_program(kset: KernelSet, prefix: str, header_name: str) -> str:
         "    print_row(0.0, x);",
         "    for (long k = 0; k < steps; ++k) {",
         "        /* one RK4 step under zero torque: traj = [x_k, x_k+1] */",
-        f"        int status = {prefix}simulate(1, dt, 0, x, NULL, NULL, NULL, NULL, 0, NULL, traj, NULL);",
+        f"        int status = {prefix}simulate(1, dt, 0, x, NULL, NULL, NULL, NULL, 0, NULL, 0, traj,"
+        " NULL);",
         "        if (status != 0) {",
         "            fprintf(stderr, \"error: the state stopped being finite at t = %g s\\n\",",
         "                    (k + 1) * dt);",

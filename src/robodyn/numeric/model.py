@@ -105,17 +105,21 @@ class Model:
                   feedforward: np.ndarray | None = None, reference: np.ndarray | None = None,
                   gain: np.ndarray | None = None, integral_gain: np.ndarray | None = None,
                   mode: str = "feedback", tau_limit: np.ndarray | None = None,
-                  ) -> tuple[np.ndarray, np.ndarray]:
-        """Fixed-step trajectory with a sampled state-feedback law, in one call.
+                  control: str = "sampled") -> tuple[np.ndarray, np.ndarray]:
+        """Fixed-step trajectory under a state-feedback law, in one call.
 
-        At step k the torque is held over the step (a digital controller at the integration
-        rate); ``e = reference[k] - x``::
+        With ``e = reference[row] - x``::
 
-            "feedback":         tau = feedforward[k] + gain e + integral_gain * integral(e_q dt)
+            "feedback":         tau = feedforward[row] + gain e + integral_gain * integral(e_q dt)
             "gravity":          the same + g(q)
-            "computed_torque":  tau = M(q) (feedforward[k] + gain e) + C qd + g + friction
+            "computed_torque":  tau = M(q) (feedforward[row] + gain e) + C qd + g + friction
 
-        then clipped to ``+-tau_limit``.
+        then clipped to ``+-tau_limit``. ``control="sampled"``: the law is evaluated at the start
+        of step k (row k) and held over the step, as a digital controller at the integration
+        rate; the integral is ``dt sum(e_q)`` including the current sample.
+        ``control="continuous"`` (RK4 only): the law is evaluated at every RK4 stage on the
+        stage's state, with rows sampled every ``dt / 2`` (row 2k at the start of step k), and
+        the integral is integrated by the same RK4: a continuous-time controller.
 
         Parameters
         ----------
@@ -127,23 +131,24 @@ class Model:
         method : {"rk4", "semi_implicit"}
             Classical RK4, or semi-implicit Euler (velocity first, then position with the new
             velocity: symplectic only while M is constant, first order in general).
-        feedforward : (steps, n), optional
+        feedforward : (steps, n) or (2 steps + 1, n) when continuous, optional
             Torques, or accelerations under "computed_torque".
-        reference : (steps, 2 n), optional
-            Desired ``[q, qd]`` per step.
+        reference : (steps, 2 n) or (2 steps + 1, 2 n) when continuous, optional
+            Desired ``[q, qd]`` per sample.
         gain : (n, 2 n), optional
             State-feedback gain (``[Kp, Kd]`` for PD, an LQR gain, ...).
         integral_gain : (n,), optional
         mode : {"feedback", "gravity", "computed_torque"}
         tau_limit : (n,), optional
             Actuator limits (N m or N), positive.
+        control : {"sampled", "continuous"}
 
         Returns
         -------
         x : (steps + 1, 2 n)
             States, ``x[0] = x0``.
         tau : (steps, n)
-            Applied torques.
+            Torques at the start of each step (those applied over it when sampled).
 
         Raises
         ------
@@ -157,9 +162,16 @@ class Model:
             raise ValueError(f"unknown fixed-step method {method!r}; choose {', '.join(methods)}")
         if mode not in modes:
             raise ValueError(f"unknown controller mode {mode!r}; choose {', '.join(modes)}")
+        if control not in ("sampled", "continuous"):
+            raise ValueError(f"unknown control {control!r}; choose 'sampled' or 'continuous'")
+        continuous = control == "continuous"
+        if continuous and method != "rk4":
+            raise ValueError(f"control='continuous' needs method='rk4' ({method} evaluates the law "
+                             "once per step: use control='sampled')")
+        rows = 2 * steps + 1 if continuous else steps
         arrays = {
-            "x0": (x0, (nx,)), "feedforward": (feedforward, (steps, n)),
-            "reference": (reference, (steps, nx)), "gain": (gain, (n, nx)),
+            "x0": (x0, (nx,)), "feedforward": (feedforward, (rows, n)),
+            "reference": (reference, (rows, nx)), "gain": (gain, (n, nx)),
             "integral_gain": (integral_gain, (n,)), "tau_limit": (tau_limit, (n,)),
         }
         checked: dict[str, np.ndarray | None] = {}
@@ -175,14 +187,14 @@ class Model:
         tau_out = np.empty((steps, n))
         if isinstance(self._impl, ModuleType):
             status = _integrate_numpy(self, steps, dt, methods[method], modes[mode], checked, x_out,
-                                      tau_out)
+                                      tau_out, continuous)
         else:
             ffi = self._impl.ffi
             ptr = {k: (ffi.NULL if v is None else ffi.from_buffer("double[]", v))
                    for k, v in checked.items()}
             status = self._impl.lib.rd_simulate(
                 steps, float(dt), methods[method], ptr["x0"], ptr["feedforward"], ptr["reference"],
-                ptr["gain"], ptr["integral_gain"], modes[mode], ptr["tau_limit"],
+                ptr["gain"], ptr["integral_gain"], modes[mode], ptr["tau_limit"], int(continuous),
                 ffi.from_buffer("double[]", x_out), ffi.from_buffer("double[]", tau_out))
         if status:
             raise FloatingPointError(f"the simulated state stopped being finite at step {status - 1} "
@@ -319,41 +331,61 @@ __all__ = ["Model", "compile_model"]
 
 
 def _integrate_numpy(model: Model, steps: int, dt: float, method: int, mode: int,
-                     a: dict[str, np.ndarray | None], x_out: np.ndarray, tau_out: np.ndarray) -> int:
+                     a: dict[str, np.ndarray | None], x_out: np.ndarray, tau_out: np.ndarray,
+                     continuous: bool = False) -> int:
     """The NumPy twin of the generated C ``simulate`` (same law, same steps); returns its status."""
     n = model.dof
     x = a["x0"].copy()
     x_out[0] = x
     integ = np.zeros(n)
     zero = np.zeros(n)
-    for k in range(steps):
-        # e = reference_k - x
-        e = (a["reference"][k] if a["reference"] is not None else 0.0) - x
-        integ += np.broadcast_to(e, (2 * n,))[:n] * dt
-        v = a["feedforward"][k].copy() if a["feedforward"] is not None else np.zeros(n)
+    f = model.state_derivative
+
+    def rate(row: int, xs: np.ndarray) -> np.ndarray:
+        # e_q = q_ref - q
+        return (a["reference"][row, :n] if a["reference"] is not None else 0.0) - xs[:n]
+
+    def law(row: int, xs: np.ndarray, z: np.ndarray) -> np.ndarray:
+        # e = reference_row - x
+        e = np.broadcast_to((a["reference"][row] if a["reference"] is not None else 0.0) - xs, (2 * n,))
+        v = a["feedforward"][row].copy() if a["feedforward"] is not None else np.zeros(n)
         if a["gain"] is not None:
-            v += a["gain"] @ np.broadcast_to(e, (2 * n,))
+            v += a["gain"] @ e
         if a["integral_gain"] is not None:
-            v += a["integral_gain"] * integ
-        if mode == 2:
-            # tau = M(q) v + (C qd + g + friction)
-            tau = model.mass_matrix(x[:n]) @ v + model.inverse_dynamics(x[:n], x[n:], zero)
-        else:
-            tau = v
+            v += a["integral_gain"] * z
+        # tau = M(q) v + (C qd + g + friction) under computed torque
+        tau = model.mass_matrix(xs[:n]) @ v + model.inverse_dynamics(xs[:n], xs[n:], zero) if mode == 2 else v
         if mode == 1:
-            tau = tau + model.gravity(x[:n])
+            tau = tau + model.gravity(xs[:n])
         if a["tau_limit"] is not None:
             tau = np.clip(tau, -a["tau_limit"], a["tau_limit"])
-        f = model.state_derivative
-        if method == 0:
-            k1 = f(x, tau)
-            k2 = f(x + 0.5 * dt * k1, tau)
-            k3 = f(x + 0.5 * dt * k2, tau)
-            k4 = f(x + dt * k3, tau)
+        return tau
+
+    for k in range(steps):
+        if continuous:
+            # RK4 with the law at every stage; the error integral z is extra state, z' = e_q
+            tau = law(2 * k, x, integ)
+            k1, r1 = f(x, tau), rate(2 * k, x)
+            xs, zs = x + 0.5 * dt * k1, integ + 0.5 * dt * r1
+            k2, r2 = f(xs, law(2 * k + 1, xs, zs)), rate(2 * k + 1, xs)
+            xs, zs = x + 0.5 * dt * k2, integ + 0.5 * dt * r2
+            k3, r3 = f(xs, law(2 * k + 1, xs, zs)), rate(2 * k + 1, xs)
+            xs, zs = x + dt * k3, integ + dt * r3
+            k4, r4 = f(xs, law(2 * k + 2, xs, zs)), rate(2 * k + 2, xs)
             x = x + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            integ = integ + dt / 6.0 * (r1 + 2.0 * r2 + 2.0 * r3 + r4)
         else:
-            qd = x[n:] + dt * f(x, tau)[n:]
-            x = np.concatenate([x[:n] + dt * qd, qd])
+            integ = integ + rate(k, x) * dt
+            tau = law(k, x, integ)
+            if method == 0:
+                k1 = f(x, tau)
+                k2 = f(x + 0.5 * dt * k1, tau)
+                k3 = f(x + 0.5 * dt * k2, tau)
+                k4 = f(x + dt * k3, tau)
+                x = x + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            else:
+                qd = x[n:] + dt * f(x, tau)[n:]
+                x = np.concatenate([x[:n] + dt * qd, qd])
         if not np.all(np.isfinite(x)):
             return k + 1
         x_out[k + 1] = x

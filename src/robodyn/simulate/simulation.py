@@ -91,7 +91,7 @@ class Trajectory:
 def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: float, dt: float,
              method: str = "rk4", controller: ControllerLike = None, *,
              tau_limit: float | np.ndarray | None = None, rtol: float = 1e-9,
-             atol: float = 1e-12) -> Trajectory:
+             atol: float = 1e-12, control: str = "sampled") -> Trajectory:
     """Simulate ``model`` from ``(q0, qd0)`` for ``duration`` seconds.
 
     Parameters
@@ -113,6 +113,12 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         Actuator limits, N m (N), applied to every torque; overrides the controller's own.
     rtol, atol : float
         Tolerances of the SciPy methods.
+    control : {"sampled", "continuous"}
+        Fixed-step methods only. "sampled": the controller is evaluated at the start of each
+        step and its torque held over the step (a digital controller at the integration rate).
+        "continuous" (RK4): evaluated at every RK4 stage, a continuous-time controller tracked
+        to the integrator's fourth order (built-in controllers in C; a callable from Python).
+        The SciPy methods always evaluate the law wherever they evaluate the dynamics.
 
     Returns
     -------
@@ -137,6 +143,11 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         raise ValueError(f"duration {duration:g} s is not a whole number of steps dt = {dt:g} s")
     if method not in FIXED_STEP + ADAPTIVE:
         raise ValueError(f"unknown method {method!r}; choose one of {', '.join(FIXED_STEP + ADAPTIVE)}")
+    if control not in ("sampled", "continuous"):
+        raise ValueError(f"unknown control {control!r}; choose 'sampled' or 'continuous'")
+    if control == "continuous" and method == "semi_implicit":
+        raise ValueError("control='continuous' needs method='rk4' or a SciPy method (semi-implicit "
+                         "Euler evaluates the law once per step: use control='sampled')")
     if controller is not None and not callable(controller):
         raise TypeError(f"controller must be a built-in controller, a callable (t, q, qd) -> tau or "
                         f"None, got {type(controller).__name__}")
@@ -146,39 +157,67 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
     t = dt * np.arange(steps + 1)
     x0 = np.concatenate([q0, qd0])
     if method in FIXED_STEP:
-        x, tau, evals = _fixed_step(model, x0, t, dt, method, controller, limit)
+        x, tau, evals = _fixed_step(model, x0, t, dt, method, controller, limit,
+                                    control == "continuous")
     else:
         x, tau, evals = _adaptive(model, x0, t, method, controller, limit, rtol, atol)
     return _result(model, t, x, tau, method, dt, controller, evals)
 
 
 def _fixed_step(model: Model, x0: np.ndarray, t: np.ndarray, dt: float, method: str,
-                controller: ControllerLike, limit: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, int]:
+                controller: ControllerLike, limit: np.ndarray | None,
+                continuous: bool = False) -> tuple[np.ndarray, np.ndarray, int]:
     n, steps = model.dof, t.size - 1
     per_step = 4 if method == "rk4" else 1
     if controller is None or isinstance(controller, Controller):
-        kwargs = {} if controller is None else controller.sampled(model, t[:-1])
-        x, tau = model.integrate(x0, steps, dt, method, tau_limit=limit, **kwargs)
+        # continuous: the inputs sampled every dt/2, for the RK4 stages
+        times = 0.5 * dt * np.arange(2 * steps + 1) if continuous else t[:-1]
+        kwargs = {} if controller is None else controller.sampled(model, times)
+        x, tau = model.integrate(x0, steps, dt, method, tau_limit=limit,
+                                 control="continuous" if continuous else "sampled", **kwargs)
         last = np.zeros(n) if controller is None else controller.law(
-            model, t[-1], x[-1], _sampled_integral(controller, t, x, dt))
+            model, t[-1], x[-1], _error_integral(controller, t, x, dt, continuous))
         return x, np.vstack([tau, _clip(last, limit)]), steps * per_step
     x = np.empty((steps + 1, 2 * n))
     tau = np.empty((steps + 1, n))
     x[0] = x0
+    f = model.state_derivative
+
+    def law(tk: float, xk: np.ndarray) -> np.ndarray:
+        return _clip(_call(controller, tk, xk, n), limit)
+
     for k in range(steps):
-        tau[k] = _clip(_call(controller, t[k], x[k], n), limit)
-        # one step with the torque held (zero-order hold)
-        x[k + 1] = model.integrate(x[k], 1, dt, method, feedforward=tau[k][None])[0][1]
-    tau[-1] = _clip(_call(controller, t[-1], x[-1], n), limit)
+        tau[k] = law(t[k], x[k])
+        if continuous:
+            # RK4 with the callable evaluated at every stage
+            k1 = f(x[k], tau[k])
+            xs = x[k] + 0.5 * dt * k1
+            k2 = f(xs, law(t[k] + 0.5 * dt, xs))
+            xs = x[k] + 0.5 * dt * k2
+            k3 = f(xs, law(t[k] + 0.5 * dt, xs))
+            xs = x[k] + dt * k3
+            k4 = f(xs, law(t[k] + dt, xs))
+            x[k + 1] = x[k] + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        else:
+            # one step with the torque held (zero-order hold)
+            x[k + 1] = model.integrate(x[k], 1, dt, method, feedforward=tau[k][None])[0][1]
+    tau[-1] = law(t[-1], x[-1])
     return x, tau, steps * per_step
 
 
-def _sampled_integral(controller: Controller, t: np.ndarray, x: np.ndarray, dt: float) -> np.ndarray | None:
-    """The C integrator's error integral at the last sample: ``dt sum_{j<=N} e_j``."""
+def _error_integral(controller: Controller, t: np.ndarray, x: np.ndarray, dt: float,
+                    continuous: bool) -> np.ndarray | None:
+    """The error integral at the last sample, for the last row of ``tau``.
+
+    Sampled: the C integrator's own ``dt sum_{j<=N} e_j``. Continuous: the trapezoidal rule over
+    the samples (the integrator's RK4 value is not returned; this differs by O(dt^2)).
+    """
     if not controller.has_integral:
         return None
     n = x.shape[1] // 2
     errors = np.array([controller.position_error(tk, xk[:n]) for tk, xk in zip(t, x, strict=True)])
+    if continuous:
+        return dt * (errors.sum(axis=0) - 0.5 * (errors[0] + errors[-1]))
     return dt * errors.sum(axis=0)
 
 
