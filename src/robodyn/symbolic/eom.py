@@ -260,11 +260,8 @@ def derive(robot: Robot, method: Method = "newton_euler", *,
             forms.append(Program(tuple(rec.assignments), out).pruned())
         tau_rigid, m_rigid, g = forms
     elif method == "lagrange":
-        m_rigid, potential = lagrange_mod.mass_matrix_and_potential(robot, q)
-        g = lagrange_mod.gravity_from_potential(potential, q)
-        c = christoffel_coriolis(m_rigid, q, qd)
-        qdd_v, qd_v = sp.Matrix(qdd), sp.Matrix(qd)
-        tau_rigid = sp.ImmutableMatrix(m_rigid * qdd_v + c * qd_v + g)
+        lag = lagrange_mod.lagrange(robot, q, qd, qdd)
+        m_rigid, g, tau_rigid, c = lag.mass_matrix, lag.gravity, lag.tau, lag.coriolis
     else:
         terms = kane_mod.kane(robot, q, qd, qdd)
         m_rigid, g, tau_rigid = terms.mass_matrix, terms.gravity, terms.tau
