@@ -58,8 +58,10 @@ def _controller(args: argparse.Namespace, model: rd.Model, q0: np.ndarray):
     if not 0 < move <= args.duration:
         raise ValueError(f"--move-time: must be in (0, duration = {args.duration:g}] s, got {move:g}")
     plan = quintic(q0, target, move, dt=args.dt)
-    kp = _vector(args.kp, n, "--kp")
-    kd = _vector(args.kd, n, "--kd")
+    # default gains: a stiff error loop for computed torque (1/s^2, 1/s), moderate PD otherwise
+    ct = args.controller == "computed-torque"
+    kp = _vector(args.kp, n, "--kp", 400.0 if ct else 100.0)
+    kd = _vector(args.kd, n, "--kd", 40.0 if ct else 20.0)
     if args.controller == "computed-torque":
         return ComputedTorque(plan, kp=kp, kd=kd), plan
     if args.controller == "pd":
@@ -80,12 +82,6 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     out.mkdir(parents=True, exist_ok=True)
     with progress(f"compiling {robot.name} ({args.backend} backend)"):
         model = rd.compile_model(robot, backend=args.backend)
-    if args.controller == "computed-torque" and args.kp is None:
-        args.kp, args.kd = np.array([400.0]), np.array([40.0])
-    if args.kp is None:
-        args.kp = np.array([100.0])
-    if args.kd is None:
-        args.kd = np.array([20.0])
     controller, plan = _controller(args, model, q0)
     limit = _vector(args.tau_limit, n, "--tau-limit") if args.tau_limit is not None else None
     with progress(f"simulating {args.duration:g} s at dt = {args.dt:g} s ({args.method})"):
@@ -204,7 +200,12 @@ def _cmd_iso9283(args: argparse.Namespace) -> int:
 
 def add_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
     """Register ``simulate``, ``calibrate`` and ``iso9283`` on the ``robodyn`` sub-parsers."""
-    from robodyn.calibrate.models import MODELS
+    _simulate_parser(sub, fmt, robot_help)
+    _calibrate_parser(sub, fmt, robot_help)
+    _iso9283_parser(sub, fmt)
+
+
+def _simulate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
     from robodyn.simulate.simulation import ADAPTIVE, FIXED_STEP
 
     p = sub.add_parser(
@@ -253,6 +254,10 @@ def add_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> 
                    help="output folder (default: %(default)s)")
     p.set_defaults(func=_cmd_simulate)
 
+
+def _calibrate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
+    from robodyn.calibrate.models import MODELS
+
     p = sub.add_parser(
         "calibrate", help="kinematic calibration from measured end-effector positions",
         formatter_class=fmt,
@@ -287,6 +292,8 @@ def add_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> 
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
     p.set_defaults(func=_cmd_calibrate)
 
+
+def _iso9283_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
     p = sub.add_parser(
         "iso9283", help="ISO 9283 pose accuracy, repeatability, overshoot from measurements",
         formatter_class=fmt,

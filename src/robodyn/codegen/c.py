@@ -354,6 +354,31 @@ def _law_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) -> list[
     return lines
 
 
+def _staged_rk4(prefix: str, args: str) -> list[str]:
+    """The body of one RK4 step with the control law evaluated at every stage (C lines)."""
+    sd, law = f"{prefix}state_derivative", f"{prefix}control_law"
+    ind = "            "
+    lines = [f"{ind}{law}(2 * k, x, integ, {args}, tau);",
+             f"{ind}{sd}(x, tau, k1);",
+             f"{ind}{prefix}error_rate(2 * k, x, reference, r1);"]
+    # stages 2-4: state and integral advanced by (dt/2, dt/2, dt) times the previous slopes
+    for (frac, row), (kp, rp), (kn, rn) in zip((("0.5 * dt", "2 * k + 1"), ("0.5 * dt", "2 * k + 1"),
+                                               ("dt", "2 * k + 2")),
+                                              (("k1", "r1"), ("k2", "r2"), ("k3", "r3")),
+                                              (("k2", "r2"), ("k3", "r3"), ("k4", "r4")), strict=True):
+        lines += [f"{ind}for (int i = 0; i < NX; ++i) xt[i] = x[i] + {frac} * {kp}[i];",
+                  f"{ind}for (int i = 0; i < N; ++i) zt[i] = integ[i] + {frac} * {rp}[i];",
+                  f"{ind}{law}({row}, xt, zt, {args}, ts);",
+                  f"{ind}{sd}(xt, ts, {kn});",
+                  f"{ind}{prefix}error_rate({row}, xt, reference, {rn});"]
+    lines += [f"{ind}/* x += dt/6 (k1 + 2 k2 + 2 k3 + k4), the same for z */",
+              f"{ind}for (int i = 0; i < NX; ++i)",
+              f"{ind}    x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);",
+              f"{ind}for (int i = 0; i < N; ++i)",
+              f"{ind}    integ[i] += dt / 6.0 * (r1[i] + 2.0 * r2[i] + 2.0 * r3[i] + r4[i]);"]
+    return lines
+
+
 def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) -> str:
     """C source of ``PREFIXsimulate``: fixed-step integration under a state-feedback law.
 
@@ -397,29 +422,7 @@ def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) ->
         "        if (staged) {",
         "            /* RK4 with the law at every stage (rows 2k, 2k+1, 2k+1, 2k+2 at t, t+dt/2, t+dt)",
         "               and the error integral z as extra state: z' = e_q */",
-        f"            {law}(2 * k, x, integ, {args}, tau);",
-        f"            {sd}(x, tau, k1);",
-        f"            {prefix}error_rate(2 * k, x, reference, r1);",
-        "            for (int i = 0; i < NX; ++i) xt[i] = x[i] + 0.5 * dt * k1[i];",
-        "            for (int i = 0; i < N; ++i) zt[i] = integ[i] + 0.5 * dt * r1[i];",
-        f"            {law}(2 * k + 1, xt, zt, {args}, ts);",
-        f"            {sd}(xt, ts, k2);",
-        f"            {prefix}error_rate(2 * k + 1, xt, reference, r2);",
-        "            for (int i = 0; i < NX; ++i) xt[i] = x[i] + 0.5 * dt * k2[i];",
-        "            for (int i = 0; i < N; ++i) zt[i] = integ[i] + 0.5 * dt * r2[i];",
-        f"            {law}(2 * k + 1, xt, zt, {args}, ts);",
-        f"            {sd}(xt, ts, k3);",
-        f"            {prefix}error_rate(2 * k + 1, xt, reference, r3);",
-        "            for (int i = 0; i < NX; ++i) xt[i] = x[i] + dt * k3[i];",
-        "            for (int i = 0; i < N; ++i) zt[i] = integ[i] + dt * r3[i];",
-        f"            {law}(2 * k + 2, xt, zt, {args}, ts);",
-        f"            {sd}(xt, ts, k4);",
-        f"            {prefix}error_rate(2 * k + 2, xt, reference, r4);",
-        "            /* x += dt/6 (k1 + 2 k2 + 2 k3 + k4), the same for z */",
-        "            for (int i = 0; i < NX; ++i)",
-        "                x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);",
-        "            for (int i = 0; i < N; ++i)",
-        "                integ[i] += dt / 6.0 * (r1[i] + 2.0 * r2[i] + 2.0 * r3[i] + r4[i]);",
+        *_staged_rk4(prefix, args),
         "        } else {",
         "            /* sampled law, held over the step; integral += e_q dt first */",
         "            const long row = continuous ? 2 * k : k;",
