@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["DescriptionError", "DescriptionWarning"]
+__all__ = ["DescriptionError", "DescriptionWarning", "ValidationError"]
 
 
 class DescriptionError(ValueError):
@@ -17,4 +17,13 @@ class DescriptionWarning(UserWarning):
     """A robot description is readable but physically implausible.
 
     Raised as :class:`DescriptionError` instead when a loader runs with ``strict=True``.
+    """
+
+
+class ValidationError(ValueError):
+    """Measured data cannot be compared with a robot's model.
+
+    Raised by :func:`robodyn.validate`: the message names the recording (its source file), the
+    field or joint, the row where one matters, and the reason (joints that do not match the
+    robot, a missing target signal, too few samples, values that are not finite).
     """
