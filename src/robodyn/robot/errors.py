@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["DescriptionError", "DescriptionWarning", "ValidationError"]
+__all__ = ["DescriptionError", "DescriptionWarning", "IdentificationError", "ValidationError"]
 
 
 class DescriptionError(ValueError):
@@ -26,4 +26,14 @@ class ValidationError(ValueError):
     Raised by :func:`robodyn.validate`: the message names the recording (its source file), the
     field or joint, the row where one matters, and the reason (joints that do not match the
     robot, a missing target signal, too few samples, values that are not finite).
+    """
+
+
+class IdentificationError(ValueError):
+    """Measured data cannot be used to identify a robot's parameters, or an estimator failed.
+
+    Raised by :func:`robodyn.identify`: the message names the recording (its source file), the
+    field or joint, the row where one matters, and the reason (joints that do not match the
+    robot, too few samples for the parameters, values that are not finite, an infeasible or
+    failed semidefinite program).
     """
