@@ -156,3 +156,35 @@ def test_rejection_has_no_side_effects(tmp_path) -> None:
     with pytest.raises(DescriptionError):
         parse(payload)
     assert not target.exists()
+
+
+@pytest.mark.parametrize(
+    "value",
+    [
+        "-" * 998 + "1",  # 999 levels of unary minus: RecursionError before the depth bound
+        "+" * 500 + "-" * 498 + "l",
+        "sin(" * 150 + "l" + ")" * 150,  # within the parser's parenthesis limit
+    ],
+)
+def test_deeply_nested_expression_is_a_clear_error(value: str) -> None:
+    with pytest.raises(DescriptionError, match=r"nested \d+ levels deep \(at most 100\)") as info:
+        parse(value)
+    assert str(info.value).startswith(WHERE + ": invalid expression ")
+
+
+def test_nesting_within_the_bound_is_accepted() -> None:
+    assert parse("-" * 98 + "l") == L  # 99 levels: an even number of minus signs
+    assert parse("sqrt(" * 40 + "l" + ")" * 40) == L ** sp.Rational(1, 2**40)
+
+
+@pytest.mark.parametrize(
+    ("value", "reason"),
+    [
+        ("((9**99)**99)**99", r"constant power of about 10\*\*9353 is out of range"),
+        ("(0.5**99)**99", r"constant power of about 10\*\*-2950 is out of range"),
+    ],
+)
+def test_huge_constant_powers_are_rejected(value: str, reason: str) -> None:
+    # each exponent is small; the exact integer result would have millions of digits
+    with pytest.raises(DescriptionError, match=reason):
+        parse(value)

@@ -12,7 +12,10 @@ are accepted:
 
 Nothing else (attribute access, subscripts, lambdas, strings, comparisons, keyword arguments,
 unknown names or functions) is evaluated: each raises :class:`DescriptionError`. The raw text is
-never handed to ``eval``, ``exec`` or ``sympify``. Integer literals stay exact, so ``"pi/2"`` is
+never handed to ``eval``, ``exec`` or ``sympify``. Size is bounded: at most
+``MAX_EXPRESSION_LENGTH`` characters, syntax trees at most ``MAX_EXPRESSION_DEPTH`` deep (checked
+without recursion before anything is evaluated), exponents at most 100 in magnitude and constant
+powers below ``10**300``. Integer literals stay exact, so ``"pi/2"`` is
 exactly ``sympy.pi/2`` and ``"1/3"`` is ``Rational(1, 3)``; float literals become ``sympy.Float``.
 """
 
@@ -26,7 +29,14 @@ import sympy as sp
 
 from robodyn.robot.errors import DescriptionError
 
-__all__ = ["CONSTANTS", "FUNCTIONS", "MAX_EXPRESSION_LENGTH", "parse_value", "parameter_symbol"]
+__all__ = [
+    "CONSTANTS",
+    "FUNCTIONS",
+    "MAX_EXPRESSION_DEPTH",
+    "MAX_EXPRESSION_LENGTH",
+    "parameter_symbol",
+    "parse_value",
+]
 
 #: Functions an expression may call: name -> (SymPy function, number of arguments).
 FUNCTIONS: Mapping[str, tuple[Callable[..., sp.Expr], int]] = {
@@ -49,8 +59,14 @@ CONSTANTS: Mapping[str, sp.Expr] = {"pi": sp.pi}
 #: Longest expression text accepted, characters.
 MAX_EXPRESSION_LENGTH = 1000
 
+#: Deepest syntax tree accepted (``"-" * 998 + "1"`` is 999 levels deep): nesting levels.
+MAX_EXPRESSION_DEPTH = 100
+
 #: Largest magnitude of a numeric exponent (guards against ``10**10**10``).
 _MAX_EXPONENT = 100
+
+#: Largest base-10 order of magnitude of a constant power (guards against ``((9**99)**99)**99``).
+_MAX_MAGNITUDE = 300
 
 _BINOPS: Mapping[type[ast.operator], Callable[[sp.Expr, sp.Expr], sp.Expr]] = {
     ast.Add: lambda a, b: a + b,
@@ -139,6 +155,16 @@ def parse_value(
         raise DescriptionError(
             f"{where}: invalid expression {value!r}: syntax error ({reason})"
         ) from None
+    except (RecursionError, MemoryError):
+        raise DescriptionError(
+            f"{where}: invalid expression {value!r}: nested too deeply to parse"
+        ) from None
+    depth = _depth(tree.body)
+    if depth > MAX_EXPRESSION_DEPTH:
+        raise DescriptionError(
+            f"{where}: invalid expression {value[:40]!r}...: nested {depth} levels deep "
+            f"(at most {MAX_EXPRESSION_DEPTH})"
+        )
     try:
         result = _walk(tree.body, names)
     except _Reject as exc:
@@ -161,6 +187,17 @@ def _type_name(value: object) -> str:
         "list": "a list",
         "str": "a text",
     }.get(type(value).__name__, type(value).__name__)
+
+
+def _depth(root: ast.AST) -> int:
+    """Depth of a syntax tree, counted with an explicit stack (no recursion)."""
+    deepest = 0
+    stack = [(root, 1)]
+    while stack:
+        node, level = stack.pop()
+        deepest = max(deepest, level)
+        stack.extend((child, level + 1) for child in ast.iter_child_nodes(node))
+    return deepest
 
 
 def _walk(node: ast.AST, names: Mapping[str, sp.Symbol]) -> sp.Expr:
@@ -189,8 +226,8 @@ def _walk(node: ast.AST, names: Mapping[str, sp.Symbol]) -> sp.Expr:
             raise _Reject(f"operator {type(node.op).__name__} is not allowed")
         left = _walk(node.left, names)
         right = _walk(node.right, names)
-        if isinstance(node.op, ast.Pow) and right.is_number and abs(right) > _MAX_EXPONENT:
-            raise _Reject(f"exponent {right} is too large (at most {_MAX_EXPONENT} in magnitude)")
+        if isinstance(node.op, ast.Pow):
+            _check_power(left, right)
         return op(left, right)
     if isinstance(node, ast.UnaryOp):
         operand = _walk(node.operand, names)
@@ -202,6 +239,25 @@ def _walk(node: ast.AST, names: Mapping[str, sp.Symbol]) -> sp.Expr:
     if isinstance(node, ast.Call):
         return _call(node, names)
     raise _Reject(f"construct {type(node).__name__} is not allowed")
+
+
+def _check_power(base: sp.Expr, exponent: sp.Expr) -> None:
+    """Reject ``base**exponent`` when the exponent or a constant result would be huge."""
+    if not exponent.is_number:
+        return
+    if abs(exponent) > _MAX_EXPONENT:
+        raise _Reject(f"exponent {exponent} is too large (at most {_MAX_EXPONENT} in magnitude)")
+    if base.is_number and base != 0:
+        # |base**exponent| = 10**(exponent * log10|base|): bounded both ways
+        try:
+            magnitude = float(exponent) * math.log10(abs(complex(sp.N(base, 15))))
+        except (TypeError, ValueError, OverflowError):
+            return  # not a finite number: reported once the whole value is known
+        if abs(magnitude) > _MAX_MAGNITUDE:
+            raise _Reject(
+                f"a constant power of about 10**{magnitude:.0f} is out of range "
+                f"(at most 10**{_MAX_MAGNITUDE} in magnitude, at least 10**-{_MAX_MAGNITUDE})"
+            )
 
 
 def _call(node: ast.Call, names: Mapping[str, sp.Symbol]) -> sp.Expr:
