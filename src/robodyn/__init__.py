@@ -10,6 +10,7 @@ Public API::
 """
 
 from robodyn.calibrate import Calibration, calibrate
+from robodyn.identify import Identification, identify
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.load import builtin_names, load
 from robodyn.robot.model import Drive, Friction, Joint, Link, Robot
@@ -20,6 +21,7 @@ __all__ = [
     "Calibration",
     "Drive",
     "EquationsOfMotion",
+    "Identification",
     "Friction",
     "Joint",
     "Link",
@@ -30,6 +32,7 @@ __all__ = [
     "calibrate",
     "compile_model",
     "derive",
+    "identify",
     "load",
     "simulate",
 ]

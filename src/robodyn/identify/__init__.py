@@ -1,0 +1,11 @@
+"""Identification of inertial, drive and friction parameters from measured motion (thesis ch. 5).
+
+Public entry point: :func:`identify` (``rd.identify``), returning an :class:`Identification`.
+"""
+
+from robodyn.identify.base import BaseRelations, base_relations
+from robodyn.identify.pipeline import identify
+from robodyn.identify.preprocess import Preprocess
+from robodyn.identify.result import BaseParameters, Identification
+
+__all__ = ["BaseParameters", "BaseRelations", "Identification", "Preprocess", "base_relations", "identify"]

@@ -1,0 +1,287 @@
+"""``rd.identify``: inertial, drive and friction parameters from measured motion and effort.
+
+Steps (each a function of its own module):
+
+1. check the recordings (joints, shapes, finite values, a target signal);
+2. preprocess each recording (:mod:`robodyn.identify.preprocess`: zero-phase filter, derivatives,
+   the same filter on the target, decimation);
+3. base parameters of the robot (:mod:`robodyn.identify.base`, Gautier's QR on random states);
+4. identification matrix: the compiled, batched regressor ``Y(q, qd, qdd)`` (N, n, 15 n) of every
+   sample, restricted to the base columns and stacked, one row per joint per sample;
+5. ``target="current"``: each row scaled by the joint's drive gain ``K_j`` (N m / A) so that the
+   fit is in torque units, ``K_j i_j = Y_j p`` (:func:`drive_gains`);
+6. estimate (:mod:`robodyn.identify.estimate`, :mod:`robodyn.identify.consistent`);
+7. the full standard parameter set and a :class:`Robot` carrying it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from robodyn.identify.base import base_relations
+from robodyn.identify.estimate import FOLDS, LinearFit, fit_linear
+from robodyn.identify.preprocess import Preprocess, Samples, preprocess, resolve_preprocess
+from robodyn.identify.result import BaseParameters, Identification
+from robodyn.identify.to_robot import robot_with_parameters
+from robodyn.numeric.model import Model, compile_model
+from robodyn.robot.errors import IdentificationError
+from robodyn.robot.model import Robot
+from robodyn.symbolic.regressor import parameter_values
+
+__all__ = ["check_recording", "drive_gains", "identify", "nominal_standard"]
+
+TARGETS = ("tau", "current")
+METHODS = ("ols", "wls", "consistent")
+#: Unit directions whose singular value is below this fraction of the largest are reported.
+UNEXCITED_RTOL = 1e-6
+
+
+def _src(rec: Any, index: int) -> str:
+    return str(getattr(rec, "source", "") or f"recordings[{index}]")
+
+
+def _first_bad(a: np.ndarray) -> tuple[int, int]:
+    rows, cols = np.nonzero(~np.isfinite(a))
+    return int(rows[0]), int(cols[0])
+
+
+def check_recording(robot: Robot, rec: Any, index: int, target: str | None) -> None:
+    """Raise :class:`IdentificationError` when ``rec`` cannot be used with ``robot``.
+
+    Checks: joint names equal the robot's (same order), ``q`` (N, n), finite ``t``/``q``/target
+    (the first bad row and column named), and the target signal present.
+    """
+    src = _src(rec, index)
+    names = getattr(rec, "joint_names", None)
+    n = robot.dof
+    q = np.asarray(rec.q, dtype=float)
+    if q.ndim != 2 or q.shape[1] != n:
+        raise IdentificationError(f"{src}: q: expected shape (N, {n}) for robot {robot.name!r} "
+                                  f"({n} joints), got {q.shape}")
+    if names is not None and tuple(names) != tuple(f"q{j + 1}" for j in range(n)) \
+            and tuple(names) != robot.joint_names:
+        missing = [j for j in robot.joint_names if j not in names]
+        extra = [j for j in names if j not in robot.joint_names]
+        why = (f"missing {missing}, unknown {extra}" if missing or extra
+               else f"order {list(names)} is not the chain order {list(robot.joint_names)}")
+        raise IdentificationError(f"{src}: joint_names do not match robot {robot.name!r}: {why} "
+                                  f"(use rec.select(robot.joint_names))")
+    fields = [("t", np.asarray(rec.t, dtype=float).reshape(-1, 1)), ("q", q)]
+    if target is not None:
+        y = getattr(rec, target, None)
+        if y is None:
+            raise IdentificationError(f"{src}: {target}: the recording has no {target!r} signal to "
+                                      f"fit (target={target!r})")
+        y = np.asarray(y, dtype=float)
+        if y.shape != q.shape:
+            raise IdentificationError(f"{src}: {target}: shape {y.shape} differs from q {q.shape}")
+        fields.append((target, y))
+    for name, a in fields:
+        if not np.all(np.isfinite(a)):
+            row, col = _first_bad(a)
+            column = "" if name == "t" else f", column {col} ({robot.joint_names[col]})"
+            raise IdentificationError(f"{src}: {name}: value {a[row, col]} is not finite at row "
+                                      f"{row}{column}")
+
+
+def nominal_standard(robot: Robot) -> np.ndarray:
+    """The description's standard parameter vector (15 n,) at its parameters' defaults."""
+    subs = robot.defaults()
+    return np.array([float(sp.sympify(v).xreplace(subs)) for v in parameter_values(robot)])
+
+
+def _description_gains(robot: Robot) -> np.ndarray:
+    subs = robot.defaults()
+    return np.array([abs(float(sp.sympify(j.drive.gear_ratio * j.drive.torque_constant).xreplace(subs)))
+                     for j in robot.joints])
+
+
+def drive_gains(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.ndarray],
+                nominal: np.ndarray, mode: str) -> tuple[np.ndarray, str]:
+    """Drive gains ``K_j`` (n,) in N m / A and where they come from.
+
+    ``mode="description"``: ``K_j = |G_j k_t,j|`` from the description's drives. ``"absorbed"``:
+    per joint, the current is regressed on the description's own torque prediction and the
+    joint's drive and friction columns, ``i_j = tau_nom,j / K_j + Ia qdd_j + friction``, so
+    ``K_j`` is the gain that scales the nominal rigid-body model onto the measured current (it
+    also absorbs a uniform error of the nominal link masses on that joint, e.g. an unmodelled
+    tool). ``"auto"``: description gains when any differs from 1 (the default drive), otherwise
+    absorbed.
+    """
+    desc = _description_gains(robot)
+    if mode == "description" or (mode == "auto" and np.any(np.abs(desc - 1.0) > 1e-12)):
+        if np.any(desc <= 0):
+            j = int(np.argmin(desc))
+            raise IdentificationError(f"{robot.source}: joints[{j}].drive: gear_ratio x "
+                                      f"torque_constant is {desc[j]:g}; a current target needs a "
+                                      f"positive drive gain (or gains='absorbed')")
+        return desc, "description"
+    n = robot.dof
+    gains = np.ones(n)
+    for j in range(n):
+        rows, rhs = [], []
+        for s, y in zip(samples, y_full, strict=True):
+            tau_nom = y[:, j, :] @ nominal
+            qd = s.qd[:, j]
+            rows.append(np.column_stack([tau_nom, s.qdd[:, j], qd, qd > 0, -(qd < 0.0),
+                                         np.ones_like(qd)]))
+            rhs.append(s.y[:, j])
+        a, b = np.vstack(rows), np.concatenate(rhs)
+        used = np.linalg.norm(a, axis=0) > 1e-12
+        coef, *_ = np.linalg.lstsq(a[:, used], b, rcond=None)
+        inv_k = coef[0] if used[0] else 0.0
+        if not used[0] or inv_k <= 0:
+            raise IdentificationError(
+                f"joint {robot.joint_names[j]!r} (joints[{j}]): its drive gain cannot be absorbed: "
+                f"the nominal torque does not explain the current (1/K = {inv_k:g}); give the "
+                f"gain in the description's drive (gear_ratio x torque_constant)")
+        gains[j] = 1.0 / inv_k
+    return gains, "absorbed"
+
+
+def _stack(samples: Sequence[Samples], y_full: Sequence[np.ndarray], columns: np.ndarray,
+           gains: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``Phi`` (m, b), ``y`` (m,), joint of each row, CV block of each row (m = sum N_k n)."""
+    phis, ys, joints, blocks = [], [], [], []
+    for s, y in zip(samples, y_full, strict=True):
+        count, n = s.q.shape
+        phis.append(y[:, :, columns].reshape(count * n, -1))
+        ys.append((s.y * gains[None, :]).reshape(-1))  # K_j i_j (or tau_j)
+        joints.append(np.tile(np.arange(n), count))
+        blocks.append(np.repeat(np.arange(count) * FOLDS // count, n))
+    return np.vstack(phis), np.concatenate(ys), np.concatenate(joints), np.concatenate(blocks)
+
+
+def identify(robot: Robot, recordings: Any, target: str | None = None, method: str = "wls", *,
+             friction: str = "linear", regularization: float | str | None = "auto",
+             cutoff: float | str | None = "auto", decimate: int | str = "auto",
+             velocity: str = "position", gains: str = "auto",
+             bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None
+             ) -> Identification:
+    """Identify the base inertial, drive and friction parameters of a robot from recordings.
+
+    Parameters
+    ----------
+    robot : Robot
+        The nominal description (its values are the prior of the regularisation).
+    recordings : Recording or sequence of Recording
+        Measured runs, joints in the robot's order: ``t`` (N,) s, ``q`` (N, n) and the target
+        ``tau`` or ``current`` (N, n).
+    target : {"tau", "current"}, optional
+        Default: ``"tau"`` when every recording has torques, else ``"current"``.
+    method : {"ols", "wls", "consistent"}
+        Ordinary or weighted least squares, or physically consistent (pseudo-inertia LMIs).
+    friction : {"linear"}
+        Friction in the fit: viscous, Coulomb (+/-) and offset per joint. Nonlinear models are
+        fitted after this linear step by :func:`robodyn.identify.friction.fit_friction`.
+    regularization : "auto", float or None
+        Tikhonov weight toward the description's values (dimensionless, see
+        :mod:`robodyn.identify.estimate`); "auto": chosen by time-block cross-validation on these
+        data; None: plain least squares (not-excited directions stay at the prior).
+    cutoff : "auto", float or None
+        Zero-phase low-pass cut-off, Hz (:mod:`robodyn.identify.preprocess`); None: none.
+    decimate : "auto" or int
+    velocity : {"position", "measured"}
+        Joint velocities from the filtered positions (default) or the filtered measured ones.
+    gains : {"auto", "description", "absorbed"}
+        Drive gains for ``target="current"`` (:func:`drive_gains`).
+    bounds : dict of str to (float, float), optional
+        Box constraints on named standard parameters for ``method="consistent"``
+        (e.g. ``{"M7": (0.3, 2.0)}`` for a known payload range).
+    model : Model, optional
+        A compiled model of ``robot`` to reuse (default ``rd.compile_model(robot)``).
+
+    Returns
+    -------
+    Identification
+
+    Raises
+    ------
+    IdentificationError
+        Joints not matching the robot, NaN, a missing target, too few samples for the
+        parameters, an unknown option, an infeasible or failed semidefinite program.
+    """
+    recs = [recordings] if hasattr(recordings, "q") else list(recordings)
+    if not recs:
+        raise IdentificationError("recordings: none given")
+    if target is None:
+        target = "tau" if all(getattr(r, "tau", None) is not None for r in recs) else "current"
+    if target not in TARGETS:
+        raise IdentificationError(f"target: expected one of {TARGETS}, got {target!r}")
+    if method not in METHODS:
+        raise IdentificationError(f"method: expected one of {METHODS}, got {method!r}")
+    if friction != "linear":
+        raise IdentificationError(f"friction: rd.identify fits the linear model; fit {friction!r} "
+                                  f"afterwards with robodyn.identify.fit_friction")
+    if gains not in ("auto", "description", "absorbed"):
+        raise IdentificationError(f"gains: expected 'auto', 'description' or 'absorbed', got {gains!r}")
+    for i, rec in enumerate(recs):
+        check_recording(robot, rec, i, target)
+    settings = resolve_preprocess(recs, cutoff, decimate, velocity)
+    model = model if model is not None else compile_model(robot)
+    relations = base_relations(model)
+    samples = [_decimated(preprocess(r, settings, target), settings) for r in recs]
+    y_full = [model.regressor(s.q, s.qd, s.qdd) for s in samples]
+    count = sum(s.q.shape[0] for s in samples)
+    b = relations.independent.size
+    if count * robot.dof < 2 * b:
+        raise IdentificationError(
+            f"recordings: too few samples for the parameters: {count} samples x {robot.dof} joints "
+            f"= {count * robot.dof} equations after decimation by {settings.decimate} for {b} base "
+            f"parameters (at least {2 * b} needed; record longer or pass decimate=1)")
+    nominal = nominal_standard(robot)
+    if target == "current":
+        k, k_source = drive_gains(robot, samples, y_full, nominal, gains)
+    else:
+        k, k_source = np.ones(robot.dof), "none"
+    phi, y, joint, blocks = _stack(samples, y_full, relations.independent, k)
+    theta0 = relations.to_base(nominal)
+    lin_method = "ols" if method == "ols" else "wls"
+    fit = fit_linear(phi, y, theta0, joint, blocks, method=lin_method, regularization=regularization)
+    if method == "consistent":
+        from robodyn.identify.consistent import consistent_standard
+
+        standard = consistent_standard(robot, relations, phi, y, joint, fit, nominal, bounds)
+        theta = relations.to_base(standard)
+    else:
+        theta = fit.theta
+        standard = _complete(relations, theta, nominal)
+    table = _table(relations, theta, fit, theta0)
+    ident_robot = robot_with_parameters(robot, standard, k if target == "current" else None,
+                                        source=f"identified ({method}) from {robot.source}")
+    s = fit.singular_values
+    weak = fit.directions[:, s < UNEXCITED_RTOL * s[0]]
+    return Identification(
+        robot=ident_robot, base_parameters=table, standard=standard, preprocess=settings,
+        target=target, method=method, gains=k, gains_source=k_source, regularization=fit.lam,
+        condition=fit.condition, singular_values=s, unexcited_directions=weak,
+        residual_std=fit.sigma / k, samples=count, relations=relations,
+        _model=model)
+
+
+def _decimated(s: Samples, settings: Preprocess) -> Samples:
+    d = settings.decimate
+    if d == 1:
+        return s
+    return Samples(s.t[::d], s.q[::d], s.qd[::d], s.qdd[::d], None if s.y is None else s.y[::d],
+                   s.source)
+
+
+def _complete(relations: Any, theta: np.ndarray, nominal: np.ndarray) -> np.ndarray:
+    """Standard vector with the dependent parameters at their nominal values and the
+    independent ones set so that its base parameters equal ``theta``."""
+    p = nominal.copy()
+    # theta = p_b + beta p_d  ->  p_b = theta - beta p_d
+    p[relations.independent] = theta - relations.beta @ nominal[relations.dependent]
+    return p
+
+
+def _table(relations: Any, theta: np.ndarray, fit: LinearFit, theta0: np.ndarray) -> BaseParameters:
+    std = np.sqrt(np.clip(np.diag(fit.cov), 0.0, np.inf))
+    return BaseParameters(names=relations.names, values=theta, std=std, nominal=theta0,
+                          relations=relations.expressions, identifiable=~fit.unexcited)
+

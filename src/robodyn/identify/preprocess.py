@@ -1,0 +1,171 @@
+"""From a raw recording to the samples an identification fits: filter, differentiate, decimate.
+
+One rule, used by :func:`robodyn.identify` and again by :meth:`Identification.predict`, so that a
+prediction processes a new recording exactly as the fit processed its data:
+
+* positions ``q`` are low-passed with a zero-phase Butterworth filter (order 4 per pass, run
+  forward and backward: :func:`robodyn.measure.filtering.differentiate`), and ``qd``, ``qdd`` are
+  the derivatives of the filtered positions (measured velocities are used, filtered the same
+  way, only with ``velocity="measured"``; their spikes make position differences the safer
+  default); a joint whose position spans less than 1 mrad (1 mm) is held still: its ``qd`` and
+  ``qdd`` are exactly zero;
+* the target (torque or current) is low-passed with the SAME filter, so that the fit of a
+  filtered target on filtered motion is not biased by different filter gains;
+* for fitting only, the filtered samples are then decimated by an integer factor (keeping every
+  ``decimate``-th sample), which thins the strongly correlated neighbouring rows the filter
+  leaves; :meth:`Identification.predict` returns every sample.
+
+``cutoff=None`` turns all filtering off: the recording's own ``qd`` and ``qdd`` (measured or
+estimated when the recording was built) and its raw target are used (simulated data).
+
+Default cut-off (``cutoff="auto"``): the largest bandwidth of the moving joints' positions
+(:func:`robodyn.measure.filtering.bandwidth_cutoff`) over the recordings, clamped to
+``[AUTO_MIN_HZ, AUTO_MAX_HZ]`` = [2, 10] Hz and to 0.2 x the sampling rate: manipulator motion
+(and with it the rigid-body torque) lives below a few hertz, while the second derivative of
+encoder noise grows with the square of frequency. Default decimation (``decimate="auto"``): the
+largest integer not above ``fs / (5 cutoff)``, i.e. about five samples per cut-off period.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass
+from robodyn.robot.errors import IdentificationError
+
+__all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "Preprocess", "Samples", "preprocess", "resolve_preprocess"]
+
+AUTO_MIN_HZ = 2.0
+AUTO_MAX_HZ = 10.0
+_MOVING_RAD = 1e-3  # a joint whose position spans less than this never moves (rad or m)
+
+
+@dataclass(frozen=True)
+class Preprocess:
+    """The frozen preprocessing settings of an identification.
+
+    Attributes
+    ----------
+    cutoff : float or None
+        -3 dB frequency of one pass of the zero-phase Butterworth filter, Hz; None: no filtering.
+    order : int
+        Butterworth order of one pass.
+    decimate : int
+        Keep every ``decimate``-th filtered sample for fitting (1: all).
+    velocity : {"position", "measured"}
+        Whether ``qd`` is the derivative of the filtered positions or the filtered measured one.
+    """
+
+    cutoff: float | None
+    order: int = 4
+    decimate: int = 1
+    velocity: Literal["position", "measured"] = "position"
+
+
+@dataclass(frozen=True, eq=False)
+class Samples:
+    """Processed samples of one recording, all (N, n) at the recording's own times.
+
+    Attributes
+    ----------
+    t : numpy.ndarray, shape (N,)
+    q, qd, qdd : numpy.ndarray, shape (N, n)
+        rad, rad/s, rad/s^2 (m for prismatic joints).
+    y : numpy.ndarray or None, shape (N, n)
+        The (filtered) target: N m (N) or A; None when the recording has no such signal.
+    source : str
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    y: np.ndarray | None
+    source: str
+
+
+def _source(rec: Any) -> str:
+    return str(getattr(rec, "source", "") or "Recording")
+
+
+def target_signal(rec: Any, target: str) -> np.ndarray | None:
+    """The recording's raw target (N, n) (``tau`` or ``current``), or None when absent."""
+    return getattr(rec, target, None)
+
+
+def resolve_preprocess(recordings: list[Any], cutoff: float | str | None, decimate: int | str,
+                       velocity: str = "position", order: int = 4) -> Preprocess:
+    """Settings for these recordings: the ``"auto"`` rules of the module docstring resolved."""
+    if velocity not in ("position", "measured"):
+        raise IdentificationError(f"velocity: expected 'position' or 'measured', got {velocity!r}")
+    fs = min(1.0 / float(np.median(np.diff(np.asarray(r.t, float)))) for r in recordings)
+    if isinstance(cutoff, str):
+        if cutoff != "auto":
+            raise IdentificationError(f"cutoff: expected a frequency in Hz, None or 'auto', got {cutoff!r}")
+        bands = []
+        for r in recordings:
+            q = np.asarray(r.q, float)
+            moving = np.ptp(q, axis=0) > _MOVING_RAD
+            if np.any(moving) and q.shape[0] >= 16:
+                bands.append(bandwidth_cutoff(np.asarray(r.t, float), q[:, moving]))
+        band = max(bands) if bands else AUTO_MIN_HZ
+        cut = float(np.clip(band, AUTO_MIN_HZ, AUTO_MAX_HZ))
+        cut = min(cut, 0.2 * fs)
+    elif cutoff is None:
+        cut = None
+    else:
+        cut = float(cutoff)
+        if not 0.0 < cut < 0.5 * fs:
+            raise IdentificationError(f"cutoff: must lie in (0, {0.5 * fs:g}) Hz (the Nyquist "
+                                      f"frequency of the slowest recording), got {cut:g}")
+    if isinstance(decimate, str):
+        if decimate != "auto":
+            raise IdentificationError(f"decimate: expected a positive integer or 'auto', got {decimate!r}")
+        dec = 1 if cut is None else max(1, int(np.floor(fs / (5.0 * cut))))
+    else:
+        dec = int(decimate)
+        if dec < 1 or dec != decimate:
+            raise IdentificationError(f"decimate: expected a positive integer, got {decimate!r}")
+    return Preprocess(cutoff=cut, order=order, decimate=dec, velocity=velocity)  # type: ignore[arg-type]
+
+
+def preprocess(rec: Any, settings: Preprocess, target: str | None) -> Samples:
+    """Process one recording (not decimated; see the module docstring).
+
+    Parameters
+    ----------
+    rec : Recording
+        Raw recording: ``t`` (N,) s, ``q`` (N, n), optional ``qd``/``qdd``/``tau``/``current``.
+    settings : Preprocess
+    target : {"tau", "current"} or None
+        Which signal to filter as the target (None: none).
+
+    Returns
+    -------
+    Samples
+    """
+    t = np.asarray(rec.t, dtype=float)
+    q = np.asarray(rec.q, dtype=float)
+    raw_y = target_signal(rec, target) if target is not None else None
+    y = None if raw_y is None else np.asarray(raw_y, dtype=float)
+    if settings.cutoff is None:
+        if rec.qd is None or rec.qdd is None:
+            raise IdentificationError(f"{_source(rec)}: qd/qdd: cutoff=None uses the recording's own "
+                                      f"velocities and accelerations, but it has none")
+        return Samples(t, q, np.asarray(rec.qd, float), np.asarray(rec.qdd, float), y, _source(rec))
+    cut, order = settings.cutoff, settings.order
+    # q_f = H q (zero-phase low-pass), qd = d q_f / dt, qdd = d^2 q_f / dt^2
+    q_f, qd, qdd = differentiate(t, q, cut, order=order)
+    estimated = getattr(rec, "estimated", frozenset())
+    if settings.velocity == "measured" and rec.qd is not None and "qd" not in estimated:
+        # qd = H qd_measured, qdd = d qd / dt
+        qd_f, qdd, _ = differentiate(t, np.asarray(rec.qd, float), cut, order=order)
+        qd = qd_f
+    held = np.ptp(q, axis=0) < _MOVING_RAD
+    qd[:, held] = 0.0  # a joint held still: its filtered encoder noise is no motion
+    qdd[:, held] = 0.0
+    y_f = None if y is None else lowpass(t, y, cut, order=order)  # the same H on the target
+    return Samples(t, q_f, qd, qdd, y_f, _source(rec))

@@ -1,0 +1,150 @@
+"""Frozen results of an identification: the base parameter table and :class:`Identification`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from robodyn.identify.base import BaseRelations
+from robodyn.identify.preprocess import Preprocess, preprocess
+from robodyn.numeric.model import Model
+from robodyn.robot.model import Robot
+
+__all__ = ["BaseParameters", "Identification"]
+
+
+@dataclass(frozen=True, eq=False)
+class BaseParameters:
+    """Table of the identified base parameters, one row each.
+
+    Attributes
+    ----------
+    names : tuple of str, length b
+    values : numpy.ndarray, shape (b,)
+        SI units (kg m^2, kg m, kg, N m s/rad, N m), target-torque units.
+    std : numpy.ndarray, shape (b,)
+        Standard deviations (inf: not identifiable from these data; the value is then the prior).
+    nominal : numpy.ndarray, shape (b,)
+        The description's values of the same combinations.
+    relations : tuple of sympy.Expr, length b
+        Each base parameter in the standard parameter symbols (``XX1``, ``MY2``, ...).
+    identifiable : numpy.ndarray of bool, shape (b,)
+        False where the data do not excite the parameter (it keeps its prior value).
+    """
+
+    names: tuple[str, ...]
+    values: np.ndarray
+    std: np.ndarray
+    nominal: np.ndarray
+    relations: tuple[sp.Expr, ...]
+    identifiable: np.ndarray
+
+    @property
+    def relative_std(self) -> np.ndarray:
+        """``100 std / |value|`` (%), shape (b,); inf for a zero value or infinite std."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rel = 100.0 * self.std / np.abs(self.values)
+        return np.where(np.isfinite(rel), rel, np.inf)
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def to_frame(self) -> Any:
+        """The table as a pandas DataFrame (columns name, value, std, relative_std_percent,
+        nominal, identifiable, relation)."""
+        import pandas as pd
+
+        return pd.DataFrame({
+            "name": self.names, "value": self.values, "std": self.std,
+            "relative_std_percent": self.relative_std, "nominal": self.nominal,
+            "identifiable": self.identifiable, "relation": [str(r) for r in self.relations],
+        })
+
+    def __str__(self) -> str:
+        lines = [f"{'name':<8} {'value':>13} {'std':>11} {'rel std %':>10}  relation"]
+        for i, name in enumerate(self.names):
+            flag = "" if self.identifiable[i] else "  (not excited)"
+            lines.append(f"{name:<8} {self.values[i]:>13.6g} {self.std[i]:>11.3g} "
+                         f"{self.relative_std[i]:>10.3g}  {self.relations[i]}{flag}")
+        return "\n".join(lines)
+
+
+@dataclass(frozen=True, eq=False)
+class Identification:
+    """Result of :func:`robodyn.identify`.
+
+    Attributes
+    ----------
+    robot : Robot
+        The description carrying the identified parameters (the full standard set: physically
+        consistent with ``method="consistent"``; otherwise the nominal values of the dependent
+        standard parameters completed by the identified base combinations).
+    base_parameters : BaseParameters
+    standard : numpy.ndarray, shape (15 n,)
+        The standard parameter vector of ``robot``.
+    preprocess : Preprocess
+        Filter cut-off, order and decimation used (applied again by :meth:`predict`).
+    target : {"tau", "current"}
+    method : {"ols", "wls", "consistent"}
+    gains : numpy.ndarray, shape (n,)
+        Drive gains ``K_j`` (N m / A) dividing the predicted torque when ``target="current"``
+        (ones for ``target="tau"``).
+    gains_source : {"none", "description", "absorbed"}
+    regularization : float
+        Tikhonov weight used (dimensionless; 0: none).
+    condition : float
+        Condition number of the weighted, column-scaled identification matrix.
+    singular_values : numpy.ndarray, shape (b,)
+    unexcited_directions : numpy.ndarray, shape (b, k)
+        Unit directions in base-parameter space (column-scaled) whose singular value is below
+        1e-6 of the largest: what the data cannot tell apart.
+    residual_std : numpy.ndarray, shape (n,)
+        Per-joint residual standard deviation of the fit (target units).
+    samples : int
+        Samples (after decimation) used in the fit.
+    relations : BaseRelations
+    """
+
+    robot: Robot
+    base_parameters: BaseParameters
+    standard: np.ndarray
+    preprocess: Preprocess
+    target: str
+    method: str
+    gains: np.ndarray
+    gains_source: str
+    regularization: float
+    condition: float
+    singular_values: np.ndarray
+    unexcited_directions: np.ndarray
+    residual_std: np.ndarray
+    samples: int
+    relations: BaseRelations
+    _model: Model
+
+    def predict(self, recording: Any) -> np.ndarray:
+        """Predicted target at the recording's own samples.
+
+        The raw recording is processed as the identification data were (same filter cut-off
+        and order, same derivative estimates, no decimation).
+
+        Parameters
+        ----------
+        recording : Recording
+            ``t`` (N,), ``q`` (N, n) in the robot's joint order.
+
+        Returns
+        -------
+        numpy.ndarray, shape (N, n)
+            N m (N) for ``target="tau"``, A for ``target="current"``.
+        """
+        from robodyn.identify.pipeline import check_recording
+
+        check_recording(self.robot, recording, 0, None)
+        s = preprocess(recording, self.preprocess, None)
+        y = self._model.regressor(s.q, s.qd, s.qdd)
+        tau = y @ self.standard  # tau = Y(q, qd, qdd) p
+        return tau / self.gains[None, :]
