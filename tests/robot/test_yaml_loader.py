@@ -521,3 +521,64 @@ def test_not_utf8_file(tmp_path: Path) -> None:
 def test_text_source_names_errors() -> None:
     with pytest.raises(DescriptionError, match=r"^builtin:x: joints: required field is missing$"):
         load_yaml_text("name: a\n", source="builtin:x")
+
+
+def alias_bomb(levels: int = 9) -> str:
+    """A ~700-byte description whose ``hydro`` block expands to 9**levels entries via aliases."""
+    lines = ["name: bomb", "joints:", "  - name: j1", "    type: revolute", "    dh: {a: 1}",
+             "    link:", "      mass: 1", "      hydro:",
+             "        l0: &l0 [x, x, x, x, x, x, x, x, x]"]
+    lines += [f"        l{i}: &l{i} [" + ", ".join([f"*l{i - 1}"] * 9) + "]"
+              for i in range(1, levels)]
+    return "\n".join(lines) + "\n"
+
+
+def test_yaml_aliases_are_rejected_with_file_and_line(tmp_path: Path) -> None:
+    # 9**9 = 387 million strings once expanded: hashing it through str() exhausted memory
+    text = alias_bomb()
+    assert len(text) < 1500
+    path = write(tmp_path, text)
+    pattern = (rf"^{re.escape(str(path))}: line 10, column 18: YAML alias \*l0 is not allowed "
+               r"in robot descriptions")
+    with pytest.raises(DescriptionError, match=pattern):
+        load_yaml_file(path)
+
+
+def test_merge_key_aliases_are_rejected_too() -> None:
+    text = one_joint("{name: j, type: revolute, dh: {}, link: {mass: 1, hydro: {a: &h {r: 1}, "
+                     "b: {<<: *h}}}}")
+    with pytest.raises(DescriptionError, match=r"YAML alias \*h is not allowed"):
+        load_yaml_text(text, source="t.yaml")
+
+
+def test_deep_yaml_nesting_is_a_clear_error() -> None:
+    text = "name: a\njoints: " + "[" * 3000 + "]" * 3000 + "\n"  # RecursionError in PyYAML
+    with pytest.raises(DescriptionError, match=r"^t\.yaml: line 2, column \d+: nested more than "
+                                               r"32 levels deep$"):
+        load_yaml_text(text, source="t.yaml")
+
+
+@pytest.mark.parametrize(
+    ("hydro", "pattern"),
+    [
+        ("{1: a}", r"\.link\.hydro: keys must be texts, got int 1"),
+        ("{when: 2020-01-02}", r"\.link\.hydro\.when: expected a text, number, list or mapping, "
+                               r"got date"),
+        ("{c: [{r: .nan}]}", r"\.link\.hydro\.c\[0\]\.r: expected a finite number, got nan"),
+    ],
+)
+def test_hydro_must_be_plain_data(hydro: str, pattern: str, tmp_path: Path) -> None:
+    bad(jt("{mass: 1, hydro: " + hydro + "}"), J0 + pattern, tmp_path)
+
+
+def test_description_hash_is_canonical() -> None:
+    # the same data in another key order is the same description; another value is not
+    def robot(hydro: str) -> Robot:
+        return load_yaml_text(jt("{mass: 1, hydro: " + hydro + "}"), source="t.yaml")
+
+    a = robot("{drag: 1.2, cylinders: [{radius: 0.05, length: 1}]}")
+    b = robot("{cylinders: [{length: 1, radius: 0.05}], drag: 1.2}")
+    c = robot("{cylinders: [{length: 1, radius: 0.06}], drag: 1.2}")
+    assert a.description_hash == b.description_hash
+    assert a.description_hash != c.description_hash
+    assert re.fullmatch(r"[0-9a-f]{64}", a.description_hash)

@@ -20,6 +20,7 @@ is a unit 3-vector in the frame reached after ``pre_i``. Standard DH gives ``pre
 from __future__ import annotations
 
 import hashlib
+import json
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -231,11 +232,40 @@ class Robot:
 
 
 def _canonical_text(robot: Robot) -> str:
-    """A deterministic text of everything that defines the robot (for hashing)."""
-    parts = [robot.name, str(robot.base), str(robot.tool), str(robot.gravity)]
-    parts += [f"{k}={v!r}" for k, v in sorted(robot.parameters.items())]
-    for j, link in zip(robot.joints, robot.links, strict=True):
-        parts += [j.name, j.type, str(j.pre), str(j.axis), str(j.post), str(j.drive),
-                  str(j.friction), str((j.lower, j.upper))]
-        parts += [link.name, str(link.mass), str(link.com), str(link.inertia), str(link.hydro)]
-    return "\n".join(parts)
+    """A deterministic text of everything that defines the robot (for hashing).
+
+    JSON with sorted keys: mappings kept verbatim (``hydro``) hash the same whatever their key
+    order; expressions and matrices enter as their SymPy text.
+    """
+    joints = [
+        {"name": j.name, "type": j.type, "pre": str(j.pre), "axis": str(j.axis),
+         "post": str(j.post), "drive": str(j.drive), "friction": str(j.friction),
+         "limits": str((j.lower, j.upper))}
+        for j in robot.joints
+    ]
+    links = [
+        {"name": link.name, "mass": str(link.mass), "com": str(link.com),
+         "inertia": str(link.inertia), "hydro": _plain(link.hydro)}
+        for link in robot.links
+    ]
+    data = {
+        "name": robot.name, "base": str(robot.base), "tool": str(robot.tool),
+        "gravity": str(robot.gravity),
+        "parameters": {k: repr(v) for k, v in robot.parameters.items()},
+        "joints": joints, "links": links,
+    }
+    return json.dumps(data, sort_keys=True, default=_json_default)
+
+
+def _plain(value: Any) -> Any:
+    """Verbatim data as JSON-ready values: text keys, lists for sequences."""
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    return value
+
+
+def _json_default(value: Any) -> str:
+    """JSON stand-in for values outside JSON (SymPy numbers, arrays): type and text."""
+    return f"{type(value).__name__}:{value!s}"

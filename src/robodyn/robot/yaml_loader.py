@@ -10,6 +10,7 @@ physically impossible values are rejected with a :class:`DescriptionError` whose
 from __future__ import annotations
 
 import copy
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import MappingProxyType
@@ -25,7 +26,7 @@ from robodyn.robot.errors import DescriptionError
 from robodyn.robot.expressions import parameter_symbol, parse_value
 from robodyn.robot.model import Drive, Friction, Link, Robot
 
-__all__ = ["JOINT_TYPES", "load_yaml_file", "load_yaml_text"]
+__all__ = ["JOINT_TYPES", "MAX_YAML_DEPTH", "load_yaml_file", "load_yaml_text"]
 
 #: Joint types accepted in ``joints[i].type`` and the type they load as.
 JOINT_TYPES: Mapping[str, str] = MappingProxyType(
@@ -43,6 +44,9 @@ _FRICTION_KEYS = ("side", "viscous", "coulomb", "coulomb_positive", "coulomb_neg
 _LINK_KEYS = ("name", "mass", "com", "inertia", "hydro")
 _INERTIA_KEYS = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
 _ZERO = sp.Integer(0)
+
+#: Deepest nesting of YAML collections accepted (a description needs about 8 levels).
+MAX_YAML_DEPTH = 32
 
 
 def load_yaml_file(path: str | Path, *, strict: bool = False) -> Robot:
@@ -106,8 +110,40 @@ def load_yaml_text(text: str, *, source: str, strict: bool = False) -> Robot:
     return _Reader(source, strict).robot(data)
 
 
+class _Refused(yaml.MarkedYAMLError):
+    """Valid YAML that a robot description does not accept (an alias, too deep a nesting)."""
+
+    def __init__(self, problem: str, mark: yaml.Mark) -> None:
+        super().__init__(problem=problem, problem_mark=mark)
+
+
 class _UniqueKeyLoader(yaml.SafeLoader):
-    """``yaml.SafeLoader`` that rejects a key repeated in one mapping (a silent overwrite)."""
+    """``yaml.SafeLoader`` that rejects aliases and a key repeated in one mapping.
+
+    Aliases (``*name``) are refused where they occur: a few hundred bytes of nested aliases
+    expand to gigabytes once the data is copied, printed or hashed ("billion laughs"), and a
+    robot description has no need of them.
+    """
+
+    _depth = 0
+
+    def compose_node(self, parent: yaml.Node | None, index: Any) -> yaml.Node | None:
+        if self.check_event(yaml.AliasEvent):
+            event = self.peek_event()
+            raise _Refused(
+                f"YAML alias *{event.anchor} is not allowed in robot descriptions (aliases can "
+                "expand a small file to gigabytes); write the values out",
+                event.start_mark,
+            )
+        if self._depth >= MAX_YAML_DEPTH:
+            raise _Refused(
+                f"nested more than {MAX_YAML_DEPTH} levels deep", self.peek_event().start_mark
+            )
+        self._depth += 1
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
 
     def construct_mapping(self, node: yaml.Node, deep: bool = False) -> dict[Any, Any]:
         if isinstance(node, yaml.MappingNode):
@@ -137,7 +173,8 @@ def _parse_yaml(text: str, source: str) -> Any:
         mark = exc.problem_mark or exc.context_mark
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else "unknown line"
         problem = exc.problem or exc.context or "invalid YAML"
-        raise DescriptionError(f"{source}: {where}: YAML syntax error: {problem}") from None
+        kind = "" if isinstance(exc, _Refused) else "YAML syntax error: "
+        raise DescriptionError(f"{source}: {where}: {kind}{problem}") from None
     except yaml.YAMLError as exc:
         raise DescriptionError(f"{source}: YAML syntax error: {exc}") from None
 
@@ -217,6 +254,23 @@ class _Reader:
         if not isinstance(value, list | tuple) or len(value) != n:
             raise self.error(path, f"expected a list of {n} numbers, got {_kind(value)}")
         return [self.expr(v, f"{path}[{k}]") for k, v in enumerate(value)]
+
+    def plain(self, value: Any, path: str) -> None:
+        """Data kept verbatim (``hydro``): text-keyed mappings, lists, text, numbers, booleans."""
+        if isinstance(value, Mapping):
+            for key, item in value.items():
+                if not isinstance(key, str):
+                    raise self.error(path, f"keys must be texts, got {_kind(key)}")
+                self.plain(item, f"{path}.{key}")
+        elif isinstance(value, list):
+            for k, item in enumerate(value):
+                self.plain(item, f"{path}[{k}]")
+        elif isinstance(value, float) and not math.isfinite(value):
+            raise self.error(path, f"expected a finite number, got {value!r}")
+        elif value is not None and not isinstance(value, str | int | float | bool):
+            raise self.error(
+                path, f"expected a text, number, list or mapping, got {type(value).__name__}"
+            )
 
     # -- sections ----------------------------------------------------------------------------
 
@@ -452,6 +506,7 @@ class _Reader:
         if "hydro" in m and m["hydro"] is not None:
             if not isinstance(m["hydro"], Mapping):
                 raise self.error(f"{path}.hydro", f"expected a mapping, got {_kind(m['hydro'])}")
+            self.plain(m["hydro"], f"{path}.hydro")
             hydro = MappingProxyType(copy.deepcopy(dict(m["hydro"])))
         link = Link(
             name=name, mass=mass, com=sp.ImmutableMatrix(com),
