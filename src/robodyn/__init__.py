@@ -11,11 +11,13 @@ Public API::
 
 from robodyn.calibrate import Calibration, calibrate
 from robodyn.identify import Identification, identify
+from robodyn.measure import Recording, read_recording
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.load import builtin_names, load
 from robodyn.robot.model import Drive, Friction, Joint, Link, Robot
 from robodyn.simulate import Trajectory, simulate
 from robodyn.symbolic.eom import EquationsOfMotion, derive
+from robodyn.validate import Validation, validate
 
 __all__ = [
     "Calibration",
@@ -26,14 +28,18 @@ __all__ = [
     "Joint",
     "Link",
     "Model",
+    "Recording",
     "Robot",
     "Trajectory",
+    "Validation",
     "builtin_names",
     "calibrate",
     "compile_model",
     "derive",
     "identify",
     "load",
+    "read_recording",
     "simulate",
+    "validate",
 ]
 __version__ = "0.1.0"

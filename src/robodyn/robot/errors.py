@@ -29,6 +29,33 @@ class ValidationError(ValueError):
     """
 
 
+class RecordingError(ValueError):
+    """Measured data (a recording file, a recording spec or arrays) is malformed.
+
+    The message names the file (or ``Recording``), the field or column, the row or line where
+    known, and the reason, e.g. ``"run.csv: column 'Position3' (position.columns[2]): NaN at
+    line 17"``.
+    """
+
+
+class RecordingWarning(UserWarning):
+    """Measured data is readable but suspicious (e.g. gaps in the time stamps)."""
+
+
+class SimulationError(FloatingPointError, ValueError):
+    """A simulation (or a forward-dynamics call) stopped being finite.
+
+    A ``FloatingPointError`` (what the integrators always raised) and a ``ValueError`` (what the
+    command line reports as bad input, exit 2). The message says when it happened and what to
+    change.
+    """
+
+
+class SingularMassMatrixError(SimulationError):
+    """The joint-space mass matrix is singular (a joint moves no mass, inertia or rotor), so the
+    forward dynamics has no solution. The message names the robot and the joint."""
+
+
 class IdentificationError(ValueError):
     """Measured data cannot be used to identify a robot's parameters, or an estimator failed.
 
