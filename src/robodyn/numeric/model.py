@@ -25,6 +25,7 @@ from robodyn.codegen.c import CPrinter
 from robodyn.codegen.kernels import KernelSet, build_kernels, kernel_signature
 from robodyn.codegen.python import PythonPrinter
 from robodyn.robot.model import Robot
+from robodyn.robot.overrides import checked_parameter_values
 
 Backend = Literal["c", "numpy"]
 _PREFIX = "rd_"
@@ -259,11 +260,8 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
     """
     if backend not in ("c", "numpy"):
         raise ValueError(f"unknown backend {backend!r}; choose 'c' (compiled) or 'numpy'")
-    unknown = [k for k in (parameters or {}) if k not in robot.parameters]
-    if unknown:
-        raise ValueError(f"robot {robot.name!r} has no parameter(s) {', '.join(unknown)}; "
-                         f"it has {', '.join(robot.parameters) or 'none'}")
-    values = {k: float(v) for k, v in {**robot.parameters, **(parameters or {})}.items()}
+    # unknown names, non-finite values and impossible physics at the new values are refused
+    values = checked_parameter_values(robot, parameters, where="compile_model(parameters=...)")
     # generated sources are cached by (description, parameter values, generator source)
     key = hashlib.sha256(repr((robot.description_hash, sorted(values.items()), backend,
                                _generator_hash())).encode()).hexdigest()[:24]
