@@ -1,0 +1,15 @@
+"""Validation of a dynamic model against measured data (thesis ch. 5).
+
+``rd.validate(robot, recording)`` compares the model's predicted torque or motor current with the
+measured one (per joint RMS, maximum, relative error, NRMSE), simulates short windows from the
+measured state under the measured torque (drift per window), and estimates the target's noise
+floor and the residual spectra. :mod:`robodyn.validate.figures` draws the result.
+"""
+
+from robodyn.validate.metrics import ErrorMetrics, error_metrics
+from robodyn.validate.spectra import NoiseFloor, ResidualSpectra, noise_floor, residual_spectra
+from robodyn.validate.validation import Validation, validate
+from robodyn.validate.windows import WindowDrift, simulate_windows
+
+__all__ = ["ErrorMetrics", "NoiseFloor", "ResidualSpectra", "Validation", "WindowDrift",
+           "error_metrics", "noise_floor", "residual_spectra", "simulate_windows", "validate"]
