@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
-__all__ = ["DescriptionError", "DescriptionWarning", "IdentificationError", "ValidationError"]
+__all__ = [
+    "DataFileError",
+    "DescriptionError",
+    "DescriptionWarning",
+    "IdentificationError",
+    "ValidationError",
+]
 
 
 class DescriptionError(ValueError):
@@ -63,4 +69,14 @@ class IdentificationError(ValueError):
     field or joint, the row where one matters, and the reason (joints that do not match the
     robot, too few samples for the parameters, values that are not finite, an infeasible or
     failed semidefinite program).
+    """
+
+
+class DataFileError(ValueError):
+    """A data table (calibration poses, ISO 9283 cycles, approach records) cannot be read.
+
+    Raised by :func:`robodyn.calibrate.io.read_table` and the readers built on it: the message
+    names the file, the line (1-based, as an editor counts) and the column where known, and the
+    reason (not a UTF-8 text file, a row with more or fewer values than the header, a missing or
+    repeated column, a value that is not a finite number).
     """
