@@ -41,7 +41,7 @@ from lxml import etree
 
 from robodyn import spatial as S
 from robodyn.robot import placement, validation
-from robodyn.robot.chain import ChainElement, assemble
+from robodyn.robot.chain import ChainElement, assemble, combine_links
 from robodyn.robot.errors import DescriptionError
 from robodyn.robot.model import Friction, Link, Robot
 
@@ -84,15 +84,22 @@ def number(x: float | str, *, where: str) -> sp.Expr:
     return sp.Float(v)
 
 
-def load_urdf(path: str | Path, *, strict: bool = False) -> Robot:
-    """Load a serial-chain URDF file.
+def load_urdf(path: str | Path, *, strict: bool = False, tool: str | None = None) -> Robot:
+    """Load a URDF file whose moving joints form a serial chain.
 
     Parameters
     ----------
     path : str or Path
         The ``.urdf`` file.
     strict : bool
-        Turn physical-plausibility warnings on links into :class:`DescriptionError`.
+        Turn physical-plausibility warnings (implausible inertia, singular mass matrix) into
+        :class:`DescriptionError`.
+    tool : str, optional
+        Name of the link whose frame is the end effector (``Robot.tool``, the pose
+        ``model.forward_kinematics`` returns), e.g. ``"tool0"`` or ``"flange"``; it must lie
+        beyond the last moving joint. By default: the end of the unbranched run of fixed joints
+        after the last moving joint, or the last moving link itself when that run branches
+        (e.g. ``ee_link`` and ``tool0`` both fixed to the last link).
 
     Returns
     -------
@@ -104,16 +111,25 @@ def load_urdf(path: str | Path, *, strict: bool = False) -> Robot:
     ------
     DescriptionError
         The file is not well-formed XML or not a URDF, a number is missing or not finite, a
-        joint refers to an undefined link, the tree is not a single serial chain (a link with
-        several child joints, several roots, a loop), a joint is ``floating``, ``planar`` or a
-        ``<mimic>`` joint, a moving joint has a zero axis, or there is no moving joint. Every
-        message starts with the file name and names the joint or link at fault.
+        joint refers to an undefined link, the links do not form one tree (several roots, a
+        loop), the moving joints do not lie on one path from the root (a branching movable
+        tree), a joint is ``floating``, ``planar`` or a ``<mimic>`` joint, a moving joint has a
+        zero axis, there is no moving joint, or ``tool`` is not a link beyond the last moving
+        joint. Every message starts with the file name and names the joint or link at fault.
     FileNotFoundError
         If ``path`` does not exist.
+
+    Warns
+    -----
+    DescriptionWarning
+        A link's inertia is implausible, or the mass matrix is singular because a moving
+        joint moves no inertia (e.g. the links it carries have no ``<inertial>``); the
+        message names the joint and the links.
     """
     path = Path(path)
     name = str(path)
-    data = path.read_bytes()
+    # blank lines before the XML declaration are common in pasted and generated files
+    data = path.read_bytes().lstrip(b" \t\r\n")
     root = _parse_xml(data, name)
     try:
         model = yourdfpy.URDF.load(
@@ -130,17 +146,26 @@ def load_urdf(path: str | Path, *, strict: bool = False) -> Robot:
     joint_xml = {j.get("name"): j for j in root.findall("joint")}
     link_xml = {lk.get("name"): lk for lk in root.findall("link")}
     _check_names(model, name)
-    chain = _serial_chain(model, name)
+    chain, side = _serial_chain(model, name, tool)
     bodies: dict[str, Link] = {}
     for lk in model.links:
         where = f"{name}: links.{lk.name}"
         bodies[lk.name] = _link(lk, link_xml[lk.name], where)
         validation.check_link(bodies[lk.name], where=where, strict=strict, defaults={})
+    chain_links = {chain[0].parent} | {j.child for j in chain}
+    bodies = _merge_side_branches(bodies, side, chain_links, joint_xml, name)
     elements = [_element(j, joint_xml[j.name], bodies[j.child], name) for j in chain]
     try:
-        return assemble(model.name, elements, source=name)
+        robot = assemble(model.name, elements, source=name)
     except ValueError as exc:
         raise DescriptionError(str(exc)) from None
+    validation.check_mass_matrix(robot, where=name, strict=strict, missing=_no_inertial(model))
+    return robot
+
+
+def _no_inertial(model: yourdfpy.Robot) -> frozenset[str]:
+    """Names of the links without an ``<inertial>`` element."""
+    return frozenset(lk.name for lk in model.links if lk.inertial is None)
 
 
 def _parse_xml(data: bytes, name: str) -> Any:
@@ -193,8 +218,8 @@ def _check_names(model: yourdfpy.Robot, name: str) -> None:
                 )
 
 
-def _serial_chain(model: yourdfpy.Robot, name: str) -> list[yourdfpy.Joint]:
-    """The joints from the root link outwards; raises unless the tree is one serial chain."""
+def _check_joint_types(model: yourdfpy.Robot, name: str) -> None:
+    """Reject unknown, floating, planar and ``<mimic>`` joints, naming the joint."""
     if not model.joints:
         raise DescriptionError(
             f"{name}: robot {model.name!r} has no joints (a serial chain needs at least one)"
@@ -215,40 +240,154 @@ def _serial_chain(model: yourdfpy.Robot, name: str) -> list[yourdfpy.Joint]:
                 f"{name}: joint {j.name!r}: <mimic> joints (coupled to joint {j.mimic.joint!r}) "
                 "are not supported yet"
             )
-    parent_of: dict[str, str] = {}
+
+
+def _tree(model: yourdfpy.Robot, name: str) -> tuple[str, dict[str, yourdfpy.Joint],
+                                                     dict[str, list[yourdfpy.Joint]]]:
+    """The root link, each link's parent joint and each link's child joints (file order).
+
+    Raises unless the links form one tree: a link that is the child of two joints, several
+    root links, or a loop.
+    """
+    parent_joint: dict[str, yourdfpy.Joint] = {}
     children: dict[str, list[yourdfpy.Joint]] = {}
     for j in model.joints:
-        if j.child in parent_of:
+        if j.child in parent_joint:
             raise DescriptionError(
                 f"{name}: link {j.child!r} is the child of two joints "
-                f"({parent_of[j.child]!r} and {j.name!r}); not a tree"
+                f"({parent_joint[j.child].name!r} and {j.name!r}); not a tree"
             )
-        parent_of[j.child] = j.name
+        parent_joint[j.child] = j
         children.setdefault(j.parent, []).append(j)
-    for link, js in children.items():
-        if len(js) > 1:
-            raise DescriptionError(
-                f"{name}: link {link!r} has {len(js)} child joints "
-                f"({', '.join(repr(j.name) for j in js)}): branching trees are not supported, "
-                "only serial chains"
-            )
-    roots = [lk.name for lk in model.links if lk.name not in parent_of]
+    roots = [lk.name for lk in model.links if lk.name not in parent_joint]
     if len(roots) != 1:
         what = "no root link (the joints form a loop)" if not roots else f"{len(roots)} root links"
         listed = f" ({', '.join(map(repr, roots))})" if roots else ""
         raise DescriptionError(f"{name}: {what}{listed}; a serial chain has exactly one root link")
-    chain: list[yourdfpy.Joint] = []
-    link = roots[0]
-    while link in children:
-        j = children[link][0]
-        chain.append(j)
-        link = j.child
-    if len(chain) != len(model.joints):
-        missing = sorted({j.name for j in model.joints} - {j.name for j in chain})
+    reached = {roots[0]}
+    stack = [roots[0]]
+    while stack:
+        for j in children.get(stack.pop(), []):
+            reached.add(j.child)
+            stack.append(j.child)
+    if len(reached) != len(model.links):
+        missing = sorted({j.name for j in model.joints if j.child not in reached})
         raise DescriptionError(
-            f"{name}: joints {missing} are not connected to the chain from root link {roots[0]!r}"
+            f"{name}: joints {missing} are not connected to the tree from root link "
+            f"{roots[0]!r} (they form a loop)"
         )
-    return chain
+    return roots[0], parent_joint, children
+
+
+def _path(link: str, parent_joint: Mapping[str, yourdfpy.Joint]) -> list[yourdfpy.Joint]:
+    """The joints from the root link to ``link``, root first."""
+    out: list[yourdfpy.Joint] = []
+    while link in parent_joint:
+        out.append(parent_joint[link])
+        link = out[-1].parent
+    return out[::-1]
+
+
+def _serial_chain(
+    model: yourdfpy.Robot, name: str, tool: str | None
+) -> tuple[list[yourdfpy.Joint], list[yourdfpy.Joint]]:
+    """The joints from the root link to the tool link, and the fixed joints off that path.
+
+    The moving joints must all lie on one path from the root; fixed side branches (``base``,
+    ``tool0``, sensor frames) may hang anywhere. The tool link is ``tool`` when given (it must
+    lie beyond the last moving joint), else the end of the unbranched run of fixed joints after
+    the last moving joint (the last moving link itself when that run branches).
+    """
+    _check_joint_types(model, name)
+    root, parent_joint, children = _tree(model, name)
+    moving = [j for j in model.joints if j.type != "fixed"]
+    if not moving:
+        raise DescriptionError(f"{name}: robot {model.name!r} has no moving joint")
+    paths = {j.name: _path(j.child, parent_joint) for j in moving}
+    last = max(moving, key=lambda j: len(paths[j.name]))
+    on_path = {j.name for j in paths[last.name]}
+    for j in moving:
+        if j.name not in on_path:
+            _raise_branching(name, paths[j.name], paths[last.name], children, j, last)
+    if tool is None:
+        end = last.child
+        while len(children.get(end, [])) == 1:
+            end = children[end][0].child
+    else:
+        end = _tool_link(model, name, tool, last, parent_joint)
+    chain = _path(end, parent_joint)
+    chain_names = {j.name for j in chain}
+    side = [j for j in model.joints if j.name not in chain_names]
+    return chain, side
+
+
+def _raise_branching(name: str, a: list[yourdfpy.Joint], b: list[yourdfpy.Joint],
+                     children: Mapping[str, list[yourdfpy.Joint]],
+                     ja: yourdfpy.Joint, jb: yourdfpy.Joint) -> None:
+    """Name the link where the paths to moving joints ``ja`` and ``jb`` part."""
+    k = 0
+    while k < min(len(a), len(b)) and a[k].name == b[k].name:
+        k += 1
+    link = a[k].parent
+    branches = [c.name for c in children[link]]
+    raise DescriptionError(
+        f"{name}: link {link!r} has {len(branches)} child joints "
+        f"({', '.join(map(repr, branches))}) leading to the moving joints {ja.name!r} and "
+        f"{jb.name!r}: branching trees are not supported, only serial chains (fixed side "
+        "branches are)"
+    )
+
+
+def _tool_link(model: yourdfpy.Robot, name: str, tool: str, last: yourdfpy.Joint,
+               parent_joint: Mapping[str, yourdfpy.Joint]) -> str:
+    """Check that link ``tool`` exists and lies beyond the last moving joint ``last``."""
+    beyond = sorted(lk.name for lk in model.links
+                    if last.name in {j.name for j in _path(lk.name, parent_joint)})
+    if tool not in {lk.name for lk in model.links}:
+        raise DescriptionError(
+            f"{name}: tool link {tool!r} is not a link of the file (links beyond the last "
+            f"moving joint {last.name!r}: {', '.join(map(repr, beyond))})"
+        )
+    if tool not in beyond:
+        raise DescriptionError(
+            f"{name}: tool link {tool!r} is not beyond the last moving joint {last.name!r} "
+            f"(choose one of {', '.join(map(repr, beyond))})"
+        )
+    return tool
+
+
+def _fixed_transform(elem: Any, where: str) -> sp.ImmutableMatrix:
+    """The ``<origin>`` transform of a fixed joint, shape (4, 4)."""
+    xyz, rpy = _origin(elem.find("origin"), where)
+    pre, _, post = placement.from_origin(xyz, rpy, (0, 0, 1))
+    return sp.ImmutableMatrix(pre * post)
+
+
+def _merge_side_branches(
+    bodies: dict[str, Link], side: Sequence[yourdfpy.Joint], chain_links: set[str],
+    joint_xml: Mapping[str, Any], name: str,
+) -> dict[str, Link]:
+    """Chain links with the mass of every fixed side branch welded to them (inputs unchanged).
+
+    A side link that has neither mass nor inertia (a frame such as ``tool0`` or ``base``)
+    changes nothing and is skipped.
+    """
+    out = dict(bodies)
+    by_parent: dict[str, list[yourdfpy.Joint]] = {}
+    for j in side:
+        by_parent.setdefault(j.parent, []).append(j)
+    for anchor in chain_links:
+        # depth-first over the fixed subtrees hanging off this chain link
+        stack = [(j, sp.ImmutableMatrix(sp.eye(4))) for j in by_parent.get(anchor, [])]
+        while stack:
+            j, t_parent = stack.pop()
+            t = sp.ImmutableMatrix(t_parent * _fixed_transform(joint_xml[j.name],
+                                                                f"{name}: joint {j.name!r}"))
+            link = bodies[j.child]
+            if link.mass != 0 or link.inertia != sp.zeros(3):
+                out[anchor] = combine_links(out[anchor], link, t)
+            stack.extend((c, t) for c in by_parent.get(j.child, []))
+    return out
 
 
 def _origin(elem: Any, where: str) -> tuple[list[sp.Expr], list[sp.Expr]]:
