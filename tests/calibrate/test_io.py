@@ -67,7 +67,8 @@ def test_csv_errors_name_file_line_and_column(tmp_path):
         read_calibration_csv(_write(tmp_path, HEADER + "0,0,0,0,0,0,1,2,3\n0,0,0,0,0,0,1,abc,3\n"), r)
     with pytest.raises(ValueError, match=r"data.csv: line 2, column 'q3': nan is not a finite number"):
         read_calibration_csv(_write(tmp_path, HEADER + "0,0,nan,0,0,0,1,2,3\n"), r)
-    with pytest.raises(ValueError, match=r"data.csv: line 2: column 'z' is missing"):
+    with pytest.raises(ValueError, match=r"data.csv: line 2: 8 values, but the header \(line 1\) "
+                                         r"has 9 columns"):
         read_calibration_csv(_write(tmp_path, HEADER + "0,0,0,0,0,0,1,2\n"), r)
     with pytest.raises(ValueError, match="no data rows"):
         read_calibration_csv(_write(tmp_path, HEADER), r)

@@ -16,6 +16,7 @@ is.
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 from collections.abc import Sequence
@@ -25,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from robodyn.calibrate.result import Calibration
+from robodyn.robot.errors import DataFileError
 from robodyn.robot.model import Robot
 
 __all__ = ["CalibrationData", "read_calibration_csv", "read_table", "write_calibration"]
@@ -33,6 +35,10 @@ __all__ = ["CalibrationData", "read_calibration_csv", "read_table", "write_calib
 def read_table(path: str | Path, required: Sequence[str], *, optional: Sequence[str] = (),
                text_columns: Sequence[str] = ()) -> dict[str, list]:
     """Columns of a CSV file with a header row, as lists (numbers as floats).
+
+    The file is UTF-8 text (a leading byte-order mark is accepted); blank lines and lines starting
+    with ``#`` are skipped; every other line is one CSV record with exactly as many values as the
+    header has columns.
 
     Parameters
     ----------
@@ -44,49 +50,90 @@ def read_table(path: str | Path, required: Sequence[str], *, optional: Sequence[
     text_columns : sequence of str
         Columns kept as text.
 
+    Returns
+    -------
+    dict of str to list
+        One list per wanted column (required, then the optional ones present), one entry per
+        data row.
+
     Raises
     ------
-    FileNotFoundError, ValueError
-        Missing file, no header, a missing column, a short row, a value that is not a finite
-        number: the message names the file, the line and the column.
+    FileNotFoundError
+        No such file.
+    DataFileError
+        Not a UTF-8 text file, no header or no data rows, a missing or repeated column, a row
+        with more or fewer values than the header, a value that is not a finite number: the
+        message names the file, the line and the column.
     """
+    return _read_table(path, required, optional, text_columns)[0]
+
+
+def _read_table(path: str | Path, required: Sequence[str], optional: Sequence[str],
+                text_columns: Sequence[str]) -> tuple[dict[str, list], list[int]]:
+    """:func:`read_table` and the line number of each data row."""
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"{path}: no such file")
-    with path.open(newline="", encoding="utf-8") as fh:
-        lines = [(k + 1, line) for k, line in enumerate(fh)
-                 if line.strip() and not line.lstrip().startswith("#")]
+    lines = _records(path)
     if not lines:
-        raise ValueError(f"{path}: empty file (a header row and data rows are needed)")
-    rows = list(csv.reader([text for _, text in lines]))
-    header = [h.strip() for h in rows[0]]
+        raise DataFileError(f"{path}: empty file (a header row and data rows are needed)")
+    header_line, raw_header = lines[0]
+    header = [h.strip() for h in raw_header]
     where = {name: k for k, name in enumerate(header)}
+    repeated = sorted({h for h in header if h and header.count(h) > 1})
+    if repeated:
+        raise DataFileError(f"{path}: line {header_line}: column(s) {', '.join(repeated)} "
+                            "appear more than once in the header")
     missing = [c for c in required if c not in where]
     if missing:
-        raise ValueError(f"{path}: line {lines[0][0]}: missing column(s) {', '.join(missing)} "
-                         f"(the header has {', '.join(header)})")
-    if len(rows) < 2:
-        raise ValueError(f"{path}: no data rows after the header")
+        raise DataFileError(f"{path}: line {header_line}: missing column(s) "
+                            f"{', '.join(missing)} (the header has {', '.join(header)})")
+    if len(lines) < 2:
+        raise DataFileError(f"{path}: no data rows after the header")
     wanted = list(required) + [c for c in optional if c in where]
     out: dict[str, list] = {c: [] for c in wanted}
-    for (lineno, _), row in zip(lines[1:], rows[1:], strict=True):
+    for lineno, row in lines[1:]:
+        if len(row) != len(header):
+            # a value too many or too few shifts every column after it: never guess
+            raise DataFileError(f"{path}: line {lineno}: {len(row)} values, but the header "
+                                f"(line {header_line}) has {len(header)} columns")
         for c in wanted:
-            k = where[c]
-            if k >= len(row):
-                raise ValueError(f"{path}: line {lineno}: column {c!r} is missing ({len(row)} values, "
-                                 f"{len(header)} columns)")
-            text = row[k].strip()
+            text = row[where[c]].strip()
             if c in text_columns:
                 out[c].append(text)
                 continue
             try:
                 value = float(text)
             except ValueError:
-                raise ValueError(f"{path}: line {lineno}, column {c!r}: {text!r} is not a number") from None
+                raise DataFileError(f"{path}: line {lineno}, column {c!r}: {text[:40]!r} is not "
+                                    "a number") from None
             if not math.isfinite(value):
-                raise ValueError(f"{path}: line {lineno}, column {c!r}: {text} is not a finite number")
+                raise DataFileError(f"{path}: line {lineno}, column {c!r}: {text} is not a "
+                                    "finite number")
             out[c].append(value)
-    return out
+    return out, [lineno for lineno, _ in lines[1:]]
+
+
+def _records(path: Path) -> list[tuple[int, list[str]]]:
+    """(line number, CSV values) of each line that is not blank or a ``#`` comment."""
+    data = path.read_bytes()
+    if b"\0" in data:
+        raise DataFileError(f"{path}: a binary file (NUL bytes), not a CSV text file")
+    try:
+        text = data.decode("utf-8-sig")  # a byte-order mark some spreadsheets write is dropped
+    except UnicodeDecodeError as exc:
+        raise DataFileError(f"{path}: not a UTF-8 text file (byte {exc.start}: {exc.reason}); "
+                            "save it as UTF-8 CSV") from None
+    records = []
+    for k, line in enumerate(io.StringIO(text, newline=""), start=1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        try:
+            # one record per line: a quoted value may not span lines
+            records.append((k, next(csv.reader([line.rstrip("\r\n")], strict=True))))
+        except csv.Error as exc:
+            raise DataFileError(f"{path}: line {k}: not a CSV record ({exc})") from None
+    return records
 
 
 @dataclass(frozen=True, eq=False)
@@ -121,20 +168,22 @@ def _quaternion_matrix(w, x, y, z) -> np.ndarray:
 def read_calibration_csv(path: str | Path, robot: Robot) -> CalibrationData:
     """Read measured poses for ``robot`` from a calibration CSV (module docstring)."""
     joints = list(robot.joint_names)
-    table = read_table(path, joints + ["x", "y", "z"], optional=["qw", "qx", "qy", "qz", "sigma"])
+    table, lines = _read_table(path, joints + ["x", "y", "z"],
+                               ["qw", "qx", "qy", "qz", "sigma"], ())
     q = np.column_stack([table[j] for j in joints])
     points = np.column_stack([table[c] for c in ("x", "y", "z")])
     orientations = None
     quat = [c for c in ("qw", "qx", "qy", "qz") if c in table]
     if quat and len(quat) != 4:
-        raise ValueError(f"{path}: orientation needs all of qw, qx, qy, qz (found {', '.join(quat)})")
+        raise DataFileError(f"{path}: orientation needs all of qw, qx, qy, qz (found "
+                            f"{', '.join(quat)})")
     if quat:
         qq = np.column_stack([table[c] for c in ("qw", "qx", "qy", "qz")])
         norm = np.linalg.norm(qq, axis=1)
         bad = np.flatnonzero(np.abs(norm - 1) > 1e-3)
         if bad.size:
-            raise ValueError(f"{path}: data row {bad[0] + 1}: quaternion (qw, qx, qy, qz) has norm "
-                             f"{norm[bad[0]]:.6g}, not 1")
+            raise DataFileError(f"{path}: line {lines[bad[0]]}: quaternion (qw, qx, qy, qz) has "
+                                f"norm {norm[bad[0]]:.6g}, not 1")
         qq = qq / norm[:, None]
         orientations = _quaternion_matrix(*qq.T)
     sigma = None
@@ -142,7 +191,8 @@ def read_calibration_csv(path: str | Path, robot: Robot) -> CalibrationData:
         sigma = np.array(table["sigma"])
         bad = np.flatnonzero(~(sigma > 0))
         if bad.size:
-            raise ValueError(f"{path}: data row {bad[0] + 1}, column 'sigma': must be positive")
+            raise DataFileError(f"{path}: line {lines[bad[0]]}, column 'sigma': "
+                                f"{sigma[bad[0]]:g} is not positive")
     return CalibrationData(q, points, orientations, sigma, str(path))
 
 

@@ -260,6 +260,7 @@ def pose_characteristics_from_csv(path: str | Path) -> PoseCharacteristics:
     measurement; every pose needs the same number (>= 2) of cycles and one commanded position.
     """
     from robodyn.calibrate.io import read_table
+    from robodyn.robot.errors import DataFileError
 
     table = read_table(path, ["pose", "x_cmd", "y_cmd", "z_cmd", "x", "y", "z"], text_columns=("pose",))
     labels = list(dict.fromkeys(table["pose"]))
@@ -268,11 +269,11 @@ def pose_characteristics_from_csv(path: str | Path) -> PoseCharacteristics:
         rows = [k for k, v in enumerate(table["pose"]) if v == lab]
         c = np.column_stack([np.asarray(table[k])[rows] for k in ("x_cmd", "y_cmd", "z_cmd")])
         if np.ptp(c, axis=0).max() > 0:
-            raise ValueError(f"{path}: pose {lab!r} has more than one commanded position")
+            raise DataFileError(f"{path}: pose {lab!r} has more than one commanded position")
         cmd.append(c[0])
         att.append(np.column_stack([np.asarray(table[k])[rows] for k in ("x", "y", "z")]))
     counts = {len(a) for a in att}
     if len(counts) != 1:
-        raise ValueError(f"{path}: poses have different numbers of cycles ({sorted(counts)})")
+        raise DataFileError(f"{path}: poses have different numbers of cycles ({sorted(counts)})")
     return pose_characteristics(np.array(cmd), np.array(att), labels=labels)
 
