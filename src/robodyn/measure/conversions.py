@@ -1,0 +1,109 @@
+"""Sensor conversions: encoder counters, current transducers, torque from current, sample period.
+
+Each function takes raw (N, n) columns and per-joint (n,) constants and returns new arrays (the
+input is never modified).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["counts_to_angle", "current_to_torque", "estimate_period", "unwrap_counter",
+           "volts_to_current"]
+
+
+def unwrap_counter(counts: np.ndarray, bits: int) -> np.ndarray:
+    """Undo the wrap-around of an unsigned ``bits``-bit counter.
+
+    Parameters
+    ----------
+    counts : (N,) or (N, n) ndarray
+        Raw counter readings in ``[0, 2**bits)``.
+    bits : int
+        Counter width (e.g. 24).
+
+    Returns
+    -------
+    (N,) or (N, n) ndarray
+        Continuous counts: a step larger than half the range between two samples is taken as a
+        wrap (the counter must move less than ``2**(bits-1)`` counts per sample).
+    """
+    c = np.asarray(counts, dtype=float)
+    span = float(2**bits)
+    step = np.diff(c, axis=0)
+    # each jump beyond half the range is a wrap: subtract the nearest whole number of spans
+    step -= span * np.round(step / span)
+    return np.concatenate([c[:1], c[:1] + np.cumsum(step, axis=0)], axis=0)
+
+
+def counts_to_angle(counts: np.ndarray, counts_per_rev: np.ndarray, gear_ratio: np.ndarray
+                    ) -> np.ndarray:
+    """Joint angle, rad, from motor-encoder counts: ``2 pi counts / (counts_per_rev gear_ratio)``.
+
+    Parameters
+    ----------
+    counts : (N, n) ndarray
+        (Unwrapped) motor counts.
+    counts_per_rev, gear_ratio : (n,) ndarray
+        Counts per motor revolution; motor turns per joint turn.
+    """
+    return 2.0 * np.pi * np.asarray(counts, dtype=float) / (counts_per_rev * gear_ratio)
+
+
+def volts_to_current(volts: np.ndarray, offset: np.ndarray, gain: np.ndarray) -> np.ndarray:
+    """Motor current, A, from a Hall-effect transducer: ``I = (V - offset) / gain``.
+
+    Parameters
+    ----------
+    volts : (N, n) ndarray
+        Transducer output, V.
+    offset : (n,) ndarray
+        Output at zero current, V.
+    gain : (n,) ndarray
+        Transducer gain, V/A.
+    """
+    return (np.asarray(volts, dtype=float) - offset) / gain
+
+
+def current_to_torque(current: np.ndarray, gear_ratio: np.ndarray, torque_constant: np.ndarray
+                      ) -> np.ndarray:
+    """Joint torque, N m, from motor current: ``tau = gear_ratio k_t I`` (losses not included).
+
+    Parameters
+    ----------
+    current : (N, n) ndarray
+        Motor current, A.
+    gear_ratio : (n,) ndarray
+        Motor turns per joint turn.
+    torque_constant : (n,) ndarray
+        Motor torque constant k_t, N m/A.
+    """
+    return np.asarray(current, dtype=float) * (gear_ratio * torque_constant)
+
+
+def estimate_period(q: np.ndarray, qd: np.ndarray) -> float:
+    """Sample period, s, of a log whose time column is only a sample index.
+
+    The positions must advance by the measured velocity times the period; the least-squares
+    period over all joints and samples is
+    ``T = sum(dq_k vbar_k) / sum(vbar_k^2)`` with ``dq_k = q_{k+1} - q_k`` and ``vbar_k`` the
+    mean of the velocities at both ends of the step (trapezoidal rule).
+
+    Parameters
+    ----------
+    q : (N, n) ndarray
+        Positions, rad.
+    qd : (N, n) ndarray
+        Measured velocities, rad/s.
+
+    Returns
+    -------
+    float
+        T, s; raises ValueError when the arm did not move.
+    """
+    dq = np.diff(q, axis=0)
+    vbar = 0.5 * (qd[1:] + qd[:-1])  # trapezoidal rule: dq = T (v_k + v_k+1) / 2
+    den = float(np.sum(vbar * vbar))
+    if den <= 0.0:
+        raise ValueError("cannot estimate the sample period: the measured velocity is zero throughout")
+    return float(np.sum(dq * vbar)) / den

@@ -1,0 +1,361 @@
+"""CSV/TSV recordings (optionally gzip-compressed): reading through a spec, robodyn's own layout.
+
+Reading checks the file before trusting it: every row must have as many fields as the header
+(or the first row), every used cell must be a finite number, and the time column must increase;
+each error names the file, the column and the spec field that asked for it, and the 1-based line
+of the file. The numbers themselves are parsed by ``pandas.read_csv``.
+
+robodyn's own layout (written by :func:`write_csv`, read with ``spec=None``): a header
+``t, q[NAME]..., qd[NAME]..., qdd[NAME]..., tau[NAME]..., current[NAME]..., temperature[NAME]...,
+tool_t, tool_x, tool_y, tool_z`` in SI units with only the fields that were measured (estimated
+ones are estimated again on reading); tool samples fill the first M rows of their columns, the
+rest of those cells are empty. Numbers are written with 17 significant digits, so a round trip
+is exact.
+"""
+
+from __future__ import annotations
+
+import gzip
+import io
+import re
+from os import PathLike
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from robodyn.measure.conversions import (
+    counts_to_angle,
+    current_to_torque,
+    estimate_period,
+    unwrap_counter,
+    volts_to_current,
+)
+from robodyn.measure.recording import JOINT_FIELDS, Recording
+from robodyn.measure.spec import (
+    CURRENT_UNITS,
+    POSITION_UNITS,
+    TIME_UNITS,
+    TORQUE_UNITS,
+    VELOCITY_UNITS,
+    Channel,
+    RecordingSpec,
+    load_spec,
+)
+from robodyn.robot.errors import RecordingError
+
+__all__ = ["read_csv", "write_csv"]
+
+_NATIVE = re.compile(r"^(q|qd|qdd|tau|current|temperature)\[(.+)\]$")
+_TOOL = ("tool_t", "tool_x", "tool_y", "tool_z")
+
+
+# ----------------------------------------------------------------------------------------------
+# the table: lines, field counts, numbers
+# ----------------------------------------------------------------------------------------------
+
+
+class _Table:
+    """The data rows of a delimited text file, with the file's line number of every row."""
+
+    def __init__(self, path: Path, delimiter: str | None, header: bool, comment: str | None):
+        self.name = path.name
+        raw = path.read_bytes()
+        if path.suffix.lower() == ".gz":
+            try:
+                raw = gzip.decompress(raw)
+            except (OSError, EOFError) as exc:
+                raise RecordingError(f"{self.name}: not a readable gzip file ({exc})") from None
+        try:
+            text = raw.decode("utf-8-sig")
+        except UnicodeDecodeError as exc:
+            raise RecordingError(f"{self.name}: not UTF-8 text (byte {exc.start})") from None
+        lines = text.splitlines()
+        keep = [k for k, line in enumerate(lines)
+                if line.strip() and not (comment and line.lstrip().startswith(comment))]
+        if not keep:
+            raise RecordingError(f"{self.name}: empty file (no header and no data rows)")
+        if delimiter is None:
+            delimiter = "\t" if ".tsv" in [s.lower() for s in path.suffixes] else ","
+        if header and len(keep) == 1:
+            raise RecordingError(f"{self.name}: header only, no data rows (line {keep[0] + 1})")
+        kept = [lines[k] for k in keep]
+        # every row has as many fields as the first (header) row
+        if '"' not in text:
+            counts = np.fromiter((line.count(delimiter) for line in kept), dtype=np.int64,
+                                 count=len(kept))
+            bad = np.nonzero(counts != counts[0])[0]
+            if bad.size:
+                k = int(bad[0])
+                first = "header" if header else "first row"
+                raise RecordingError(f"{self.name}: line {keep[k] + 1}: {counts[k] + 1} fields, but the "
+                                     f"{first} (line {keep[0] + 1}) has {counts[0] + 1}")
+        try:
+            frame = pd.read_csv(io.StringIO("\n".join(kept)), sep=delimiter,
+                                header=0 if header else None, skip_blank_lines=False,
+                                engine="c", low_memory=False)
+        except (pd.errors.ParserError, ValueError) as exc:
+            raise RecordingError(f"{self.name}: cannot parse as delimited text "
+                                 f"({' '.join(str(exc).split())})") from None
+        self.frame = frame
+        self.line = np.asarray(keep[1:] if header else keep) + 1  # 1-based line of each row
+        self.header = header
+        self.columns = [str(c) for c in frame.columns] if header else list(range(frame.shape[1]))
+
+    def has(self, column: str | int) -> bool:
+        if isinstance(column, int):
+            return column < self.frame.shape[1]
+        return self.header and column in self.columns
+
+    def _label(self, column: str | int) -> str:
+        return f"column {column!r}" if isinstance(column, str) else f"column {column} (0-based)"
+
+    def column(self, column: str | int, field: str, allow_empty: bool = False) -> np.ndarray:
+        """Column as floats; missing, non-numeric and non-finite cells are errors."""
+        if not self.has(column):
+            if isinstance(column, int):
+                why = f"the file has {self.frame.shape[1]} columns"
+            elif not self.header:
+                why = "the spec says header: false, so columns are 0-based indices"
+            else:
+                shown = ", ".join(self.columns[:12]) + (", ..." if len(self.columns) > 12 else "")
+                why = f"the file's columns: {shown}"
+            raise RecordingError(f"{self.name}: {field}: {self._label(column)} not in the file ({why})")
+        series = self.frame.iloc[:, column] if isinstance(column, int) else self.frame[column]
+        values = pd.to_numeric(series, errors="coerce").to_numpy(dtype=float)
+        bad = ~np.isfinite(values)
+        if allow_empty:
+            bad &= series.notna().to_numpy()
+        if bad.any():
+            k = int(np.argmax(bad))
+            cell = series.iloc[k]
+            reason = "empty cell" if pd.isna(cell) else (
+                f"{cell!r} is not a number" if isinstance(cell, str) else f"{cell} (not finite)")
+            raise RecordingError(f"{self.name}: {self._label(column)} ({field}): {reason} at line "
+                                 f"{self.line[k]} ({int(bad.sum())} bad cell(s) in this column)")
+        return values
+
+
+# ----------------------------------------------------------------------------------------------
+# reading through a spec
+# ----------------------------------------------------------------------------------------------
+
+
+def _block(table: _Table, ch: Channel) -> np.ndarray:
+    assert ch.columns is not None
+    return np.column_stack([table.column(c, f"{ch.field}.columns[{k}]")
+                            for k, c in enumerate(ch.columns)])
+
+
+def _no_sensor(values: np.ndarray, ch: Channel) -> np.ndarray:
+    """All-zero columns become NaN (joint without that sensor) when the spec says missing: zero."""
+    if ch.missing == "zero":
+        values = values.copy()
+        values[:, np.all(values == 0.0, axis=0)] = np.nan
+    return values
+
+
+def _position(table: _Table, ch: Channel) -> np.ndarray:
+    raw = _block(table, ch)
+    if ch.unit == "counts":
+        if ch.wrap_bits is not None:
+            raw = unwrap_counter(raw, ch.wrap_bits)
+        value = counts_to_angle(raw, ch.counts_per_rev, ch.gear_ratio)
+    else:
+        value = raw * POSITION_UNITS[ch.unit] / ch.gear_ratio
+    return ch.sign * value + ch.offset  # joint = sign * converted + offset
+
+
+def _velocity(table: _Table, ch: Channel) -> np.ndarray:
+    raw = _block(table, ch)
+    if ch.unit == "counts/s":
+        value = counts_to_angle(raw, ch.counts_per_rev, ch.gear_ratio)
+    else:
+        value = raw * VELOCITY_UNITS[ch.unit] / ch.gear_ratio
+    return ch.sign * value
+
+
+def _current(table: _Table, ch: Channel) -> np.ndarray:
+    raw = _block(table, ch)
+    if ch.unit == "V":
+        value = volts_to_current(raw, ch.offset, ch.gain)  # I = (V - offset) / gain
+    else:
+        value = raw * CURRENT_UNITS[ch.unit] - ch.offset
+    return _no_sensor(ch.sign * value, ch)
+
+
+def _time(table: _Table, spec: RecordingSpec) -> np.ndarray:
+    raw = table.column(spec.time_column, "time.column")
+    steps = np.diff(raw)
+    if np.any(steps <= 0):
+        k = int(np.argmax(steps <= 0)) + 1
+        raise RecordingError(f"{table.name}: {table._label(spec.time_column)} (time.column): not "
+                             f"strictly increasing at line {table.line[k]} ({raw[k]:.9g} after "
+                             f"{raw[k - 1]:.9g} on line {table.line[k - 1]})")
+    return raw
+
+
+def read_csv(path: str | PathLike[str], spec: Any = None, robot: Any = None) -> Recording:
+    """Read a CSV/TSV recording (``.gz`` decompressed) through a recording spec.
+
+    Parameters
+    ----------
+    path : str or path
+        The file; it is only read.
+    spec : str, path or mapping, optional
+        Built-in spec name, YAML file or dict (:func:`robodyn.measure.spec.load_spec`); None for
+        robodyn's own layout (:func:`write_csv`).
+    robot : Robot, optional
+        Joints are matched by name and returned in the robot's chain order.
+
+    Returns
+    -------
+    Recording
+        SI units; positions after unwrapping, scaling, gear ratio, sign, offset and couplings.
+    """
+    p = Path(path)
+    if spec is None:
+        return _select_robot(_read_native(p), robot)
+    sp = load_spec(spec)
+    table = _Table(p, sp.delimiter, sp.header, sp.comment)
+    ch = sp.channels
+    raw_t = _time(table, sp)
+    q = _position(table, ch["position"])
+    qd = _velocity(table, ch["velocity"]) if "velocity" in ch else None
+    coupling = sp.coupling_matrix()
+    if sp.couplings:
+        q = q @ coupling.T  # q_true = C q_measured, row by row
+        qd = None if qd is None else qd @ coupling.T
+    units = {}
+    if sp.time_unit == "index":
+        if sp.period == "estimate":
+            period = estimate_period(q, qd)
+            units["sample_period"] = (f"{period:.6g} s, estimated from position increments "
+                                      "against measured velocity")
+        else:
+            period = float(sp.period)
+        t = (raw_t - raw_t[0]) * period
+    else:
+        t = raw_t * TIME_UNITS[sp.time_unit]
+    current = _current(table, ch["current"]) if "current" in ch else None
+    tau = None
+    if "torque" in ch:
+        tc = ch["torque"]
+        if tc.columns is None:
+            tau = current_to_torque(current, tc.gear_ratio, tc.torque_constant) * tc.sign
+        else:
+            tau = _no_sensor(tc.sign * _block(table, tc) * TORQUE_UNITS[tc.unit], tc)
+    temperature = _no_sensor(_block(table, ch["temperature"]), ch["temperature"]) \
+        if "temperature" in ch else None
+    tau, current, temperature = (None if a is None or np.isnan(a).all() else a
+                                 for a in (tau, current, temperature))
+    rec = Recording(t=t, q=q, qd=qd, tau=tau, current=current, temperature=temperature,
+                    joint_names=sp.joint_names, units=units, source=p.name)
+    return _select_robot(rec, robot)
+
+
+def _select_robot(rec: Recording, robot: Any) -> Recording:
+    if robot is None:
+        return rec
+    wanted = tuple(robot.joint_names)
+    missing = [j for j in wanted if j not in rec.joint_names]
+    if missing:
+        raise RecordingError(f"{rec.source}: joint names {list(rec.joint_names)} do not match the "
+                             f"robot {robot.name!r} ({list(wanted)}): missing {missing}")
+    return rec.select(list(wanted))
+
+
+# ----------------------------------------------------------------------------------------------
+# robodyn's own layout
+# ----------------------------------------------------------------------------------------------
+
+
+def _read_native(p: Path) -> Recording:
+    table = _Table(p, None, True, "#")
+    if not table.columns or table.columns[0] != "t":
+        raise RecordingError(f"{p.name}: spec: the file is not in robodyn's own layout (first column "
+                             f"'t', then 'q[NAME]', ...); pass spec= (a built-in name, a YAML file "
+                             f"or a dict) to say which columns hold what")
+    fields: dict[str, list[str]] = {}
+    for c in table.columns[1:]:
+        m = _NATIVE.match(c)
+        if m:
+            fields.setdefault(m.group(1), []).append(m.group(2))
+        elif c not in _TOOL:
+            raise RecordingError(f"{p.name}: column {c!r}: not a column of robodyn's layout "
+                                 "(t, q[NAME], qd[NAME], ..., tool_t, tool_x, tool_y, tool_z)")
+    names = fields.get("q")
+    if not names:
+        raise RecordingError(f"{p.name}: no q[NAME] columns (joint positions are required)")
+    t_all = table.column("t", "t", allow_empty=True)
+    n = int(np.argmax(np.isnan(t_all))) if np.isnan(t_all).any() else t_all.size
+    if not np.isnan(t_all[n:]).all():
+        raise RecordingError(f"{p.name}: column 't': empty cell at line {table.line[n]}")
+    arrays: dict[str, Any] = {}
+    for field, cols in fields.items():
+        if cols != names:
+            raise RecordingError(f"{p.name}: {field}[...] columns name the joints {cols}, but the "
+                                 f"q[...] columns name {names}")
+        block = np.column_stack([table.column(f"{field}[{j}]", field, allow_empty=True)
+                                 for j in names])
+        head = block[:n]
+        # empty cells: allowed below the last joint sample, and as a whole sensor column
+        bad = np.isnan(head)
+        if field in ("tau", "current", "temperature"):
+            bad &= ~np.all(bad, axis=0)
+        if bad.any():
+            r, c = np.argwhere(bad)[0]
+            raise RecordingError(f"{p.name}: column '{field}[{names[c]}]': empty cell at line "
+                                 f"{table.line[r]}")
+        arrays[field] = head
+    tool: dict[str, Any] = {}
+    if "tool_t" in table.columns:
+        cols = [table.column(c, c, allow_empty=True) for c in _TOOL]
+        m = int(np.sum(~np.isnan(cols[0])))
+        for c, v in zip(_TOOL, cols, strict=True):
+            if np.isnan(v[:m]).any() or not np.isnan(v[m:]).all():
+                k = int(np.argmax(np.isnan(v[:m]))) if np.isnan(v[:m]).any() else m
+                raise RecordingError(f"{p.name}: column {c!r}: the tool samples must fill the first "
+                                     f"rows without gaps (line {table.line[min(k, len(v) - 1)]})")
+        tool = {"tool_t": cols[0][:m], "tool_points": np.column_stack(cols[1:])[:m]}
+    return Recording(t=t_all[:n], joint_names=tuple(names), source=p.name, **arrays, **tool)
+
+
+def write_csv(rec: Recording, path: str | PathLike[str]) -> Path:
+    """Write a recording in robodyn's own CSV layout (gzip-compressed when the name ends in .gz).
+
+    Only measured fields are written (those in ``rec.estimated`` are estimated again when the file
+    is read), with 17 significant digits so that :func:`read_csv` returns the same numbers.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    p = Path(path)
+    n_rows = max(rec.n_samples, 0 if rec.tool_t is None else rec.tool_t.size)
+    cols: dict[str, np.ndarray] = {}
+
+    def pad(v: np.ndarray) -> np.ndarray:
+        out = np.full(n_rows, np.nan)
+        out[: v.size] = v
+        return out
+
+    cols["t"] = pad(rec.t)
+    for field in JOINT_FIELDS:
+        value = getattr(rec, field)
+        if value is None or field in rec.estimated:
+            continue
+        for k, name in enumerate(rec.joint_names):
+            cols[f"{field}[{name}]"] = pad(value[:, k])
+    if rec.tool_t is not None:
+        cols["tool_t"] = pad(rec.tool_t)
+        for k, axis in enumerate("xyz"):
+            cols[f"tool_{axis}"] = pad(rec.tool_points[:, k])
+    text = pd.DataFrame(cols).to_csv(index=False, float_format="%.17g", na_rep="")
+    data = text.encode("utf-8")
+    if p.suffix.lower() == ".gz":
+        data = gzip.compress(data, mtime=0)
+    p.write_bytes(data)
+    return p
