@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 import robodyn as rd
+from robodyn.output_names import check_stem, output_path
 from robodyn.report.text import err, progress, table
 
 __all__ = ["add_parsers"]
@@ -74,8 +75,9 @@ def _controller(args: argparse.Namespace, model: rd.Model, q0: np.ndarray):
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from robodyn.simulate.plots import trajectory_figure
 
-    robot = rd.load(args.robot)
+    robot = rd.load(args.robot, tool=args.tool)
     n = robot.dof
+    csv_path = output_path(args.output, robot.name, "_simulation.csv", what="robot name")
     q0 = _vector(args.q0, n, "--q0")
     qd0 = _vector(args.qd0, n, "--qd0")
     out = Path(args.output)
@@ -88,7 +90,6 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         sim = rd.simulate(model, q0, qd0, args.duration, args.dt, method=args.method,
                           controller=controller, tau_limit=limit, control=args.control)
     names = robot.joint_names
-    csv_path = out / f"{robot.name}_simulation.csv"
     with csv_path.open("w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(["t", *(f"q_{j}" for j in names), *(f"qd_{j}" for j in names),
@@ -97,7 +98,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             w.writerow([repr(float(v)) for v in (sim.t[k], *sim.q[k], *sim.qd[k], *sim.qdd[k],
                                                  *sim.tau[k], sim.energy[k])])
     with progress("plotting"):
-        fig = trajectory_figure(sim, names, out / f"{robot.name}_simulation.png", plan)
+        fig = trajectory_figure(sim, names, output_path(out, robot.name, "_simulation.png"), plan)
     rows = [[j, f"{sim.q[-1, k]:.6g}", f"{np.abs(sim.qd[:, k]).max():.4g}",
              f"{np.abs(sim.tau[:, k]).max():.4g}"] for k, j in enumerate(names)]
     headers = ["joint", "final q", "max |qd|", "max |tau|"]
@@ -124,7 +125,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     from robodyn.calibrate.pipeline import validate
     from robodyn.report.calibration_report import calibration_html
 
-    robot = rd.load(args.robot)
+    robot = rd.load(args.robot, tool=args.tool)
+    stem = check_stem(args.stem) if args.stem is not None else f"{robot.name}_calibrated"
     data = read_calibration_csv(args.data, robot)
     circle = None
     if args.circle:
@@ -145,9 +147,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         held = read_calibration_csv(args.validate, robot)
         stats = validate(cal, held.q, held.points)
         validation = (Path(args.validate).name, held.points - cal.predict(held.q))
-    stem = args.stem or f"{robot.name}_calibrated"
     paths = write_calibration(cal, args.output, stem=stem)
-    paths["html"] = calibration_html(cal, Path(args.output) / f"{stem}_report.html",
+    paths["html"] = calibration_html(cal, output_path(args.output, stem, "_report.html"),
                                      source=str(args.data), validation=validation)
     print(cal.summary())
     if validation is not None:

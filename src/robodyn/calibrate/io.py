@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from robodyn.calibrate.result import Calibration
+from robodyn.output_names import output_path
 from robodyn.robot.errors import DataFileError
 from robodyn.robot.model import Robot
 
@@ -244,17 +245,27 @@ def write_calibration(cal: Calibration, out_dir: str | Path, *,
     dict
         Paths by kind (``"yaml"``, ``"urdf"``, ``"report"``, ``"json"``, ``"residuals"``); ``"urdf"``
         is None when no URDF writer is available (``"note"`` then says so).
+
+    Raises
+    ------
+    ValueError
+        ``stem`` is not a plain file name (a path separator, ``..``): nothing is written outside
+        ``out_dir``.
     """
     from robodyn.robot.yaml_writer import dump_yaml
 
     out = Path(out_dir)
+    stem = stem if stem is not None else cal.robot.name
+    # every name is checked before anything is written: all files inside out_dir, or none
+    names = {kind: output_path(out, stem, suffix)
+             for kind, suffix in (("yaml", ".yaml"), ("urdf", ".urdf"), ("report", "_report.txt"),
+                                  ("json", "_report.json"), ("residuals", "_residuals.csv"))}
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OSError(f"{out}: cannot create the output directory: {exc}") from None
-    stem = stem or cal.robot.name
     paths: dict[str, Path | None] = {}
-    paths["yaml"] = out / f"{stem}.yaml"
+    paths["yaml"] = names["yaml"]
     paths["yaml"].write_text(dump_yaml(cal.robot), encoding="utf-8")
     try:
         from robodyn.export.urdf import to_urdf
@@ -265,18 +276,18 @@ def write_calibration(cal: Calibration, out_dir: str | Path, *,
 
         from robodyn.robot.errors import DescriptionWarning
 
-        paths["urdf"] = out / f"{stem}.urdf"
+        paths["urdf"] = names["urdf"]
         with warnings.catch_warnings():
             # drive data and gravity direction are kept in the YAML; URDF cannot hold them
             warnings.simplefilter("ignore", DescriptionWarning)
             to_urdf(cal.robot, paths["urdf"])
     else:
         paths["urdf"] = None  # no URDF exporter in this installation: YAML only
-    paths["report"] = out / f"{stem}_report.txt"
+    paths["report"] = names["report"]
     paths["report"].write_text(cal.summary() + "\n", encoding="utf-8")
-    paths["json"] = out / f"{stem}_report.json"
+    paths["json"] = names["json"]
     paths["json"].write_text(json.dumps(_report_data(cal), indent=1) + "\n", encoding="utf-8")
-    paths["residuals"] = out / f"{stem}_residuals.csv"
+    paths["residuals"] = names["residuals"]
     with paths["residuals"].open("w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(["pose", "dx", "dy", "dz", "distance"])
