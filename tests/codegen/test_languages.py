@@ -6,7 +6,9 @@ states and compared with ``rd.compile_model(robot, backend="numpy")`` to 1e-10 r
 difference divided by max(1, the largest reference entry)). Julia cannot be installed here and
 Simulink does not exist for Octave: those files are checked structurally, the Julia kernels also
 by evaluating a transliteration of their text, the S-function also through a stand-in for the
-Simulink block object in Octave. Missing tools skip their tests (CI installs them all).
+Simulink block object in Octave. A missing tool skips only the tests that need it (marked
+``@pytest.mark.tool``); CI installs them all and sets ROBODYN_REQUIRE_ALL=1, which turns those skips
+into failures.
 """
 
 from __future__ import annotations
@@ -203,7 +205,7 @@ def _call_library(ffi, lib, b: Bundle, prefix: str) -> tuple[dict, dict]:
     return single, batch
 
 
-@pytest.mark.skipif(GCC is None, reason="no C compiler")
+@pytest.mark.tool("gcc|cc")
 def test_c_library_matches_numpy(bundle):
     bundle.wait("c_lib")
     ffi, lib = _load(bundle.dir("c") / f"lib{bundle.name}_c.so", bundle.kset, f"{bundle.name}_")
@@ -212,7 +214,7 @@ def test_c_library_matches_numpy(bundle):
     _check_all(batch, bundle, "C (batch)")
 
 
-@pytest.mark.skipif(GCC is None, reason="no C compiler")
+@pytest.mark.tool("gcc|cc")
 def test_c_simulator_matches_compiled_model(bundle):
     bundle.wait("c_sim")
     n = bundle.kset.dof
@@ -254,7 +256,7 @@ def test_fortran_lines_and_literals(bundle):
         assert f"subroutine {bundle.name}_{k}_batch(count" in text
 
 
-@pytest.mark.skipif(GFORTRAN is None, reason="gfortran not installed")
+@pytest.mark.tool("gfortran")
 def test_fortran_matches_numpy(bundle):
     bundle.wait("fortran")
     ffi, lib = _load(bundle.dir("fortran") / f"lib{bundle.name}_f.so", bundle.kset, f"{bundle.name}_")
@@ -353,8 +355,7 @@ class OctaveRun:
 
 @pytest.fixture(scope="module")
 def octave_run(bundle) -> OctaveRun:
-    if OCTAVE is None:
-        pytest.skip("octave-cli not installed")
+    assert OCTAVE is not None, "a test using octave_run needs @pytest.mark.tool('octave-cli')"
     work = bundle.dir("octave")
     with_mex = MKOCTFILE is not None
     if with_mex:
@@ -380,6 +381,7 @@ def _sizes(run: OctaveRun) -> dict[str, str]:
     return dict(line.split(" ", 1) for line in (run.directory / "sizes.txt").read_text().splitlines())
 
 
+@pytest.mark.tool("octave-cli")
 def test_octave_m_files_match_numpy(bundle, octave_run):
     results, single = {}, {}
     sizes = _sizes(octave_run)
@@ -396,12 +398,13 @@ def test_octave_m_files_match_numpy(bundle, octave_run):
     assert max(errors.values()) <= REL, errors
 
 
+@pytest.mark.tool("octave-cli")
 def test_octave_m_files_reject_bad_input(bundle, octave_run):
     ids = (octave_run.directory / "error_ids.txt").read_text().splitlines()
     assert ids[:3] == ["robodyn:size", "robodyn:nargin", "robodyn:size"]
 
 
-@pytest.mark.skipif(MKOCTFILE is None, reason="mkoctfile not installed")
+@pytest.mark.tool("octave-cli", "mkoctfile")
 def test_mex_matches_numpy(bundle, octave_run):
     results = {k.name: _read_batch(octave_run.directory / f"mex_{k.name}.csv", k.outputs[0].shape)
                for k in bundle.kset.kernels}
@@ -412,14 +415,14 @@ def test_mex_matches_numpy(bundle, octave_run):
         assert sizes[f"mex_{kernel.name}"] == f"[{shape[0]} {shape[1] if len(shape) == 2 else 1}]"
 
 
-@pytest.mark.skipif(MKOCTFILE is None, reason="mkoctfile not installed")
+@pytest.mark.tool("octave-cli", "mkoctfile")
 def test_mex_rejects_bad_input(bundle, octave_run):
     ids = (octave_run.directory / "error_ids.txt").read_text().splitlines()
     assert ids[3:8] == ["robodyn:mex:size", "robodyn:mex:nargin", "robodyn:mex:kernel",
                         "robodyn:mex:type", "robodyn:mex:size"]
 
 
-@pytest.mark.skipif(MKOCTFILE is None, reason="mkoctfile not installed")
+@pytest.mark.tool("octave-cli", "mkoctfile")
 def test_sfunction_through_stand_in_block(bundle, octave_run):
     n = bundle.kset.dof
     assert _sizes(octave_run)["sfun"] == f"1 1 2 {2 * n} {n} {n}"
@@ -564,7 +567,7 @@ def test_latex_document_structure(bundle):
         assert line.count(r"\left") == line.count(r"\right"), line
 
 
-@pytest.mark.skipif(PDFLATEX is None, reason="pdflatex not installed")
+@pytest.mark.tool("pdflatex")
 def test_latex_document_compiles(bundle):
     work = bundle.dir("latex")
     proc = subprocess.run([PDFLATEX, "-interaction=nonstopmode", "-halt-on-error", f"{bundle.name}.tex"],

@@ -13,18 +13,16 @@ import sympy as sp
 import yaml
 
 from robodyn import spatial as S
-from robodyn.robot import placement
+from robodyn.robot import placement, yaml_loader
 from robodyn.robot.chain import ChainElement, assemble
 from robodyn.robot.errors import DescriptionWarning
 from robodyn.robot.model import Drive, Friction, Link, Robot
 from robodyn.robot.yaml_writer import dump_yaml, matrix_to_rpy
 
-yaml_loader = pytest.importorskip("robodyn.robot.yaml_loader")
-
 ROOT = Path(__file__).resolve().parents[2]
 GEN3 = ROOT.parent / "shared" / "data" / "kinova-gen3" / "gen3.urdf"
 LIBRARY = ROOT / "src" / "robodyn" / "robot" / "library"
-needs_gen3 = pytest.mark.skipif(not GEN3.exists(), reason="kinova-gen3 data not available")
+needs_gen3 = pytest.mark.data(GEN3)
 
 
 def reload(robot: Robot) -> Robot:
@@ -164,10 +162,8 @@ def test_random_robots_round_trip(seed: int) -> None:
 
 
 def test_puma560_round_trip() -> None:
-    from robodyn.robot.load import builtin_names, load
+    from robodyn.robot.load import load
 
-    if "puma560" not in builtin_names():
-        pytest.skip("puma560 is not built in")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DescriptionWarning)
         robot = load("puma560")

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.linalg import solve_continuous_are
 
 from robodyn.simulate import (
     LQR,
@@ -166,11 +165,16 @@ def test_linearisation_matches_finite_differences(trolley, puma):
 def test_lqr_balances_the_trolley_double_inverted_pendulum(trolley, tmp_path):
     q_w = np.diag([10.0, 100.0, 100.0, 1.0, 10.0, 10.0])
     lqr = LQR.about(trolley, np.zeros(3), q_w, 1.0, actuated=[0])
-    # Riccati residual and stable closed loop
-    lin = lqr.linearization
+    # Riccati residual A^T P + P A - P B R^-1 B^T P + Q = 0 (R = 1), relative to its largest term,
+    # P symmetric positive definite, K = R^-1 B^T P on the actuated joint, stable closed loop
+    lin, p = lqr.linearization, lqr.P
     b = lin.B[:, [0]]
-    p = solve_continuous_are(lin.A, b, q_w, np.eye(1))
-    np.testing.assert_allclose(lqr.P, p)
+    terms = (lin.A.T @ p, p @ lin.A, p @ b @ b.T @ p, q_w)
+    residual = terms[0] + terms[1] - terms[2] + terms[3]
+    assert np.abs(residual).max() < 1e-9 * max(np.abs(term).max() for term in terms)
+    np.testing.assert_allclose(p, p.T, rtol=0, atol=1e-12 * np.abs(p).max())
+    assert np.linalg.eigvalsh(p).min() > 0
+    np.testing.assert_allclose(lqr.K[0], (b.T @ p).ravel(), rtol=1e-12, atol=0)
     assert np.all(lqr.closed_loop_poles.real < 0)
     assert np.all(lqr.K[1:] == 0)  # only the trolley pushes
     # perturbed start: rod 1 tilted 0.1 rad, rod 2 bent back 0.05 rad

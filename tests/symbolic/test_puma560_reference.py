@@ -32,8 +32,10 @@ def test_inertia_matrix_first_row_at_qn_matches_published_values():
     np.testing.assert_allclose(m[0], [3.6594, -0.4044, 0.1006, -0.0025, 0, 0], atol=5e-5)
 
 
+@pytest.mark.oracle("roboticstoolbox")
 def test_full_inverse_dynamics_matches_robotics_toolbox_rne():
-    rtb = pytest.importorskip("roboticstoolbox")
+    import roboticstoolbox as rtb
+
     p560 = rtb.models.DH.Puma560()
     eom = puma()
     f_tau, f_m, f_c = evaluator(eom, eom.tau), evaluator(eom, eom.M), evaluator(eom, eom.C)
