@@ -20,6 +20,7 @@ from pathlib import Path
 import sympy as sp
 
 import robodyn as rd
+from robodyn.cli_cache import add_cache_parser
 from robodyn.cli_workflows import add_parsers
 from robodyn.report.agreement import (
     AGREEMENT_HEADERS,
@@ -67,6 +68,11 @@ def _transform(mat: sp.MatrixBase) -> str:
     return "; ".join(" ".join(_fmt(mat[r, c]) for c in range(4)) for r in range(3))
 
 
+def _load(args: argparse.Namespace) -> rd.Robot:
+    """The ROBOT argument, its tool frame at the ``--tool`` link of a URDF file when given."""
+    return rd.load(args.robot, tool=args.tool)
+
+
 def _write(text: str, target: str | None) -> None:
     if target is None or target == "-":
         sys.stdout.write(text)
@@ -92,7 +98,7 @@ def _cmd_list(args: argparse.Namespace) -> int:
 
 
 def _cmd_show(args: argparse.Namespace) -> int:
-    robot = rd.load(args.robot)
+    robot = _load(args)
     print(f"robot {robot.name}: {robot.dof} joints ({_types(robot)})")
     print(f"source: {robot.source}")
     print(f"description sha256: {robot.description_hash}\n")
@@ -130,7 +136,7 @@ def _cmd_show(args: argparse.Namespace) -> int:
 
 
 def _cmd_derive(args: argparse.Namespace) -> int:
-    robot = rd.load(args.robot)
+    robot = _load(args)
     with _progress(f"deriving {args.method}"):
         eom = rd.derive(robot, args.method)
     with _progress(f"rendering {args.format}"):
@@ -140,7 +146,7 @@ def _cmd_derive(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    robot = rd.load(args.robot)
+    robot = _load(args)
     print(f"{robot.name}: {robot.dof} joints ({_types(robot)}), {robot.source}")
     eoms = derive_all(robot)
     results = agreement(eoms, args.samples, args.seed, symbolic=robot.dof <= 2)
@@ -157,7 +163,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
 def _cmd_codegen(args: argparse.Namespace) -> int:
     from robodyn.codegen.emit import generate
 
-    robot = rd.load(args.robot)
+    robot = _load(args)
     with _progress(f"generating {args.lang} for {robot.name}"):
         paths = generate(robot, args.lang, Path(args.output))
     for path in paths:
@@ -169,7 +175,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
     from robodyn.export.mjcf import to_mjcf
     from robodyn.export.urdf import to_urdf
 
-    robot = rd.load(args.robot)
+    robot = _load(args)
     writer = {"urdf": to_urdf, "mjcf": to_mjcf}[args.format]
     text = writer(robot)
     _write(text, args.output)
@@ -289,6 +295,7 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_export)
 
     add_parsers(sub, fmt, _ROBOT_HELP)
+    add_cache_parser(sub, fmt)
 
     p = sub.add_parser("demo", help="PUMA 560 three ways: files, comparison and HTML report",
                        formatter_class=fmt,
@@ -305,6 +312,12 @@ def _parser() -> argparse.ArgumentParser:
                    help="number of random states for the agreement check (default: %(default)s)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     p.set_defaults(func=_cmd_demo)
+    for command in ("show", "derive", "check", "codegen", "export", "simulate", "calibrate"):
+        sub.choices[command].add_argument(
+            "--tool", metavar="LINK",
+            help="URDF only: the link whose frame is the end effector, e.g. tool0 or flange "
+                 "(default: the end of the fixed joints after the last moving joint, or the "
+                 "last moving link when they branch)")
     for each in (parser, *sub.choices.values()):
         each.description = textwrap.fill(each.description or "", width=88)
     return parser

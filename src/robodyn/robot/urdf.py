@@ -1,4 +1,4 @@
-"""Read a serial-chain URDF file into a :class:`~robodyn.robot.model.Robot`.
+"""Read a URDF file whose moving joints form a serial chain into a :class:`~robodyn.robot.model.Robot`.
 
 The file is parsed by the maintained URDF parser `yourdfpy`_ (meshes and scene graphs are not
 loaded); this module only maps its model onto robodyn's convention::
@@ -7,13 +7,25 @@ loaded); this module only maps its model onto robodyn's convention::
 
 URDF joint ``i``'s ``<origin xyz rpy>`` places the joint frame, which is the child link's frame,
 in the parent link's frame; ``<axis>`` is expressed in the joint frame. ``continuous`` joints
-are revolute joints without position limits; ``fixed`` joints are merged by
-:func:`robodyn.robot.chain.assemble` (the child's mass is added to its parent, or carried by the
-ground before the first moving joint; a fixed transform after the last moving joint becomes the
-tool frame). The tool frame is the identity on the last link otherwise.
+are revolute joints without position limits.
 
-Only serial chains are read: a link with two or more child joints, ``floating`` and ``planar``
-joints and ``<mimic>`` joints raise :class:`~robodyn.robot.errors.DescriptionError`.
+Files as ROS-Industrial and robot makers publish them load: blank lines before the XML
+declaration are ignored, and the links may form a tree as long as every moving joint lies on one
+path from the root link (a ``world`` root, the REP-103 ``base`` frame, ``flange``, ``tool0``,
+``ee_link`` and sensor frames hang off that path on fixed joints). The chain is the path from
+the root to the *tool link*: ``tool=`` names it; by default it is the end of the unbranched run
+of fixed joints after the last moving joint, or the last moving link itself when that run
+branches (``ee_link`` and ``tool0`` both fixed to the last link). Fixed joints on the chain are
+merged by :func:`robodyn.robot.chain.assemble` (the child's mass is added to its parent, or
+carried by the ground before the first moving joint; the fixed transforms after the last moving
+joint become the tool frame). Fixed side branches add their mass and inertia to the chain link
+they are welded to; frames without ``<inertial>`` add nothing.
+
+Movable trees (two moving joints on different branches, e.g. gripper fingers), ``floating`` and
+``planar`` joints and ``<mimic>`` joints raise :class:`~robodyn.robot.errors.DescriptionError`.
+A link without ``<inertial>`` has zero mass; when that leaves a moving joint that moves no
+inertia (a singular mass matrix), a :class:`~robodyn.robot.errors.DescriptionWarning` names the
+joint and the links (an error under ``strict=True``).
 
 Numbers are kept as the file gives them: each becomes ``sympy.Float(x)`` (full double
 precision), except exact zeros and exact ``+-1``, which become SymPy integers so the symbolic
