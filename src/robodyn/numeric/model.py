@@ -19,16 +19,22 @@ from types import ModuleType
 from typing import Literal
 
 import numpy as np
+import sympy as sp
 
 from robodyn.codegen.build import CompiledLibrary, cache_dir, compile_library
 from robodyn.codegen.c import CPrinter
 from robodyn.codegen.kernels import KernelSet, build_kernels, kernel_signature
 from robodyn.codegen.python import PythonPrinter
+from robodyn.robot.errors import SimulationError, SingularMassMatrixError
 from robodyn.robot.model import Robot
 from robodyn.robot.overrides import checked_parameter_values
 
 Backend = Literal["c", "numpy"]
 _PREFIX = "rd_"
+
+#: Largest output of one :meth:`Model.integrate` call (states and torques), bytes: longer runs
+#: are split into several calls (as :func:`robodyn.simulate.simulate` does).
+MAX_INTEGRATE_BYTES = 1 << 30
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,12 +89,63 @@ class Model:
         return self._call("coriolis", q, qd)
 
     def forward_dynamics(self, q: np.ndarray, qd: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        """Joint accelerations ``qdd = M^-1 (tau - C qd - g - friction)``, shape like ``q``."""
-        return self._call("forward_dynamics", q, qd, tau)
+        """Joint accelerations ``qdd = M^-1 (tau - C qd - g - friction)``, shape like ``q``.
+
+        Raises
+        ------
+        SingularMassMatrixError
+            When ``M(q)`` is singular at a state (finite inputs, non-finite result).
+        """
+        return self._nonsingular(self._call("forward_dynamics", q, qd, tau), q)
 
     def state_derivative(self, x: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        """``[qd, qdd]`` of the state ``x = [q, qd]``, (2 n,) or (N, 2 n)."""
-        return self._call("state_derivative", x, tau)
+        """``[qd, qdd]`` of the state ``x = [q, qd]``, (2 n,) or (N, 2 n).
+
+        Raises
+        ------
+        SingularMassMatrixError
+            When ``M(q)`` is singular at a state (finite inputs, non-finite result).
+        """
+        xd = self._call("state_derivative", x, tau)
+        return self._nonsingular(xd, np.asarray(x, dtype=float)[..., : self.dof])
+
+    def check_mass_matrix(self, q: np.ndarray) -> None:
+        """Raise :class:`SingularMassMatrixError` when ``M(q)`` is not positive definite.
+
+        Parameters
+        ----------
+        q : (n,)
+            Joint positions (rad, m); non-finite positions are not checked.
+        """
+        q = np.asarray(q, dtype=float)
+        if not np.all(np.isfinite(q)):
+            return
+        m = self.mass_matrix(q)
+        if not np.all(np.isfinite(m)):
+            raise SingularMassMatrixError(f"{self.robot.name}: the mass matrix is not finite at "
+                                          f"q = {np.array2string(q, precision=4)}")
+        lam, vec = np.linalg.eigh(0.5 * (m + m.T))
+        # singular when the smallest eigenvalue is rounding noise next to the largest
+        if lam[0] > 1e-12 * max(abs(lam[-1]), 1e-300):
+            return
+        j = int(np.argmax(np.abs(vec[:, 0])))
+        joint = self.robot.joints[j].name
+        raise SingularMassMatrixError(
+            f"{self.robot.name}: the mass matrix is singular at q = "
+            f"{np.array2string(q, precision=4)} (smallest eigenvalue {lam[0]:.3g} against "
+            f"{lam[-1]:.3g}, mostly joint {joint!r}): joint velocities along "
+            f"{np.array2string(vec[:, 0], precision=3)} move no mass or inertia here (a massless "
+            "link, a point mass on a joint axis), so the forward dynamics has no solution; give "
+            "the links mass and inertia, or the joints rotor inertia")
+
+    def _nonsingular(self, out: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """``out`` unchanged when finite; otherwise check ``M`` at the first non-finite row."""
+        if np.all(np.isfinite(out)):
+            return out
+        rows = np.atleast_2d(np.asarray(q, dtype=float))
+        bad = ~np.all(np.isfinite(out.reshape(rows.shape[0], -1)), axis=1)
+        self.check_mass_matrix(rows[int(np.argmax(bad))])
+        return out
 
     def forward_kinematics(self, q: np.ndarray) -> np.ndarray:
         """End-effector pose in the base frame, (4, 4) or (N, 4, 4)."""
@@ -169,6 +226,14 @@ class Model:
         if continuous and method != "rk4":
             raise ValueError(f"control='continuous' needs method='rk4' ({method} evaluates the law "
                              "once per step: use control='sampled')")
+        steps = int(steps)
+        if steps < 1:
+            raise ValueError(f"integrate: steps must be a positive integer, got {steps}")
+        size = 8 * (steps + 1) * 3 * n
+        if size > MAX_INTEGRATE_BYTES:
+            raise ValueError(f"integrate: {steps:,} steps of {n} joints need {size / 2**20:,.0f} MiB "
+                             f"of output, above {MAX_INTEGRATE_BYTES / 2**20:,.0f} MiB; split the "
+                             "run into several calls from the last state (simulate() does so)")
         rows = 2 * steps + 1 if continuous else steps
         arrays = {
             "x0": (x0, (nx,)), "feedforward": (feedforward, (rows, n)),
@@ -198,8 +263,10 @@ class Model:
                 ptr["gain"], ptr["integral_gain"], modes[mode], ptr["tau_limit"], int(continuous),
                 ffi.from_buffer("double[]", x_out), ffi.from_buffer("double[]", tau_out))
         if status:
-            raise FloatingPointError(f"the simulated state stopped being finite at step {status - 1} "
-                                     f"(t = {(status - 1) * dt:g} s); reduce dt or check the inputs")
+            # the last finite state: a singular mass matrix there is the explanation
+            self.check_mass_matrix(x_out[status - 1, :n])
+            raise SimulationError(f"the simulated state stopped being finite at step {status - 1} "
+                                  f"(t = {(status - 1) * dt:g} s); reduce dt or check the inputs")
         return x_out, tau_out
 
     # --- plumbing ------------------------------------------------------------------------------
@@ -221,7 +288,9 @@ class Model:
         assert batch_shape is not None
         out_shape = batch_shape + result_shape
         if isinstance(self._impl, ModuleType):
-            return getattr(self._impl, name)(*args).reshape(out_shape)
+            # a singular M divides by zero: the callers check the result, not NumPy's warnings
+            with np.errstate(divide="ignore", invalid="ignore"):
+                return getattr(self._impl, name)(*args).reshape(out_shape)
         ffi, lib = self._impl.ffi, self._impl.lib
         # C-contiguous float64 inputs are passed without a copy
         args = [np.ascontiguousarray(a) for a in args]
@@ -257,6 +326,9 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
     ------
     CompilerNotFoundError
         With ``backend="c"`` and no C compiler (the message names the NumPy fallback).
+    SingularMassMatrixError
+        When the mass matrix is singular whatever the configuration (a joint that moves no mass,
+        inertia or rotor inertia, e.g. a massless final link): no forward dynamics exists.
     """
     if backend not in ("c", "numpy"):
         raise ValueError(f"unknown backend {backend!r}; choose 'c' (compiled) or 'numpy'")
@@ -270,6 +342,7 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
         src, decl = directory / f"rd_model_{key}.c", directory / f"rd_model_{key}.cdef"
         if not (src.exists() and decl.exists()):
             kset = _kernels_cached(robot, values)
+            _check_structure(robot, kset)
             printer = CPrinter(_PREFIX)
             _write_atomic(decl, printer.declarations(kset))
             _write_atomic(src, printer.source(kset))
@@ -277,9 +350,32 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
     else:
         path = directory / f"rd_model_{key}.py"
         if not path.exists():
-            _write_atomic(path, PythonPrinter().module(_kernels_cached(robot, values)))
+            kset = _kernels_cached(robot, values)
+            _check_structure(robot, kset)
+            _write_atomic(path, PythonPrinter().module(kset))
         impl = _import_file(path, f"robodyn_generated_{key}")
     return Model(robot, backend, tuple(sorted(values.items())), impl)
+
+
+def _check_structure(robot: Robot, kset: KernelSet) -> None:
+    """Refuse a mass matrix that is singular everywhere: the Cholesky pivot folds to ``1/0``."""
+    fd = kset["forward_dynamics"]
+    exprs = [e for _, e in fd.body] + list(fd.outputs[0].entries)
+    if not any(sp.sympify(e).has(sp.zoo, sp.nan, sp.oo) for e in exprs):
+        return
+    mass = kset["mass_matrix"]
+    env: dict[sp.Symbol, sp.Expr] = dict.fromkeys(mass.inputs[0].entries, sp.Float(0.3))
+    for sym, expr in mass.body:
+        env[sym] = expr.xreplace(env).evalf()
+    m = np.array([float(sp.sympify(e).xreplace(env).evalf()) for e in mass.outputs[0].entries])
+    diag = np.diag(m.reshape(robot.dof, robot.dof))
+    j = int(np.argmin(np.abs(diag)))
+    joint, link = robot.joints[j].name, robot.links[j].name
+    raise SingularMassMatrixError(
+        f"{robot.source}: the mass matrix of {robot.name} is singular in every configuration "
+        f"(M[{j}, {j}] = {diag[j]:.3g} for joint {joint!r}): joint {joint!r} moves no mass, "
+        f"inertia or rotor inertia, so the forward dynamics has no solution; give link {link!r} "
+        "(or the links beyond it) a mass and an inertia, or the joint a rotor inertia")
 
 
 def _generator_hash() -> str:

@@ -238,7 +238,9 @@ class PID(Controller):
 class GravityCompensation(Controller):
     """PD plus the gravity load: ``tau = Kp e + Kd ed + g(q)``.
 
-    Parameters as :class:`PD`; ``model`` is needed only for the plain-callable form.
+    Parameters as :class:`PD`. ``model``: the controller's model of the robot, needed for the
+    plain-callable form; inside :func:`~robodyn.simulate.simulate` it is used instead of the
+    plant's model when given (the plant's model otherwise).
     """
 
     kp: Any
@@ -282,7 +284,10 @@ class ComputedTorque(Controller):
         Error dynamics gains, 1/s^2 and 1/s.
     tau_limit : float or (n,), optional
     model : Model, optional
-        Needed only for the plain-callable form.
+        The controller's model of the robot. Needed for the plain-callable form; inside
+        :func:`~robodyn.simulate.simulate` it is used instead of the simulated plant's model
+        (a controller with a wrong model tracks worse); without it the plant's model is used
+        (an exact model).
     """
 
     trajectory: Reference
@@ -429,7 +434,8 @@ class LQR(Controller):
 
 
 def _need_model(ctrl: Controller, model: Model | None) -> Model:
-    model = model if model is not None else ctrl.model
+    """The controller's own ``model=`` when it has one (its belief about the plant), else ``model``."""
+    model = ctrl.model if ctrl.model is not None else model
     if model is None:
         raise ValueError(f"{ctrl.name} needs the robot's dynamics: construct it with model=... to "
                          f"call it directly (simulate() passes its model itself)")

@@ -24,11 +24,19 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from robodyn.numeric.model import Model
+from robodyn.robot.errors import SimulationError
 from robodyn.simulate.controllers import Controller
 from robodyn.simulate.energy import potential_energy
 
 FIXED_STEP = ("rk4", "semi_implicit")
 ADAPTIVE = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+
+#: Default largest number of output samples (rows of a :class:`Trajectory`): 1000 s at 1 ms,
+#: about 250 MB of arrays for six joints. Longer runs need ``decimate`` or ``max_samples``.
+MAX_SAMPLES = 1_000_000
+#: Steps per call into the generated integrator: long runs are integrated piece by piece so that
+#: memory is bounded by the kept samples, not by the number of steps.
+CHUNK_STEPS = 65_536
 
 ControllerLike = Controller | Callable[[float, np.ndarray, np.ndarray], np.ndarray] | None
 
@@ -52,13 +60,15 @@ class Trajectory:
         :func:`robodyn.simulate.energy.potential_energy`) and their sum, J.
     method : str
     dt : float
-        Output (and, for fixed-step methods, integration) step, s.
+        Integration step of the fixed-step methods, s; samples are ``decimate * dt`` apart.
     controller : str
         Name of the controller ("none" when passive).
     robot : str
     backend : str
     evaluations : int
         Right-hand-side evaluations (``state_derivative`` calls).
+    decimate : int
+        Every ``decimate``-th step was kept.
     """
 
     t: np.ndarray
@@ -75,6 +85,7 @@ class Trajectory:
     robot: str
     backend: str
     evaluations: int
+    decimate: int = 1
 
     @property
     def x(self) -> np.ndarray:
@@ -91,7 +102,8 @@ class Trajectory:
 def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: float, dt: float,
              method: str = "rk4", controller: ControllerLike = None, *,
              tau_limit: float | np.ndarray | None = None, rtol: float = 1e-9,
-             atol: float = 1e-12, control: str = "sampled") -> Trajectory:
+             atol: float = 1e-12, control: str = "sampled", decimate: int = 1,
+             max_samples: int | None = MAX_SAMPLES) -> Trajectory:
     """Simulate ``model`` from ``(q0, qd0)`` for ``duration`` seconds.
 
     Parameters
@@ -108,7 +120,11 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         Step (fixed-step methods) and output interval (all methods), s.
     method : {"rk4", "semi_implicit", "RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA"}
     controller : Controller, callable or None
-        A built-in controller, any ``(t, q, qd) -> tau`` callable, or None (no torque).
+        A built-in controller, any ``(t, q, qd) -> tau`` callable, or None (no torque). A
+        built-in controller constructed with its own ``model=`` (gravity compensation, computed
+        torque) computes its law with that model, not the plant's: a controller with a wrong
+        model tracks worse. The run then steps in Python (the generated C integrator only knows
+        the plant's model), unless both models have the same description and parameters.
     tau_limit : float or (n,), optional
         Actuator limits, N m (N), applied to every torque; overrides the controller's own.
     rtol, atol : float
@@ -119,6 +135,12 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         "continuous" (RK4): evaluated at every RK4 stage, a continuous-time controller tracked
         to the integrator's fourth order (built-in controllers in C; a callable from Python).
         The SciPy methods always evaluate the law wherever they evaluate the dynamics.
+    decimate : int
+        Keep every ``decimate``-th step (the integration still uses ``dt``); ``duration`` must
+        be a whole number of ``decimate * dt``.
+    max_samples : int or None
+        Refuse a run that would keep more samples than this (default :data:`MAX_SAMPLES`,
+        checked before anything is allocated); None: no limit.
 
     Returns
     -------
@@ -127,20 +149,36 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
     Raises
     ------
     ValueError
-        Wrong shapes, non-finite values, non-positive ``dt`` or ``duration``, unknown method.
+        Wrong shapes, non-finite values, non-positive ``dt`` or ``duration``, unknown method,
+        more samples than ``max_samples``, a controller model with another number of joints.
     TypeError
         A controller that is neither built-in nor callable.
-    FloatingPointError
-        When the state stops being finite.
+    SimulationError
+        (a ``FloatingPointError`` and a ``ValueError``) When the state stops being finite; a
+        :class:`~robodyn.robot.errors.SingularMassMatrixError` when the mass matrix is singular.
     """
     n = model.dof
     q0 = _vector(q0, n, "q0")
     qd0 = np.zeros(n) if qd0 is None else _vector(qd0, n, "qd0")
     dt = _positive(dt, "dt")
     duration = _positive(duration, "duration")
-    steps = int(round(duration / dt))
+    steps = round(duration / dt)
     if steps < 1 or abs(steps * dt - duration) > 1e-9 * duration:
         raise ValueError(f"duration {duration:g} s is not a whole number of steps dt = {dt:g} s")
+    if isinstance(decimate, bool) or not isinstance(decimate, int | np.integer) or decimate < 1:
+        raise ValueError(f"simulate: decimate must be a positive integer, got {decimate!r}")
+    decimate = int(decimate)
+    if steps % decimate:
+        raise ValueError(f"simulate: duration {duration:g} s is {steps} steps of {dt:g} s, not a "
+                         f"whole number of decimate = {decimate} steps")
+    samples = steps // decimate + 1
+    if max_samples is not None and samples > max_samples:
+        raise ValueError(
+            f"simulate: {duration:g} s at dt = {dt:g} s keeps {samples:,} samples (about "
+            f"{output_bytes(samples, n) / 1e6:,.0f} MB of arrays), above max_samples = "
+            f"{max_samples:,}; keep every k-th step with decimate=k (k >= "
+            f"{-(-steps // (max_samples - 1)) if max_samples > 1 else steps}), shorten the run, "
+            "or raise max_samples")
     if method not in FIXED_STEP + ADAPTIVE:
         raise ValueError(f"unknown method {method!r}; choose one of {', '.join(FIXED_STEP + ADAPTIVE)}")
     if control not in ("sampled", "continuous"):
@@ -154,71 +192,143 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
     limit = _tau_limit(tau_limit, n) if tau_limit is not None else None
     if limit is None and isinstance(controller, Controller) and controller.tau_limit is not None:
         limit = _tau_limit(controller.tau_limit, n)
-    t = dt * np.arange(steps + 1)
+    own = _controller_model(controller, model)
+    if own is not None:
+        # the law with the controller's own model, stepped in Python
+        ctrl = controller
+
+        def with_own_model(tk: float, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+            return ctrl.law(own, tk, np.concatenate([q, qd]), None)
+
+        with_own_model.__name__ = controller.name
+        controller = with_own_model
+    t = dt * np.arange(0, steps + 1, decimate)
     x0 = np.concatenate([q0, qd0])
-    if method in FIXED_STEP:
-        x, tau, evals = _fixed_step(model, x0, t, dt, method, controller, limit,
-                                    control == "continuous")
+    continuous = control == "continuous"
+    if method in FIXED_STEP and (controller is None or isinstance(controller, Controller)):
+        x, tau, evals = _fixed_step_c(model, x0, steps, dt, decimate, method, controller, limit,
+                                      continuous, max_samples)
+    elif method in FIXED_STEP:
+        x, tau, evals = _fixed_step_python(model, x0, steps, dt, decimate, method, controller,
+                                           limit, continuous)
     else:
         x, tau, evals = _adaptive(model, x0, t, method, controller, limit, rtol, atol)
-    return _result(model, t, x, tau, method, dt, controller, evals)
+    return _result(model, t, x, tau, method, dt, controller, evals, decimate)
 
 
-def _fixed_step(model: Model, x0: np.ndarray, t: np.ndarray, dt: float, method: str,
-                controller: ControllerLike, limit: np.ndarray | None,
-                continuous: bool = False) -> tuple[np.ndarray, np.ndarray, int]:
-    n, steps = model.dof, t.size - 1
-    per_step = 4 if method == "rk4" else 1
-    if controller is None or isinstance(controller, Controller):
+def output_bytes(samples: int, n: int) -> int:
+    """Bytes of the arrays of a :class:`Trajectory` of ``samples`` rows and ``n`` joints."""
+    # t, kinetic, potential, energy and q, qd, qdd, tau
+    return 8 * samples * (4 + 4 * n)
+
+
+def _controller_model(controller: ControllerLike, model: Model) -> Model | None:
+    """The controller's own model when it differs from the plant's, else None."""
+    own = getattr(controller, "model", None) if isinstance(controller, Controller) else None
+    if own is None or own is model:
+        return None
+    if own.dof != model.dof:
+        raise ValueError(f"simulate: the controller's model ({own.robot.name}) has {own.dof} "
+                         f"joints, the simulated robot ({model.robot.name}) {model.dof}")
+    same = (own.robot.description_hash and own.robot.description_hash == model.robot.description_hash
+            and own.parameter_values == model.parameter_values)
+    return None if same else own
+
+
+def _fixed_step_c(model: Model, x0: np.ndarray, steps: int, dt: float, decimate: int, method: str,
+                  controller: Controller | None, limit: np.ndarray | None, continuous: bool,
+                  max_samples: int | None) -> tuple[np.ndarray, np.ndarray, int]:
+    """Passive or built-in controller: the generated integrator, CHUNK_STEPS steps per call.
+
+    A PID's error integral restarts at zero in each call; the integral of the earlier pieces
+    enters as a constant feedforward ``Ki z``. Continuous-time PID (whose RK4 integral is not
+    returned) runs as one call.
+    """
+    n = model.dof
+    integral = controller is not None and controller.has_integral
+    chunk = CHUNK_STEPS
+    if integral and continuous:
+        if max_samples is not None and steps > max(max_samples, CHUNK_STEPS):
+            raise ValueError(f"simulate: a PID with control='continuous' runs in one piece, at "
+                             f"most {max(max_samples, CHUNK_STEPS):,} steps (this run has "
+                             f"{steps:,}); use control='sampled', a SciPy method or a larger dt")
+        chunk = steps
+    keep = steps // decimate + 1
+    x_out, tau_out = np.empty((keep, 2 * n)), np.empty((keep, n))
+    x_out[0] = x0
+    x, z = x0, np.zeros(n)
+    for k0 in range(0, steps, chunk):
+        m = min(chunk, steps - k0)
         # continuous: the inputs sampled every dt/2, for the RK4 stages
-        times = 0.5 * dt * np.arange(2 * steps + 1) if continuous else t[:-1]
+        times = (0.5 * dt * np.arange(2 * k0, 2 * (k0 + m) + 1) if continuous
+                 else dt * np.arange(k0, k0 + m))
         kwargs = {} if controller is None else controller.sampled(model, times)
-        x, tau = model.integrate(x0, steps, dt, method, tau_limit=limit,
-                                 control="continuous" if continuous else "sampled", **kwargs)
-        last = np.zeros(n) if controller is None else controller.law(
-            model, t[-1], x[-1], _error_integral(controller, t, x, dt, continuous))
-        return x, np.vstack([tau, _clip(last, limit)]), steps * per_step
-    x = np.empty((steps + 1, 2 * n))
-    tau = np.empty((steps + 1, n))
-    x[0] = x0
+        if integral and k0:
+            # tau = Ki (z0 + z_piece) + ...: the earlier pieces' integral as feedforward
+            kwargs["feedforward"] = np.tile(kwargs["integral_gain"] * z, (times.size, 1))
+        xs, taus = model.integrate(x, m, dt, method, tau_limit=limit,
+                                   control="continuous" if continuous else "sampled", **kwargs)
+        if integral and not continuous:
+            # z += dt sum_k (q_ref(t_k) - q_k), as the C loop does
+            z = z + dt * np.sum(kwargs["reference"][:, :n] - xs[:-1, :n], axis=0)
+        # global step k is kept when k % decimate == 0
+        first = -k0 % decimate
+        x_out[(k0 + first) // decimate: (k0 + m) // decimate + 1] = xs[first::decimate]
+        tau_rows = taus[first::decimate]
+        tau_out[(k0 + first) // decimate: (k0 + first) // decimate + len(tau_rows)] = tau_rows
+        x = xs[-1]
+    if controller is None:
+        last = np.zeros(n)
+    else:
+        t_end = steps * dt
+        if integral and continuous:
+            errors = np.array([controller.position_error(k * dt, xk[:n]) for k, xk in enumerate(xs)])
+            # the trapezoidal rule (the integrator's RK4 value is not returned; O(dt^2) apart)
+            z = dt * (errors.sum(axis=0) - 0.5 * (errors[0] + errors[-1]))
+        elif integral:
+            z = z + dt * controller.position_error(t_end, x[:n])
+        last = controller.law(model, t_end, x, z if integral else None)
+    tau_out[-1] = _clip(last, limit)
+    return x_out, tau_out, steps * (4 if method == "rk4" else 1)
+
+
+def _fixed_step_python(model: Model, x0: np.ndarray, steps: int, dt: float, decimate: int,
+                       method: str, controller: Callable, limit: np.ndarray | None,
+                       continuous: bool) -> tuple[np.ndarray, np.ndarray, int]:
+    """A Python callable, sampled or at every RK4 stage: the loop over the steps in Python."""
+    n = model.dof
+    keep = steps // decimate + 1
+    x_out, tau_out = np.empty((keep, 2 * n)), np.empty((keep, n))
     f = model.state_derivative
 
     def law(tk: float, xk: np.ndarray) -> np.ndarray:
         return _clip(_call(controller, tk, xk, n), limit)
 
+    x = x0
     for k in range(steps):
-        tau[k] = law(t[k], x[k])
+        tk = k * dt
+        tau = law(tk, x)
+        if k % decimate == 0:
+            x_out[k // decimate], tau_out[k // decimate] = x, tau
         if continuous:
             # RK4 with the callable evaluated at every stage
-            k1 = f(x[k], tau[k])
-            xs = x[k] + 0.5 * dt * k1
-            k2 = f(xs, law(t[k] + 0.5 * dt, xs))
-            xs = x[k] + 0.5 * dt * k2
-            k3 = f(xs, law(t[k] + 0.5 * dt, xs))
-            xs = x[k] + dt * k3
-            k4 = f(xs, law(t[k] + dt, xs))
-            x[k + 1] = x[k] + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            k1 = f(x, tau)
+            xs = x + 0.5 * dt * k1
+            k2 = f(xs, law(tk + 0.5 * dt, xs))
+            xs = x + 0.5 * dt * k2
+            k3 = f(xs, law(tk + 0.5 * dt, xs))
+            xs = x + dt * k3
+            k4 = f(xs, law(tk + dt, xs))
+            x = x + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            if not np.all(np.isfinite(x)):
+                model.check_mass_matrix(xs[:n])
+                raise SimulationError(f"the simulated state stopped being finite at step {k} "
+                                      f"(t = {tk:g} s); reduce dt or check the inputs")
         else:
             # one step with the torque held (zero-order hold)
-            x[k + 1] = model.integrate(x[k], 1, dt, method, feedforward=tau[k][None])[0][1]
-    tau[-1] = law(t[-1], x[-1])
-    return x, tau, steps * per_step
-
-
-def _error_integral(controller: Controller, t: np.ndarray, x: np.ndarray, dt: float,
-                    continuous: bool) -> np.ndarray | None:
-    """The error integral at the last sample, for the last row of ``tau``.
-
-    Sampled: the C integrator's own ``dt sum_{j<=N} e_j``. Continuous: the trapezoidal rule over
-    the samples (the integrator's RK4 value is not returned; this differs by O(dt^2)).
-    """
-    if not controller.has_integral:
-        return None
-    n = x.shape[1] // 2
-    errors = np.array([controller.position_error(tk, xk[:n]) for tk, xk in zip(t, x, strict=True)])
-    if continuous:
-        return dt * (errors.sum(axis=0) - 0.5 * (errors[0] + errors[-1]))
-    return dt * errors.sum(axis=0)
+            x = model.integrate(x, 1, dt, method, feedforward=tau[None])[0][1]
+    x_out[-1], tau_out[-1] = x, law(steps * dt, x)
+    return x_out, tau_out, steps * (4 if method == "rk4" else 1)
 
 
 def _adaptive(model: Model, x0: np.ndarray, t: np.ndarray, method: str, controller: ControllerLike,
@@ -245,26 +355,30 @@ def _adaptive(model: Model, x0: np.ndarray, t: np.ndarray, method: str, controll
     y0 = np.concatenate([x0, np.zeros(extra)])
     sol = solve_ivp(rhs, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol)
     if sol.status != 0 or sol.y.shape[1] != t.size:
-        raise FloatingPointError(f"solve_ivp ({method}) failed at t = {sol.t[-1]:g} s: {sol.message}")
+        raise SimulationError(f"solve_ivp ({method}) failed at t = {sol.t[-1]:g} s: {sol.message}")
     y = sol.y.T
     tau = np.array([torque(tk, yk) for tk, yk in zip(t, y, strict=True)])
     return np.ascontiguousarray(y[:, : 2 * n]), tau, int(sol.nfev)
 
 
 def _result(model: Model, t: np.ndarray, x: np.ndarray, tau: np.ndarray, method: str, dt: float,
-            controller: ControllerLike, evals: int) -> Trajectory:
+            controller: ControllerLike, evals: int, decimate: int) -> Trajectory:
     n = model.dof
     q, qd = np.ascontiguousarray(x[:, :n]), np.ascontiguousarray(x[:, n:])
     qdd = model.forward_dynamics(q, qd, tau)
-    m = model.mass_matrix(q)
-    # K = 0.5 qd^T M qd
-    kinetic = 0.5 * np.einsum("ki,kij,kj->k", qd, m, qd)
+    kinetic = np.empty(t.size)
+    for k0 in range(0, t.size, CHUNK_STEPS):
+        # K = 0.5 qd^T M qd (M in pieces: (N, n, n) would dwarf the trajectory)
+        part = slice(k0, k0 + CHUNK_STEPS)
+        kinetic[part] = 0.5 * np.einsum("ki,kij,kj->k", qd[part], model.mass_matrix(q[part]),
+                                        qd[part])
     potential = potential_energy(model, q)
     arrays = [t, q, qd, qdd, tau, kinetic, potential, kinetic + potential]
     for a in arrays:
         a.flags.writeable = False
     return Trajectory(*arrays, method=method, dt=dt, controller=_name(controller),
-                      robot=model.robot.name, backend=model.backend, evaluations=evals)
+                      robot=model.robot.name, backend=model.backend, evaluations=evals,
+                      decimate=decimate)
 
 
 def _call(controller: Callable, t: float, x: np.ndarray, n: int) -> np.ndarray:
@@ -316,4 +430,5 @@ def _tau_limit(v: float | np.ndarray, n: int) -> np.ndarray:
     return np.ascontiguousarray(arr)
 
 
-__all__ = ["ADAPTIVE", "FIXED_STEP", "Trajectory", "simulate"]
+__all__ = ["ADAPTIVE", "CHUNK_STEPS", "FIXED_STEP", "MAX_SAMPLES", "Trajectory", "output_bytes",
+           "simulate"]

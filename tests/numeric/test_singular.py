@@ -1,0 +1,108 @@
+"""A singular mass matrix is a clear error wherever the forward dynamics is needed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robodyn as rd
+from robodyn.robot.errors import SimulationError, SingularMassMatrixError
+
+MASSLESS_TIP = """
+name: massless_tip
+parameters: {m: 1.0, l: 1.0, g: 9.81}
+gravity: [0, -g, 0]
+joints:
+  - name: q1
+    type: revolute
+    dh: {a: l, alpha: 0, d: 0, theta: 0}
+    link:
+      name: rod
+      mass: m
+      com: [-l/2, 0, 0]
+      inertia: {ixx: 0, iyy: m*l**2/12, izz: m*l**2/12, ixy: 0, ixz: 0, iyz: 0}
+  - name: wrist
+    type: revolute
+    dh: {a: 0.1, alpha: 0, d: 0, theta: 0}
+    link:
+      name: tip
+      mass: 0
+      com: [0, 0, 0]
+      inertia: {ixx: 0, iyy: 0, izz: 0, ixy: 0, ixz: 0, iyz: 0}
+"""
+
+# link 1 massless, link 2 a point mass at its tip: M = m J^T J is singular wherever the arm is
+# stretched or folded (q2 = 0, pi), regular elsewhere
+POINT_MASS = """
+name: point_mass_rr
+parameters: {m: 1.0, g: 9.81}
+gravity: [0, -g, 0]
+joints:
+  - name: shoulder
+    type: revolute
+    dh: {a: 1.0, alpha: 0, d: 0, theta: 0}
+    link:
+      name: bare
+      mass: 0
+      com: [0, 0, 0]
+      inertia: {ixx: 0, iyy: 0, izz: 0, ixy: 0, ixz: 0, iyz: 0}
+  - name: elbow
+    type: revolute
+    dh: {a: 1.0, alpha: 0, d: 0, theta: 0}
+    link:
+      name: ball
+      mass: m
+      com: [0, 0, 0]
+      inertia: {ixx: 0, iyy: 0, izz: 0, ixy: 0, ixz: 0, iyz: 0}
+"""
+
+
+@pytest.fixture
+def massless(tmp_path):
+    path = tmp_path / "massless_tip.yaml"
+    path.write_text(MASSLESS_TIP)
+    return path
+
+
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+def test_a_massless_final_link_is_refused_naming_the_joint(massless, backend):
+    # before: KeyError 'ComplexInfinity' (NumPy) or a printer error (C) from inside code generation
+    with pytest.raises(SingularMassMatrixError,
+                       match=r"massless_tip.yaml: the mass matrix .* singular in every "
+                             r"configuration .* joint 'wrist' .* link 'tip'"):
+        rd.compile_model(rd.load(massless), backend=backend)
+
+
+def test_the_cli_says_so_in_one_line(massless, capsys, tmp_path):
+    from robodyn.cli import main
+
+    code = main(["simulate", str(massless), "--backend", "numpy", "-o", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == 2
+    # (the loader may warn first, one line too)
+    errors = [line for line in err.splitlines() if line.startswith("robodyn: error:")]
+    assert len(errors) == 1 and "singular" in errors[0] and "Traceback" not in err
+
+
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+def test_forward_dynamics_and_simulate_where_the_mass_matrix_is_singular(tmp_path, backend):
+    path = tmp_path / "point_mass_rr.yaml"
+    path.write_text(POINT_MASS)
+    model = rd.compile_model(rd.load(path), backend=backend)
+    stretched = np.array([0.3, 0.0])
+    # M = [[4, 2], [2, 1]]: the null direction (1, -2)/sqrt(5), mostly the elbow
+    with pytest.raises(SingularMassMatrixError,
+                       match=r"singular at q = \[0\.3 0\. *\] .* mostly joint 'elbow'"):
+        model.forward_dynamics(stretched, np.zeros(2), np.zeros(2))
+    states = np.array([[0.3, 1.0, 0, 0], [0.3, 0.0, 0, 0]])
+    with pytest.raises(SingularMassMatrixError):
+        model.state_derivative(states, np.zeros((2, 2)))
+    with pytest.raises(SingularMassMatrixError):
+        rd.simulate(model, stretched, None, 0.1, 1e-3)
+    # a SimulationError: a ValueError for the command line (exit 2), a FloatingPointError as before
+    assert issubclass(SingularMassMatrixError, SimulationError)
+    assert issubclass(SimulationError, ValueError) and issubclass(SimulationError, FloatingPointError)
+    # bent, the same arm is regular: M^-1 exists and the call returns
+    bent = np.array([0.3, 1.0])
+    qdd = model.forward_dynamics(bent, np.zeros(2), np.zeros(2))
+    np.testing.assert_allclose(model.mass_matrix(bent) @ qdd, -model.gravity(bent), atol=1e-12)
