@@ -348,3 +348,17 @@ def test_kinova_gen3_file_loads_and_its_tool_can_be_chosen() -> None:
     assert bracelet.tool == sp.eye(4)
     assert robot.tool != sp.eye(4)  # end_effector_link by default
     assert bracelet.links == robot.links
+
+
+def test_yaml_description_with_a_massless_last_link_warns_too(tmp_path: Path) -> None:
+    path = tmp_path / "arm.yaml"
+    path.write_text(
+        "name: arm\njoints:\n"
+        "  - {name: j1, type: revolute, dh: {a: 0.5, alpha: 0, d: 0, theta: 0},\n"
+        "     link: {name: upper, mass: 1.0, com: [-0.25, 0, 0]}}\n"
+        "  - {name: j2, type: revolute, dh: {a: 0.4, alpha: 0, d: 0, theta: 0},\n"
+        "     link: {name: empty, mass: 0}}\n"
+    )
+    with pytest.warns(DescriptionWarning, match=r"arm\.yaml: the mass matrix is singular: "
+                      r"joint 'j2' moves no inertia.*'empty'"):
+        rd.load(path)
