@@ -72,7 +72,31 @@ def _controller(args: argparse.Namespace, model: rd.Model, q0: np.ndarray):
     return GravityCompensation(kp, kd, plan), plan
 
 
+#: Characters per value in the CSV (``repr`` of a double with its separator), for the estimate.
+_CSV_VALUE_CHARS = 22
+
+
+def _check_size(args: argparse.Namespace, n: int) -> None:
+    """Refuse, before anything runs, an output above ``--max-samples`` (the CSV size named)."""
+    if not (math.isfinite(args.duration) and math.isfinite(args.dt) and args.dt > 0
+            and args.duration > 0):
+        raise ValueError(f"--duration and --dt must be positive finite numbers, got "
+                         f"{args.duration:g} and {args.dt:g}")
+    if args.decimate < 1:
+        raise ValueError(f"--decimate: must be a positive integer, got {args.decimate}")
+    samples = math.floor(args.duration / args.dt / args.decimate) + 1
+    if args.max_samples and samples > args.max_samples:
+        size = samples * (4 * n + 2) * _CSV_VALUE_CHARS
+        k = math.ceil(args.duration / args.dt / max(args.max_samples - 1, 1))
+        raise ValueError(
+            f"--duration {args.duration:g} s at --dt {args.dt:g} s writes {samples:,} rows (a CSV "
+            f"of about {size / 1e6:,.0f} MB), above --max-samples {args.max_samples:,}; keep "
+            f"every k-th step with --decimate k (k >= {k:,}), shorten the run, or raise "
+            "--max-samples (0: no limit)")
+
+
 def _cmd_simulate(args: argparse.Namespace) -> int:
+    from robodyn.codegen.build import CompilerNotFoundError
     from robodyn.simulate.plots import trajectory_figure
 
     robot = rd.load(args.robot, tool=args.tool)
@@ -80,15 +104,24 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     csv_path = output_path(args.output, robot.name, "_simulation.csv", what="robot name")
     q0 = _vector(args.q0, n, "--q0")
     qd0 = _vector(args.qd0, n, "--qd0")
+    _check_size(args, n)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
     with progress(f"compiling {robot.name} ({args.backend} backend)"):
-        model = rd.compile_model(robot, backend=args.backend)
+        try:
+            model = rd.compile_model(robot, backend=args.backend)
+        except CompilerNotFoundError as exc:
+            raise ValueError(f"{exc}; rerun with --backend numpy (no compiler needed)") from None
     controller, plan = _controller(args, model, q0)
     limit = _vector(args.tau_limit, n, "--tau-limit") if args.tau_limit is not None else None
     with progress(f"simulating {args.duration:g} s at dt = {args.dt:g} s ({args.method})"):
-        sim = rd.simulate(model, q0, qd0, args.duration, args.dt, method=args.method,
-                          controller=controller, tau_limit=limit, control=args.control)
+        try:
+            sim = rd.simulate(model, q0, qd0, args.duration, args.dt, method=args.method,
+                              controller=controller, tau_limit=limit, control=args.control,
+                              decimate=args.decimate, max_samples=args.max_samples or None)
+        except FloatingPointError as exc:
+            # the controller's or the integrator's message, as one line and exit 2
+            raise ValueError(str(exc)) from None
     names = robot.joint_names
     with csv_path.open("w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
@@ -207,7 +240,7 @@ def add_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> 
 
 
 def _simulate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
-    from robodyn.simulate.simulation import ADAPTIVE, FIXED_STEP
+    from robodyn.simulate.simulation import ADAPTIVE, FIXED_STEP, MAX_SAMPLES
 
     p = sub.add_parser(
         "simulate", help="simulate a robot (passive or under a controller), CSV and plots",
@@ -250,7 +283,14 @@ def _simulate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
                         "(default: %(default)s)")
     p.add_argument("--tau-limit", type=_floats, metavar="T", help="actuator limits, N m or N")
     p.add_argument("--backend", choices=("c", "numpy"), default="c",
-                   help="compiled C or pure NumPy (default: %(default)s)")
+                   help="compiled C (needs a C compiler) or pure NumPy (no compiler; slower) "
+                        "(default: %(default)s)")
+    p.add_argument("--decimate", type=int, default=1, metavar="K",
+                   help="keep every K-th step in the CSV and plots (the integration still uses "
+                        "--dt) (default: %(default)s)")
+    p.add_argument("--max-samples", type=int, default=MAX_SAMPLES, metavar="N",
+                   help="refuse a run that would write more than N rows (checked before it "
+                        "starts; 0: no limit) (default: %(default)s)")
     p.add_argument("-o", "--output", metavar="DIR", default="sim",
                    help="output folder (default: %(default)s)")
     p.set_defaults(func=_cmd_simulate)

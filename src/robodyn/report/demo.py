@@ -34,6 +34,7 @@ def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
     out = Path(output)
     out.mkdir(parents=True, exist_ok=True)
     robot = rd.load("puma560")
+    backend = demo_backend()
     eoms = derive_all(robot)
     results = agreement(eoms, samples, seed)
     by_method = {e.method: e for e in eoms}
@@ -58,7 +59,7 @@ def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
     writer.writerows(counts)
     (out / "comparison.csv").write_text(csv_text.getvalue())
     (out / "comparison.md").write_text(_markdown(robot, counts, results, samples))
-    sections, sim_ok = simulation_sections(robot, out)
+    sections, sim_ok = simulation_sections(robot, out, backend)
     cal_section, cal_ok = _calibration_section(out)
     sections += "\n" + cal_section
     page = _html_page(robot, counts, results, samples, teom, closed,
@@ -76,6 +77,19 @@ def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
     print("chapter 4 (calibration study, held-out error within 1.3x the noise): "
           + ("ok" if cal_ok else "FAILED"))
     return 0 if all(r.ok for r in results) and closed and sim_ok and cal_ok else 1
+
+
+def demo_backend() -> str:
+    """"c" when a C compiler is installed; otherwise "numpy", with a printed note."""
+    from robodyn.codegen import build
+
+    try:
+        build.find_compiler()
+    except build.CompilerNotFoundError as exc:
+        print(f"note: {' '.join(str(exc).split())}. The demo uses the NumPy backend instead "
+              "(same results, slower simulations).")
+        return "numpy"
+    return "c"
 
 
 def _calibration_section(out: Path) -> tuple[str, bool]:

@@ -17,8 +17,12 @@ from robodyn.simulate.plots import balance_figure
 from robodyn.simulate.trajectory import quintic
 
 
-def simulation_sections(robot: rd.Robot, out: Path) -> tuple[str, bool]:
-    """Run the chapter-3 demo steps, write their files into ``out``; return (HTML, all ok)."""
+def simulation_sections(robot: rd.Robot, out: Path, backend: str = "c") -> tuple[str, bool]:
+    """Run the chapter-3 demo steps, write their files into ``out``; return (HTML, all ok).
+
+    ``backend``: "c" (compiled) or "numpy" (no compiler needed) for every simulated model.
+    """
+    where = "generated C" if backend == "c" else "the NumPy backend"
     parts: list[str] = []
     code_dir = out / "code"
     with progress("generating C and Python code for the PUMA 560"):
@@ -27,8 +31,8 @@ def simulation_sections(robot: rd.Robot, out: Path) -> tuple[str, bool]:
     parts.append(f"<h2>Generated code</h2><p>Written: {listing}. <code>robodyn codegen ROBOT "
                  f"--lang c|python|octave|fortran|julia|latex|mex</code> writes the others.</p>")
 
-    with progress("computed-torque tracking of a quintic move (PUMA 560, compiled C)"):
-        model = rd.compile_model(robot)
+    with progress(f"computed-torque tracking of a quintic move (PUMA 560, {where})"):
+        model = rd.compile_model(robot, backend=backend)
         q0 = np.zeros(robot.dof)
         q1 = np.array([0.8, -0.6, 0.9, 0.5, -0.7, 1.0])[: robot.dof]
         plan = quintic(q0, q1, 2.0, dt=1e-3)
@@ -42,7 +46,7 @@ def simulation_sections(robot: rd.Robot, out: Path) -> tuple[str, bool]:
     ok_track = err < 1e-8
     parts.append(
         "<h2>Computed torque, PUMA 560</h2><p>Quintic move from zero to "
-        f"{html.escape(np.array2string(q1, precision=2))} rad in 2 s, RK4 at 1 ms in generated C, "
+        f"{html.escape(np.array2string(q1, precision=2))} rad in 2 s, RK4 at 1 ms in {where}, "
         f"K<sub>p</sub> = 400, K<sub>d</sub> = 40. Law evaluated at every RK4 stage (a "
         f"continuous-time controller): largest joint tracking error {err:.2e} rad, the "
         "integrator's own error ("
@@ -53,7 +57,8 @@ def simulation_sections(robot: rd.Robot, out: Path) -> tuple[str, bool]:
         " N m.</p>")
 
     with progress("LQR balance of the trolley double inverted pendulum"):
-        bal = balance_double_pendulum()
+        bal = balance_double_pendulum(
+            model=rd.compile_model(rd.load("trolley_double_pendulum"), backend=backend))
         fig = balance_figure(bal, out / "balance.png")
     parts.append(
         "<h2>Double inverted pendulum on a trolley (seed Fig. 3.1), LQR</h2>"
@@ -63,7 +68,7 @@ def simulation_sections(robot: rd.Robot, out: Path) -> tuple[str, bool]:
         + f'</p><img src="{fig.name}" alt="balance" style="max-width:100%">')
 
     with progress("AA300 study: plan, PD tracking, actuator sizing, animation"):
-        study = run_study(out / "aa300", animate=True)
+        study = run_study(out / "aa300", animate=True, backend=backend)
     imgs = "".join(f'<img src="aa300/{p.name}" alt="{p.stem}" style="max-width:100%">'
                    for p in study.figures)
     anim = (f'<img src="aa300/{study.animation.name}" alt="AA300 animation">'
