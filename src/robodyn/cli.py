@@ -21,6 +21,7 @@ import sympy as sp
 
 import robodyn as rd
 from robodyn.cli_cache import add_cache_parser
+from robodyn.cli_record import add_record_parser
 from robodyn.cli_workflows import add_parsers
 from robodyn.report.agreement import (
     AGREEMENT_HEADERS,
@@ -295,6 +296,7 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_export)
 
     add_parsers(sub, fmt, _ROBOT_HELP)
+    add_record_parser(sub, fmt, _ROBOT_HELP)
     add_cache_parser(sub, fmt)
 
     p = sub.add_parser("demo", help="PUMA 560 three ways: files, comparison and HTML report",

@@ -94,7 +94,7 @@ class _Table:
         try:
             frame = pd.read_csv(io.StringIO("\n".join(kept)), sep=delimiter,
                                 header=0 if header else None, skip_blank_lines=False,
-                                engine="c", low_memory=False)
+                                engine="c", low_memory=False, keep_default_na=False)
         except (pd.errors.ParserError, ValueError) as exc:
             raise RecordingError(f"{self.name}: cannot parse as delimited text "
                                  f"({' '.join(str(exc).split())})") from None
@@ -122,19 +122,30 @@ class _Table:
                 shown = ", ".join(self.columns[:12]) + (", ..." if len(self.columns) > 12 else "")
                 why = f"the file's columns: {shown}"
             raise RecordingError(f"{self.name}: {field}: {self._label(column)} not in the file ({why})")
-        series = self.frame.iloc[:, column] if isinstance(column, int) else self.frame[column]
-        values = pd.to_numeric(series, errors="coerce").to_numpy(dtype=float)
+        series = self._series(column)
+        values = pd.to_numeric(series, errors="coerce").to_numpy(dtype=float, copy=True)
         bad = ~np.isfinite(values)
         if allow_empty:
-            bad &= series.notna().to_numpy()
+            bad &= (series != "").to_numpy()
         if bad.any():
-            k = int(np.argmax(bad))
-            cell = series.iloc[k]
-            reason = "empty cell" if pd.isna(cell) else (
-                f"{cell!r} is not a number" if isinstance(cell, str) else f"{cell} (not finite)")
-            raise RecordingError(f"{self.name}: {self._label(column)} ({field}): {reason} at line "
-                                 f"{self.line[k]} ({int(bad.sum())} bad cell(s) in this column)")
+            self.fail(column, field, bad)
+        if allow_empty:
+            values[(series == "").to_numpy()] = np.nan
         return values
+
+    def _series(self, column: str | int) -> pd.Series:
+        return self.frame.iloc[:, column] if isinstance(column, int) else self.frame[column]
+
+    def fail(self, column: str | int, field: str, bad: np.ndarray) -> None:
+        """Raise for the first bad cell of ``column`` (a boolean mask over the rows)."""
+        k = int(np.argmax(bad))
+        cell = self._series(column).iloc[k]
+        if isinstance(cell, str):
+            reason = "empty cell" if cell.strip() == "" else f"{cell!r} is not a finite number"
+        else:
+            reason = f"{cell} is not a finite number"
+        raise RecordingError(f"{self.name}: {self._label(column)} ({field}): {reason} at line "
+                             f"{self.line[k]} ({int(bad.sum())} bad cell(s) in this column)")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -291,7 +302,7 @@ def _read_native(p: Path) -> Recording:
     t_all = table.column("t", "t", allow_empty=True)
     n = int(np.argmax(np.isnan(t_all))) if np.isnan(t_all).any() else t_all.size
     if not np.isnan(t_all[n:]).all():
-        raise RecordingError(f"{p.name}: column 't': empty cell at line {table.line[n]}")
+        table.fail("t", "t", np.arange(t_all.size) == n)
     arrays: dict[str, Any] = {}
     for field, cols in fields.items():
         if cols != names:
@@ -305,9 +316,8 @@ def _read_native(p: Path) -> Recording:
         if field in ("tau", "current", "temperature"):
             bad &= ~np.all(bad, axis=0)
         if bad.any():
-            r, c = np.argwhere(bad)[0]
-            raise RecordingError(f"{p.name}: column '{field}[{names[c]}]': empty cell at line "
-                                 f"{table.line[r]}")
+            c = int(np.argwhere(bad)[0][1])
+            table.fail(f"{field}[{names[c]}]", field, bad[:, c])
         arrays[field] = head
     tool: dict[str, Any] = {}
     if "tool_t" in table.columns:
