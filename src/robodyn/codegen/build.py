@@ -1,13 +1,23 @@
 """Compile generated C into a shared library in a content-addressed cache, and load it.
 
 The cache directory (``$ROBODYN_CACHE``, else ``$XDG_CACHE_HOME/robodyn``, else
-``~/.cache/robodyn``) holds one ``<hash>.so`` per distinct source and compiler command. A library
-is compiled into a private temporary file and renamed into place, so concurrent processes never
-see a half-written library and at worst compile the same thing twice.
+``~/.cache/robodyn``) is created private to the user (mode 0700) and holds one ``rd_<hash>.so``
+per distinct source and compiler command, with a manifest ``rd_<hash>.so.sha256`` (size and
+SHA-256 of the library) beside it; the compiled models also keep their generated sources there
+(``rd_model_<hash>.c``/``.cdef``/``.py``). A library is compiled into a private temporary
+folder and renamed into place, so concurrent processes never see a half-written library and at
+worst compile the same thing twice. A library whose size or hash does not match its manifest (a
+truncated or altered file) is compiled again before it is loaded.
+
+Size limit: after each compilation the least recently used files (by modification time, which
+loading a library refreshes) are removed until the cache holds at most ``$ROBODYN_CACHE_MAX_MB``
+megabytes (default :data:`DEFAULT_CACHE_MAX_MB`); the library just built is always kept.
+``robodyn cache info`` and ``robodyn cache clear`` show and empty the cache.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import platform
@@ -18,6 +28,26 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import cffi
+
+__all__ = [
+    "CFLAGS",
+    "DEFAULT_CACHE_MAX_MB",
+    "CacheInfo",
+    "CompiledLibrary",
+    "CompilerNotFoundError",
+    "cache_dir",
+    "cache_info",
+    "cache_limit",
+    "clear_cache",
+    "compile_library",
+    "find_compiler",
+]
+
+#: Default size limit of the cache, megabytes (``$ROBODYN_CACHE_MAX_MB`` overrides it).
+DEFAULT_CACHE_MAX_MB = 1024
+
+_ENTRY_PREFIX = "rd_"
+_MANIFEST = ".sha256"
 
 #: Flags: IEEE arithmetic without reassociation (no -ffast-math: results must match the symbolic
 #: model), but with ``a * b + c`` contracted to fused multiply-adds where the CPU has them (one
@@ -49,16 +79,158 @@ class CompiledLibrary:
     lib: object
 
 
-def cache_dir() -> Path:
-    """The compiled-model cache directory (created when missing)."""
+def cache_dir(*, create: bool = True) -> Path:
+    """The compiled-model cache directory.
+
+    Parameters
+    ----------
+    create : bool
+        Create it (mode 0700: other users can neither read nor plant libraries) when missing.
+
+    Returns
+    -------
+    Path
+    """
     root = os.environ.get("ROBODYN_CACHE")
     if root:
         path = Path(root)
     else:
         base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
         path = Path(base) / "robodyn"
-    path.mkdir(parents=True, exist_ok=True)
+    if create and not path.is_dir():
+        path.mkdir(mode=0o700, parents=True, exist_ok=True)
+        os.chmod(path, 0o700)  # mkdir's mode is filtered by the umask
     return path
+
+
+@dataclass(frozen=True)
+class CacheInfo:
+    """What the cache holds.
+
+    Attributes
+    ----------
+    path : Path
+        The cache directory.
+    entries : int
+        Compiled libraries (``rd_*.so``).
+    files : int
+        All robodyn files (libraries, manifests, generated sources).
+    size : int
+        Total size of those files, bytes.
+    limit : int
+        Size limit, bytes (``$ROBODYN_CACHE_MAX_MB``).
+    """
+
+    path: Path
+    entries: int
+    files: int
+    size: int
+    limit: int
+
+
+def cache_limit() -> int:
+    """The cache size limit in bytes (``$ROBODYN_CACHE_MAX_MB``, default 1024 MB).
+
+    Raises
+    ------
+    ValueError
+        When the variable is set to something other than a non-negative number.
+    """
+    text = os.environ.get("ROBODYN_CACHE_MAX_MB", "").strip()
+    if not text:
+        return DEFAULT_CACHE_MAX_MB * 2**20
+    try:
+        mb = float(text)
+    except ValueError:
+        mb = -1.0
+    if not mb >= 0 or mb == float("inf"):
+        raise ValueError(f"ROBODYN_CACHE_MAX_MB={text!r}: expected a non-negative number of "
+                         "megabytes")
+    return int(mb * 2**20)
+
+
+def _entries(directory: Path) -> list[Path]:
+    """robodyn's own files in the cache (never anything else the folder holds)."""
+    if not directory.is_dir():
+        return []
+    return [p for p in directory.iterdir() if p.name.startswith(_ENTRY_PREFIX) and p.is_file()]
+
+
+def cache_info() -> CacheInfo:
+    """Location, number of compiled libraries, files and total size of the cache."""
+    directory = cache_dir(create=False)
+    files = _entries(directory)
+    size = sum(_size(p) for p in files)
+    libraries = sum(p.suffix == ".so" for p in files)
+    return CacheInfo(directory, libraries, len(files), size, cache_limit())
+
+
+def clear_cache() -> tuple[int, int]:
+    """Remove robodyn's files from the cache; returns (files removed, bytes freed)."""
+    directory = cache_dir(create=False)
+    removed = freed = 0
+    for p in _entries(directory):
+        size = _size(p)
+        try:
+            p.unlink()
+        except FileNotFoundError:
+            continue  # another process removed it
+        removed, freed = removed + 1, freed + size
+    if directory.is_dir():
+        for tmp in directory.glob(".build-*"):
+            shutil.rmtree(tmp, ignore_errors=True)  # left by an interrupted compilation
+    return removed, freed
+
+
+def _size(path: Path) -> int:
+    try:
+        return path.stat().st_size
+    except OSError:
+        return 0
+
+
+def _evict(directory: Path, keep: Path) -> None:
+    """Remove least recently used entries until the cache is within its limit.
+
+    An entry is a file with its manifest (``rd_<hash>.so`` and ``rd_<hash>.so.sha256``), used
+    when the newer of the two was modified.
+    """
+    limit = cache_limit()
+    groups: dict[str, list[tuple[float, int, Path]]] = {}
+    for p in _entries(directory):
+        try:
+            st = p.stat()
+        except OSError:
+            continue
+        groups.setdefault(p.name.removesuffix(_MANIFEST), []).append((st.st_mtime, st.st_size, p))
+    total = sum(size for files in groups.values() for _, size, _ in files)
+    for name, files in sorted(groups.items(), key=lambda g: max(f[0] for f in g[1])):
+        if total <= limit:
+            break
+        if name == keep.name:
+            continue
+        for _, size, p in files:
+            with contextlib.suppress(OSError):
+                p.unlink()
+                total -= size
+
+
+def _digest(path: Path) -> str:
+    """``"<size> <sha256>"`` of a file."""
+    h = hashlib.sha256()
+    with path.open("rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return f"{path.stat().st_size} {h.hexdigest()}"
+
+
+def _intact(target: Path) -> bool:
+    """Whether a cached library exists and matches its manifest (size and SHA-256)."""
+    manifest = target.with_name(target.name + _MANIFEST)
+    try:
+        return manifest.read_text().strip() == _digest(target)
+    except OSError:
+        return False
 
 
 def find_compiler() -> str:
@@ -100,8 +272,12 @@ def compile_library(source: str, declarations: str, flags: tuple[str, ...] = CFL
     compiler = find_compiler()
     # -march=native code is only valid on this kind of processor: it is part of the key
     key = hashlib.sha256("\0".join([source, compiler, *flags, _cpu_id()]).encode()).hexdigest()[:24]
-    target = cache_dir() / f"rd_{key}.so"
-    if not target.exists():
+    target = cache_dir() / f"{_ENTRY_PREFIX}{key}.so"
+    if _intact(target):
+        with contextlib.suppress(OSError):
+            os.utime(target)  # most recently used: evicted last
+    else:
+        # missing, or truncated/altered since it was built: compile (again)
         with tempfile.TemporaryDirectory(dir=target.parent, prefix=".build-") as tmp:
             src = Path(tmp) / "model.c"
             src.write_text(source)
@@ -111,8 +287,12 @@ def compile_library(source: str, declarations: str, flags: tuple[str, ...] = CFL
             if proc.returncode != 0:
                 raise RuntimeError(f"compiling the generated model failed ({compiler}):\n"
                                    f"{proc.stderr[-4000:]}")
-            # atomic: other processes see the old state or the whole library
+            manifest = Path(tmp) / "model.so.sha256"
+            manifest.write_text(_digest(out) + "\n")
+            # atomic: other processes see the old state or the whole library (then its manifest)
             os.replace(out, target)
+            os.replace(manifest, target.with_name(target.name + _MANIFEST))
+        _evict(target.parent, keep=target)
     ffi = cffi.FFI()
     ffi.cdef(declarations)
     lib = ffi.dlopen(str(target))

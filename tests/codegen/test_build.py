@@ -1,0 +1,129 @@
+"""The compiled-model cache: private directory, corrupt entries rebuilt, size limit, CLI."""
+
+from __future__ import annotations
+
+import os
+import stat
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from robodyn.cli import main
+from robodyn.codegen import build
+from robodyn.codegen.build import cache_info, cache_limit, clear_cache, compile_library
+
+DECL = "double rd_test_twice(double x);"
+
+
+def source(k: int) -> str:
+    """A tiny distinct C library (one cache entry each)."""
+    return f"double rd_test_twice(double x) {{ return 2.0 * x + {k}.0; }}\n"
+
+
+@pytest.fixture()
+def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    path = tmp_path / "cache" / "robodyn"
+    monkeypatch.setenv("ROBODYN_CACHE", str(path))
+    monkeypatch.delenv("ROBODYN_CACHE_MAX_MB", raising=False)
+    return path
+
+
+def run_fresh(k: int, cache: Path) -> subprocess.CompletedProcess:
+    """Compile-or-load ``source(k)`` in a fresh process (nothing already dlopen'ed)."""
+    code = ("from robodyn.codegen.build import compile_library\n"
+            f"lib = compile_library({source(k)!r}, {DECL!r})\n"
+            "print(lib.lib.rd_test_twice(1.5))\n")
+    env = {**os.environ, "ROBODYN_CACHE": str(cache)}
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=env, check=False, timeout=120)
+
+
+@pytest.mark.tool("cc")
+def test_cache_directory_is_private(cache: Path) -> None:
+    lib = compile_library(source(0), DECL)
+    assert lib.lib.rd_test_twice(1.5) == 3.0
+    assert stat.S_IMODE(cache.stat().st_mode) == 0o700
+    assert lib.path.parent == cache
+
+
+@pytest.mark.tool("cc")
+@pytest.mark.parametrize("damage", ["truncate", "flip", "no manifest"])
+def test_corrupt_entry_is_detected_and_rebuilt(cache: Path, damage: str) -> None:
+    first = run_fresh(1, cache)
+    assert first.returncode == 0, first.stderr
+    assert first.stdout.strip() == "4.0"
+    (so,) = cache.glob("rd_*.so")
+    good = so.read_bytes()
+    if damage == "truncate":  # an interrupted copy or a full disk: dlopen said "file too short"
+        so.write_bytes(good[: len(good) // 3])
+    elif damage == "flip":  # same size, different content: only the hash tells
+        so.write_bytes(good[:-100] + bytes(b ^ 0xFF for b in good[-100:]))
+    else:
+        so.with_name(so.name + ".sha256").unlink()
+    again = run_fresh(1, cache)
+    assert again.returncode == 0, again.stderr
+    assert again.stdout.strip() == "4.0"
+    assert so.read_bytes() == good  # the same compiler and flags give the same library
+    assert so.with_name(so.name + ".sha256").read_text().split() == [
+        str(len(good)), __import__("hashlib").sha256(good).hexdigest()]
+
+
+@pytest.mark.tool("cc")
+def test_least_recently_used_entries_are_evicted_beyond_the_limit(
+        cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    a, b = compile_library(source(10), DECL).path, compile_library(source(11), DECL).path
+    entry = sum(p.stat().st_size for p in cache.glob("rd_*"))  # two entries
+    # room for about two entries: the third evicts the least recently used one
+    monkeypatch.setenv("ROBODYN_CACHE_MAX_MB", repr(entry * 1.2 / 2**20))
+    old = time.time() - 100
+    os.utime(a, (old, old))
+    os.utime(b, (old - 50, old - 50))
+    assert compile_library(source(10), DECL).lib.rd_test_twice(0.0) == 10.0  # uses a: now newest
+    c = compile_library(source(12), DECL).path
+    assert a.exists() and c.exists()
+    assert not b.exists() and not b.with_name(b.name + ".sha256").exists()
+    assert cache_info().size <= cache_limit()
+
+
+@pytest.mark.tool("cc")
+def test_an_entry_larger_than_the_limit_is_still_kept(cache, monkeypatch) -> None:
+    monkeypatch.setenv("ROBODYN_CACHE_MAX_MB", "0")
+    compile_library(source(20), DECL)
+    lib = compile_library(source(21), DECL)
+    assert [p.name for p in sorted(cache.glob("rd_*.so"))] == [lib.path.name]
+
+
+@pytest.mark.parametrize("text", ["-1", "lots", "nan", "inf"])
+def test_bad_limit_is_a_clear_error(monkeypatch, text) -> None:
+    monkeypatch.setenv("ROBODYN_CACHE_MAX_MB", text)
+    with pytest.raises(ValueError, match=rf"ROBODYN_CACHE_MAX_MB={text!r}: expected a "
+                                         "non-negative number of megabytes"):
+        cache_limit()
+
+
+@pytest.mark.tool("cc")
+def test_cli_cache_info_and_clear_leave_other_files_alone(cache: Path, capsys) -> None:
+    compile_library(source(30), DECL)
+    compile_library(source(31), DECL)
+    cache.joinpath("notes.txt").write_text("mine")  # a user's file in a shared $ROBODYN_CACHE
+    (cache / ".build-stale").mkdir()
+    size = sum(p.stat().st_size for p in cache.glob("rd_*"))
+    assert main(["cache", "info"]) == 0
+    out = capsys.readouterr().out
+    assert f"location  {cache}\n" in out
+    assert "entries   2 compiled libraries (4 files)" in out
+    assert f"size      {size / 2**20:.1f} MB ({size} bytes) of 1024.0 MB" in out
+    assert build.DEFAULT_CACHE_MAX_MB == 1024
+    assert main(["cache", "clear"]) == 0
+    assert f"removed 4 files ({size} bytes) from {cache}" in capsys.readouterr().out
+    assert sorted(p.name for p in cache.iterdir()) == ["notes.txt"]
+    assert clear_cache() == (0, 0)
+
+
+def test_cli_cache_info_before_the_cache_exists(cache: Path, capsys) -> None:
+    assert main(["cache", "info"]) == 0
+    assert f"location  {cache} (not created yet)" in capsys.readouterr().out
+    assert not cache.exists()  # info creates nothing
