@@ -1,0 +1,121 @@
+"""Bad recordings and specs: each error names the file, the field or column, the line and why."""
+
+import gzip
+
+import pytest
+
+import robodyn as rd
+from robodyn.robot.errors import RecordingError
+
+SPEC = {"joints": ["a", "b"], "time": {"column": "time", "unit": "ms"},
+        "position": {"columns": "pos{k}", "unit": "deg"}}
+GOOD = "time,pos1,pos2\n" + "".join(f"{k},{k * 0.1},{k * 0.2}\n" for k in range(20))
+
+
+def _read(tmp_path, text, spec=SPEC, name="run.csv"):
+    path = tmp_path / name
+    path.write_text(text)
+    before = path.read_bytes()
+    try:
+        return rd.read_recording(path, spec=spec)
+    finally:
+        assert path.read_bytes() == before  # input never modified
+
+
+def test_good_file_reads(tmp_path):
+    rec = _read(tmp_path, GOOD)
+    assert rec.n_samples == 20 and rec.dt == pytest.approx(1e-3)
+
+
+def test_missing_column(tmp_path):
+    text = GOOD.replace("pos2", "posX")
+    with pytest.raises(RecordingError, match=r"run.csv: position.columns\[1\]: column 'pos2' not in "
+                                             r"the file \(the file's columns: time, pos1, posX\)"):
+        _read(tmp_path, text)
+
+
+def test_spec_names_column_not_in_file(tmp_path):
+    spec = dict(SPEC, current={"columns": ["i1", "i2"], "unit": "A"})
+    with pytest.raises(RecordingError, match=r"run.csv: current.columns\[0\]: column 'i1' not in"):
+        _read(tmp_path, GOOD, spec)
+
+
+def test_non_monotonic_time(tmp_path):
+    text = GOOD.replace("\n7,", "\n5,")
+    with pytest.raises(RecordingError, match=r"run.csv: column 'time' \(time.column\): not strictly "
+                                             r"increasing at line 9 \(5 after 6 on line 8\)"):
+        _read(tmp_path, text)
+
+
+def test_nan_reports_row_and_column(tmp_path):
+    text = GOOD.replace("\n12,1.2000000000000002,2.4000000000000004", "\n12,NaN,2.4")
+    assert "12,NaN" in text
+    with pytest.raises(RecordingError, match=r"run.csv: column 'pos1' \(position.columns\[0\]\): "
+                                             r"'NaN' is not a finite number at line 14"):
+        _read(tmp_path, text)
+
+
+def test_unit_typo(tmp_path):
+    spec = dict(SPEC, position={"columns": "pos{k}", "unit": "degs"})
+    with pytest.raises(RecordingError, match=r"spec: position.unit: unknown unit 'degs' \(expected "
+                                             r"one of rad, deg, counts, m, mm\)"):
+        _read(tmp_path, GOOD, spec)
+
+
+def test_unknown_key_in_spec_file(tmp_path):
+    spec = tmp_path / "arm.yaml"
+    spec.write_text("joints: 2\ntime: {column: time, unit: ms}\n"
+                    "position: {columns: 'pos{k}', unit: deg, gear: 100}\n")
+    with pytest.raises(RecordingError, match=r"arm.yaml: position.gear: unknown key \(expected one "
+                                             r"of columns, unit, sign, offset, gear_ratio"):
+        _read(tmp_path, GOOD, spec)
+
+
+def test_mixed_row_lengths(tmp_path):
+    text = GOOD.replace("\n4,0.4,0.8", "\n4,0.4,0.8,9")
+    with pytest.raises(RecordingError, match=r"run.csv: line 6: 4 fields, but the header \(line 1\) "
+                                             r"has 3"):
+        _read(tmp_path, text)
+
+
+def test_empty_file_and_header_only(tmp_path):
+    with pytest.raises(RecordingError, match=r"run.csv: empty file \(no header and no data rows\)"):
+        _read(tmp_path, "")
+    with pytest.raises(RecordingError, match=r"run.csv: header only, no data rows \(line 1\)"):
+        _read(tmp_path, "time,pos1,pos2\n")
+
+
+def test_gzip_and_headerless_tsv(tmp_path):
+    path = tmp_path / "run.tsv.gz"
+    path.write_bytes(gzip.compress(GOOD.split("\n", 1)[1].replace(",", "\t").encode()))
+    spec = {"header": False, "joints": 2, "time": {"column": 0, "unit": "s"},
+            "position": {"columns": [1, 2], "unit": "rad"}}
+    rec = rd.read_recording(path, spec=spec)
+    assert rec.joint_names == ("q1", "q2") and rec.q[3, 1] == pytest.approx(0.6)
+    spec["position"]["columns"] = [1, 5]
+    with pytest.raises(RecordingError, match=r"run.tsv.gz: position.columns\[1\]: column 5 "
+                                             r"\(0-based\) not in the file \(the file has 3 columns\)"):
+        rd.read_recording(path, spec=spec)
+
+
+def test_spec_value_errors(tmp_path):
+    bad = [
+        (dict(SPEC, time={"column": "time", "unit": "index"}), r"time.period: with unit 'index'"),
+        (dict(SPEC, position={"columns": "pos", "unit": "rad"}),
+         r"position.columns: a column pattern must contain \{k\}"),
+        (dict(SPEC, position={"columns": "pos{k}", "unit": "counts"}), r"position.counts_per_rev: needed"),
+        (dict(SPEC, position={"columns": "pos{k}", "unit": "rad", "sign": [1, 2]}),
+         r"position.sign: each sign must be 1 or -1"),
+        (dict(SPEC, couplings=[{"joint": "c", "add": {"a": 1}}]), r"couplings\[0\].joint: 'c'"),
+        (dict(SPEC, torque={"from": "current", "torque_constant": 0.1}),
+         r"torque.from: 'current' needs a current block"),
+        (dict(SPEC, current={"columns": "pos{k}", "unit": "V"}), r"current.gain: needed for unit 'V'"),
+    ]
+    for spec, message in bad:
+        with pytest.raises(RecordingError, match=r"spec: " + message):
+            _read(tmp_path, GOOD, spec)
+
+
+def test_not_own_layout_without_spec(tmp_path):
+    with pytest.raises(RecordingError, match=r"run.csv: spec: the file is not in robodyn's own layout"):
+        _read(tmp_path, GOOD, None)
