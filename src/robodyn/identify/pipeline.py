@@ -8,8 +8,10 @@ Steps (each a function of its own module):
 3. base parameters of the robot (:mod:`robodyn.identify.base`, Gautier's QR on random states);
 4. identification matrix: the compiled, batched regressor ``Y(q, qd, qdd)`` (N, n, 15 n) of every
    sample, restricted to the base columns and stacked, one row per joint per sample;
-5. ``target="current"``: each row scaled by the joint's drive gain ``K_j`` (N m / A) so that the
-   fit is in torque units, ``K_j i_j = Y_j p`` (:func:`drive_gains`);
+5. the prior (:mod:`robodyn.identify.prior`): the description's inertial parameters with each
+   joint's rotor inertia and friction (and, for ``target="current"``, its drive gain ``K_j``,
+   N m / A) fitted joint by joint; rows of a current target are scaled by ``K_j`` so that the fit
+   is in torque units, ``K_j i_j = Y_j p``;
 6. estimate (:mod:`robodyn.identify.estimate`, :mod:`robodyn.identify.consistent`);
 7. the full standard parameter set and a :class:`Robot` carrying it.
 """
@@ -25,6 +27,7 @@ import sympy as sp
 from robodyn.identify.base import base_relations
 from robodyn.identify.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identify.preprocess import Preprocess, Samples, preprocess, resolve_preprocess
+from robodyn.identify.prior import joint_prior
 from robodyn.identify.result import BaseParameters, Identification
 from robodyn.identify.to_robot import robot_with_parameters
 from robodyn.numeric.model import Model, compile_model
@@ -32,7 +35,7 @@ from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
 from robodyn.symbolic.regressor import parameter_values
 
-__all__ = ["check_recording", "drive_gains", "identify", "nominal_standard"]
+__all__ = ["check_recording", "identify", "nominal_standard"]
 
 TARGETS = ("tau", "current")
 METHODS = ("ols", "wls", "consistent")
@@ -100,49 +103,6 @@ def _description_gains(robot: Robot) -> np.ndarray:
                      for j in robot.joints])
 
 
-def drive_gains(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.ndarray],
-                nominal: np.ndarray, mode: str) -> tuple[np.ndarray, str]:
-    """Drive gains ``K_j`` (n,) in N m / A and where they come from.
-
-    ``mode="description"``: ``K_j = |G_j k_t,j|`` from the description's drives. ``"absorbed"``:
-    per joint, the current is regressed on the description's own torque prediction and the
-    joint's drive and friction columns, ``i_j = tau_nom,j / K_j + Ia qdd_j + friction``, so
-    ``K_j`` is the gain that scales the nominal rigid-body model onto the measured current (it
-    also absorbs a uniform error of the nominal link masses on that joint, e.g. an unmodelled
-    tool). ``"auto"``: description gains when any differs from 1 (the default drive), otherwise
-    absorbed.
-    """
-    desc = _description_gains(robot)
-    if mode == "description" or (mode == "auto" and np.any(np.abs(desc - 1.0) > 1e-12)):
-        if np.any(desc <= 0):
-            j = int(np.argmin(desc))
-            raise IdentificationError(f"{robot.source}: joints[{j}].drive: gear_ratio x "
-                                      f"torque_constant is {desc[j]:g}; a current target needs a "
-                                      f"positive drive gain (or gains='absorbed')")
-        return desc, "description"
-    n = robot.dof
-    gains = np.ones(n)
-    for j in range(n):
-        rows, rhs = [], []
-        for s, y in zip(samples, y_full, strict=True):
-            tau_nom = y[:, j, :] @ nominal
-            qd = s.qd[:, j]
-            rows.append(np.column_stack([tau_nom, s.qdd[:, j], qd, qd > 0, -(qd < 0.0),
-                                         np.ones_like(qd)]))
-            rhs.append(s.y[:, j])
-        a, b = np.vstack(rows), np.concatenate(rhs)
-        used = np.linalg.norm(a, axis=0) > 1e-12
-        coef, *_ = np.linalg.lstsq(a[:, used], b, rcond=None)
-        inv_k = coef[0] if used[0] else 0.0
-        if not used[0] or inv_k <= 0:
-            raise IdentificationError(
-                f"joint {robot.joint_names[j]!r} (joints[{j}]): its drive gain cannot be absorbed: "
-                f"the nominal torque does not explain the current (1/K = {inv_k:g}); give the "
-                f"gain in the description's drive (gear_ratio x torque_constant)")
-        gains[j] = 1.0 / inv_k
-    return gains, "absorbed"
-
-
 def _stack(samples: Sequence[Samples], y_full: Sequence[np.ndarray], columns: np.ndarray,
            gains: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``Phi`` (m, b), ``y`` (m,), joint of each row, CV block of each row (m = sum N_k n)."""
@@ -167,7 +127,8 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     Parameters
     ----------
     robot : Robot
-        The nominal description (its values are the prior of the regularisation).
+        The nominal description (with per-joint drive and friction fits, the prior of the
+        regularisation: :mod:`robodyn.identify.prior`).
     recordings : Recording or sequence of Recording
         Measured runs, joints in the robot's order: ``t`` (N,) s, ``q`` (N, n) and the target
         ``tau`` or ``current`` (N, n).
@@ -188,7 +149,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     velocity : {"position", "measured"}
         Joint velocities from the filtered positions (default) or the filtered measured ones.
     gains : {"auto", "description", "absorbed"}
-        Drive gains for ``target="current"`` (:func:`drive_gains`).
+        Drive gains for ``target="current"`` (:func:`robodyn.identify.prior.joint_prior`).
     bounds : dict of str to (float, float), optional
         Box constraints on named standard parameters for ``method="consistent"``
         (e.g. ``{"M7": (0.3, 2.0)}`` for a known payload range).
@@ -234,22 +195,19 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
             f"= {count * robot.dof} equations after decimation by {settings.decimate} for {b} base "
             f"parameters (at least {2 * b} needed; record longer or pass decimate=1)")
     nominal = nominal_standard(robot)
-    if target == "current":
-        k, k_source = drive_gains(robot, samples, y_full, nominal, gains)
-    else:
-        k, k_source = np.ones(robot.dof), "none"
+    k, k_source, prior = joint_prior(robot, samples, y_full, nominal, target, gains)
     phi, y, joint, blocks = _stack(samples, y_full, relations.independent, k)
-    theta0 = relations.to_base(nominal)
+    theta0 = relations.to_base(prior)
     lin_method = "ols" if method == "ols" else "wls"
     fit = fit_linear(phi, y, theta0, joint, blocks, method=lin_method, regularization=regularization)
     if method == "consistent":
         from robodyn.identify.consistent import consistent_standard
 
-        standard = consistent_standard(robot, relations, phi, y, joint, fit, nominal, bounds)
+        standard = consistent_standard(robot, relations, phi, y, joint, fit, prior, bounds)
         theta = relations.to_base(standard)
     else:
         theta = fit.theta
-        standard = _complete(relations, theta, nominal)
+        standard = _complete(relations, theta, prior)
     table = _table(relations, theta, fit, theta0)
     ident_robot = robot_with_parameters(robot, standard, k if target == "current" else None,
                                         source=f"identified ({method}) from {robot.source}")

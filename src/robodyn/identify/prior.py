@@ -1,0 +1,120 @@
+"""The prior of an identification: the description, completed joint by joint from the data.
+
+Descriptions usually give masses and inertias (a CAD model, a manufacturer's URDF) but neither
+friction nor reflected rotor inertia, and motor currents come without the drive gains. So the
+prior toward which :mod:`robodyn.identify.estimate` regularises is built in one cheap step, one
+joint at a time, from the same identification samples::
+
+    y_j = a_j tau_nom,j + Ia_j qdd_j + Fv_j qd_j + Fcp_j H(qd_j) - Fcn_j H(-qd_j) + Fo_j
+
+with ``tau_nom = Y(q, qd, qdd) p_nom`` the description's rigid-body torque (its own rotor inertia
+and friction left out). For ``target="tau"``, ``a_j = 1`` is fixed. For ``target="current"``:
+
+* gains from the description (``"description"``, or ``"auto"`` when any joint's
+  ``gear_ratio x torque_constant`` differs from 1, the default drive): ``a_j = 1 / K_j`` fixed;
+* otherwise (``"absorbed"``) ``a_j`` is fitted and ``K_j = 1 / a_j``: the gain that scales the
+  description's rigid-body torque onto the measured current. It thereby also absorbs a uniform
+  error of the nominal load on that joint (an unmodelled tool); what is then identified are
+  parameters in the torque units of the description's model, and currents ``i_j = tau_j / K_j``.
+
+The prior's standard vector is the description's inertial parameters with ``(Ia, Fv, Fcp, Fcn,
+Fo)`` of each joint replaced by the fitted ones, in torque units (multiplied by ``K_j``); Coulomb
+levels and rotor inertia are clipped at zero.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import sympy as sp
+
+from robodyn.identify.preprocess import Samples
+from robodyn.robot.errors import IdentificationError
+from robodyn.robot.model import Robot
+from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
+
+__all__ = ["GAIN_MODES", "description_gains", "joint_prior"]
+
+GAIN_MODES = ("auto", "description", "absorbed")
+
+
+def description_gains(robot: Robot) -> np.ndarray:
+    """``|gear_ratio x torque_constant|`` of each joint (n,), N m / A."""
+    subs = robot.defaults()
+    return np.array([abs(float(sp.sympify(j.drive.gear_ratio * j.drive.torque_constant).xreplace(subs)))
+                     for j in robot.joints])
+
+
+def _joint_columns(s: Samples, j: int) -> np.ndarray:
+    qd = s.qd[:, j]
+    # Ia qdd + Fv qd + Fcp H(qd) - Fcn H(-qd) + Fo
+    return np.column_stack([s.qdd[:, j], qd, (qd > 0).astype(float), -(qd < 0).astype(float),
+                            np.ones_like(qd)])
+
+
+def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.ndarray],
+                nominal: np.ndarray, target: str, mode: str
+                ) -> tuple[np.ndarray, str, np.ndarray]:
+    """Drive gains, their source and the prior standard vector (module docstring).
+
+    Parameters
+    ----------
+    robot : Robot
+    samples : sequence of Samples
+        Processed, decimated samples with targets ``y`` (N_k, n).
+    y_full : sequence of numpy.ndarray, shape (N_k, n, 15 n)
+        Full regressor at those samples.
+    nominal : numpy.ndarray, shape (15 n,)
+    target : {"tau", "current"}
+    mode : {"auto", "description", "absorbed"}
+
+    Returns
+    -------
+    gains : numpy.ndarray, shape (n,)
+        ``K_j`` (ones for torque targets).
+    source : {"none", "description", "absorbed"}
+    prior : numpy.ndarray, shape (15 n,)
+    """
+    n = robot.dof
+    rigid = nominal.copy()
+    for j in range(n):
+        rigid[PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)] = 0.0
+    desc = description_gains(robot)
+    if target == "tau":
+        fixed, source = np.ones(n), "none"
+    elif mode == "description" or (mode == "auto" and np.any(np.abs(desc - 1.0) > 1e-12)):
+        if np.any(desc <= 0):
+            j = int(np.argmin(desc))
+            raise IdentificationError(f"{robot.source}: joints[{j}].drive: gear_ratio x "
+                                      f"torque_constant is {desc[j]:g}; a current target needs a "
+                                      f"positive drive gain (or gains='absorbed')")
+        fixed, source = desc, "description"
+    else:
+        fixed, source = None, "absorbed"
+    gains = np.ones(n) if fixed is None else fixed.copy()
+    prior = rigid.copy()
+    for j in range(n):
+        tau_nom = np.concatenate([y[:, j, :] @ rigid for y in y_full])
+        cols = np.vstack([_joint_columns(s, j) for s in samples])
+        b = np.concatenate([s.y[:, j] for s in samples])
+        if fixed is None:
+            a = np.column_stack([tau_nom, cols])
+        else:
+            a, b = cols, b - tau_nom / fixed[j]
+        used = np.linalg.norm(a, axis=0) > 1e-12 * max(1.0, float(np.abs(a).max()))
+        coef = np.zeros(a.shape[1])
+        coef[used] = np.linalg.lstsq(a[:, used], b, rcond=None)[0]
+        if fixed is None:
+            if not used[0] or coef[0] <= 0:
+                raise IdentificationError(
+                    f"joint {robot.joint_names[j]!r} (joints[{j}]): its drive gain cannot be "
+                    f"absorbed: the description's torque does not explain the current "
+                    f"(1/K = {coef[0]:g}); give the gain in the description's drive "
+                    f"(gear_ratio x torque_constant)")
+            gains[j] = 1.0 / coef[0]
+            coef = coef[1:]
+        ia, fv, fcp, fcn, fo = coef * gains[j]
+        prior[PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)] = (
+            max(ia, 0.0), fv, max(fcp, 0.0), max(fcn, 0.0), fo)
+    return gains, source, prior
