@@ -31,6 +31,7 @@ from robodyn.report.agreement import (
     agreement_rows,
     count_rows,
     derive_all,
+    verdict,
 )
 from robodyn.report.demo import run_demo
 from robodyn.report.text import err as _err
@@ -157,7 +158,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
           f"(tolerance {TOLERANCE:g})")
     print(_table(AGREEMENT_HEADERS, agreement_rows(results)))
     ok = all(r.ok for r in results)
-    print("\nresult: " + ("the three formulations agree" if ok else "the formulations DISAGREE"))
+    print("\nresult: " + verdict(results))
     return 0 if ok else 1
 
 

@@ -30,17 +30,27 @@ class Agreement:
         ``max over states of max|a - b| / max(max|a|, max|b|)`` per quantity ("M", "g", "tau").
     symbolic : bool or None
         Whether every simplified difference is zero (None: not checked).
+    zero : tuple of str
+        Quantities that are identically zero on every state in both formulations: nothing was
+        compared. ``g`` may be (gravity normal to the motion); ``M`` and ``tau`` may not.
+    singular : bool
+        ``M`` is singular (smallest eigenvalue below 1e-12 of the largest) at some state in
+        either formulation: the equations have no forward dynamics.
     """
 
     first: str
     second: str
     relative: dict[str, float]
     symbolic: bool | None = None
+    zero: tuple[str, ...] = ()
+    singular: bool = False
 
     @property
     def ok(self) -> bool:
-        """Within :data:`TOLERANCE` (and symbolically equal where checked)."""
-        return max(self.relative.values()) <= TOLERANCE and self.symbolic is not False
+        """Within :data:`TOLERANCE`, symbolically equal where checked, M and tau not zero, M regular."""
+        vacuous = "M" in self.zero or "tau" in self.zero
+        return (max(self.relative.values()) <= TOLERANCE and self.symbolic is not False
+                and not vacuous and not self.singular)
 
 
 def _evaluator(eom: rd.EquationsOfMotion) -> Callable[..., dict[str, np.ndarray]]:
@@ -71,6 +81,15 @@ def _states(n: int, count: int, seed: int) -> list[tuple[np.ndarray, np.ndarray,
     rng = np.random.default_rng(seed)
     return [(rng.uniform(-np.pi, np.pi, n), rng.uniform(-2, 2, n), rng.uniform(-3, 3, n))
             for _ in range(count)]
+
+
+def _singular(matrices: Sequence[np.ndarray]) -> bool:
+    """True when some (n, n) matrix has an eigenvalue at or below 1e-12 of its largest."""
+    for m in matrices:
+        lam = np.linalg.eigvalsh(0.5 * (m + m.T))
+        if lam[0] <= 1e-12 * max(abs(lam[-1]), 1e-300):
+            return True
+    return False
 
 
 def _symbolically_equal(a: rd.EquationsOfMotion, b: rd.EquationsOfMotion) -> bool:
@@ -120,12 +139,28 @@ def agreement(eoms: Sequence[rd.EquationsOfMotion], samples: int = 20, seed: int
                     diff = np.max(np.abs(va - vb))
                     worst = max(worst, diff / scale if scale > 0 else diff)
                 rel[k] = float(worst)
+            # identically zero in both: agreement that compared nothing
+            zero = tuple(k for k in _QUANTITIES
+                         if all(not np.any(v) for v in values[a.method][k] + values[b.method][k]))
+            singular = _singular(values[a.method]["M"]) or _singular(values[b.method]["M"])
             same = None
             if symbolic:
                 with _progress(f"simplifying {a.method} - {b.method}"):
                     same = _symbolically_equal(a, b)
-            out.append(Agreement(a.method, b.method, rel, same))
+            out.append(Agreement(a.method, b.method, rel, same, zero, singular))
     return out
+
+
+def verdict(results: Sequence[Agreement]) -> str:
+    """One line for the end of ``robodyn check``: agree, disagree, or nothing to compare."""
+    if any("M" in r.zero or "tau" in r.zero for r in results):
+        return ("M and tau are identically zero (no mass or inertia moves): the formulations "
+                "compared nothing")
+    if any(r.singular for r in results):
+        return "the mass matrix is singular at some states: no forward dynamics"
+    if all(r.ok for r in results):
+        return "the three formulations agree"
+    return "the formulations DISAGREE"
 
 
 def derive_all(robot: rd.Robot) -> list[rd.EquationsOfMotion]:
@@ -159,8 +194,14 @@ def agreement_rows(results: Sequence[Agreement]) -> list[list[object]]:
     rows = []
     for r in results:
         sym = {None: "-", True: "yes", False: "NO"}[r.symbolic]
-        rows.append([f"{r.first} vs {r.second}"] + [f"{r.relative[k]:.1e}" for k in _QUANTITIES]
-                    + [sym, "ok" if r.ok else "DISAGREE"])
+        cells = ["0 (both zero)" if k in r.zero else f"{r.relative[k]:.1e}" for k in _QUANTITIES]
+        if "M" in r.zero or "tau" in r.zero:
+            verdict = "NOTHING COMPARED (M, tau zero)"
+        elif r.singular:
+            verdict = "M SINGULAR"
+        else:
+            verdict = "ok" if r.ok else "DISAGREE"
+        rows.append([f"{r.first} vs {r.second}", *cells, sym, verdict])
     return rows
 
 
