@@ -62,6 +62,10 @@ def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
     sections, sim_ok = simulation_sections(robot, out, backend)
     cal_section, cal_ok = _calibration_section(out)
     sections += "\n" + cal_section
+    from robodyn.report.identification_report import kinova_section
+
+    kinova_html, kinova_ok = kinova_section(out)
+    sections += "\n" + kinova_html
     page = _html_page(robot, counts, results, samples, teom, closed,
                       render_mathml(teom), render_latex(teom), render_text(teom))
     page = page.replace("</body></html>", sections + "\n</body></html>")
@@ -76,7 +80,7 @@ def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
     print("chapter 3 (computed torque, balance): " + ("ok" if sim_ok else "FAILED"))
     print("chapter 4 (calibration study, held-out error within 1.3x the noise): "
           + ("ok" if cal_ok else "FAILED"))
-    return 0 if all(r.ok for r in results) and closed and sim_ok and cal_ok else 1
+    return 0 if all(r.ok for r in results) and closed and sim_ok and cal_ok and kinova_ok else 1
 
 
 def demo_backend() -> str:

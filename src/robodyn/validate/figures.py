@@ -48,11 +48,12 @@ def prediction_figure(val: Validation, path: Path) -> Path:
     Path
     """
     fig, axes = _grid(val.dof)
-    t = val.t - val.t[0]
+    s = slice(None, None, max(1, len(val.t) // 4000))  # at most ~4000 points per line
+    t = val.t[s] - val.t[0]
     for k, ax in enumerate(axes):
-        ax.plot(t, val.measured[:, k], color="0.7", lw=0.6, label="measured")
-        ax.plot(t, val.filtered[:, k], color="k", lw=0.9, label="measured, filtered")
-        ax.plot(t, val.predicted[:, k], color="C3", lw=1.0, label="predicted")
+        ax.plot(t, val.measured[s, k], color="0.7", lw=0.6, label="measured")
+        ax.plot(t, val.filtered[s, k], color="k", lw=0.9, label="measured, filtered")
+        ax.plot(t, val.predicted[s, k], color="C3", lw=1.0, label="predicted")
         ax.set_ylabel(f"{val.joint_names[k]} / {val.unit}", fontsize=8)
         ax.set_title(f"rel. {val.prediction.relative[k]:.3f}, noise floor "
                      f"{val.noise.relative[k]:.3f}", fontsize=8)

@@ -175,7 +175,8 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
         Measured ``t``, ``q`` (and ``qd``/``qdd``, measured or estimated by the recording) and the
         target ``tau`` (N m) or ``current`` (A). Joints are matched to the robot by name.
     target : {"tau", "current"}, optional
-        What to compare; default: ``tau`` when the recording has it, else ``current``.
+        What to compare; default: ``ident.target`` when ``ident`` is given, else ``tau`` when
+        the recording has it, else ``current``.
     ident : object with ``predict(recording) -> (N, n)``, optional
         An identification result (:func:`robodyn.identify`); when given, its prediction (which
         processes the raw recording as identification did) replaces the model's inverse
@@ -183,8 +184,8 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
     model : Model, optional
         ``compile_model(robot)`` when already at hand.
     gains : (n,) array_like, optional
-        Joint torque per motor ampere for ``target="current"`` (default: the robot's drives,
-        ``|gear_ratio| * torque_constant``).
+        Joint torque per motor ampere for ``target="current"`` (default: ``ident.gains`` when
+        ``ident`` is given, else the robot's drives, ``|gear_ratio| * torque_constant``).
     window : float or None
         Simulation window, s (None: no simulation check).
     noise_cutoff : float
@@ -205,6 +206,8 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
     """
     rec = in_chain_order(robot, recording)
     where = getattr(rec, "source", "") or "recording"
+    if target is None and ident is not None:
+        target = getattr(ident, "target", None)
     tgt = resolve_target(rec, target)
     t = np.array(rec.t, dtype=float)  # copies: the result's arrays are frozen, the user's are not
     if len(t) < MIN_SAMPLES:
@@ -223,6 +226,11 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
     q, qd, qdd = arrays["q"], arrays["qd"], arrays["qdd"]
     if model is None:
         model = compile_model(robot, backend=backend)
+    if ident is not None and getattr(ident, "target", tgt) != tgt:
+        raise ValidationError(f"{where}: the identification predicts {ident.target!r}, but "
+                              f"target={tgt!r} was asked for")
+    if ident is not None and gains is None and tgt == "current" and hasattr(ident, "gains"):
+        gains = ident.gains  # the gains the identification divided its torque by
     k = drive_gains(robot, model.parameters) if tgt == "current" and gains is None else None
     if tgt == "current" and gains is not None:
         k = np.asarray(gains, dtype=float).reshape(-1)

@@ -1,0 +1,315 @@
+"""HTML of identification and validation: parameter tables, validation sections, Kinova Gen3 demo.
+
+Each function returns an HTML fragment (and writes its figures next to it), so the reports and
+the demo page can place them wherever they like.
+"""
+
+from __future__ import annotations
+
+import html
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robodyn.report.html import html_table, page
+from robodyn.validate.validation import Validation
+
+__all__ = ["KINOVA_CONTROLLER_GAINS", "combined_relative", "identification_html",
+           "kinova_section", "parameter_table", "validation_html", "validation_section"]
+
+#: The Kinova controller's torque per ampere (``TorqueCur = k Cur``, see the data README), N m/A.
+KINOVA_CONTROLLER_GAINS = np.array([9.13, 9.13, 9.13, 9.13, 5.852, 5.852, 5.852])
+#: The README's baseline on the last 30 % of the whole-arm runs: raw and filtered current.
+KINOVA_BASELINE = (0.32, 0.22)
+
+
+def combined_relative(vals: Sequence[Validation], filtered: bool = False,
+                      joints: Sequence[int] | None = None) -> float:
+    """``||E|| / ||Y||`` over several validations together (Frobenius norms, joints with data).
+
+    Parameters
+    ----------
+    vals : sequence of Validation
+    filtered : bool
+        Against the filtered target instead of the raw one.
+    joints : sequence of int, optional
+        Only these joints (default: all).
+    """
+    num = den = 0.0
+    for v in vals:
+        y = v.filtered if filtered else v.measured
+        cols = list(range(v.dof)) if joints is None else list(joints)
+        e, yy = (v.predicted - y)[:, cols], y[:, cols]
+        has = ~np.all(np.isnan(yy), axis=0)
+        num += float(np.sum(e[:, has] ** 2))
+        den += float(np.sum(yy[:, has] ** 2))
+    return float(np.sqrt(num / den)) if den > 0 else float("nan")
+
+
+def validation_section(val: Validation, out: Path, folder: str, stem: str, heading: str,
+                       kinds: Sequence[str] = ("prediction", "friction", "errors", "spectra"),
+                       level: int = 3) -> str:
+    """One validation as HTML: per-joint table, noise floor, figures (written to ``out/folder``).
+
+    Parameters
+    ----------
+    val : Validation
+    out : Path
+        The report's folder.
+    folder : str
+        Sub-folder of ``out`` for the figures (relative links).
+    stem : str
+        File name stem of the figures.
+    heading : str
+    kinds : sequence of {"prediction", "friction", "errors", "spectra"}
+        Figures to draw.
+    level : int
+        HTML heading level.
+    """
+    from robodyn.validate import figures
+
+    draw = {"prediction": figures.prediction_figure, "friction": figures.friction_figure,
+            "errors": figures.error_histogram_figure, "spectra": figures.spectra_figure}
+    imgs = []
+    for kind in kinds:
+        path = draw[kind](val, out / folder / f"{stem}_{kind}.png")
+        imgs.append(f'<img src="{html.escape(folder)}/{html.escape(path.name)}" alt="{kind}" '
+                    'style="max-width:100%">')
+    notes = "".join(f"<li>{html.escape(n)}</li>" for n in val.notes)
+    sim = ""
+    if val.simulation is not None:
+        s = val.simulation
+        sim = (f" Simulation: {len(s.starts)} windows of {s.window:g} s from the measured state, "
+               f"driven by the measured torque (RK4 at {s.dt * 1e3:.3g} ms); drift = median "
+               f"|q<sub>sim</sub> &minus; q<sub>meas</sub>| at the end of a window, beside the "
+               f"drift of a constant-velocity guess" + (f"; {s.failed} windows failed" if s.failed
+                                                        else "") + ".")
+    est = (f" Estimated from positions: {html.escape(', '.join(sorted(val.estimated)))}."
+           if val.estimated else "")
+    return f"""<h{level}>{html.escape(heading)}</h{level}>
+<p>{html.escape(val.robot)} against <code>{html.escape(val.source)}</code>, target
+{html.escape(val.target)} ({html.escape(val.unit)}), {len(val.t)} samples over
+{val.t[-1] - val.t[0]:.3g} s. Whole arm: relative error <b>{val.prediction.total_relative:.3f}</b>
+against the raw target, {val.prediction_filtered.total_relative:.3f} against the filtered target;
+<b>noise floor {val.noise.total_relative:.3f}</b> (raw minus zero-phase {val.noise.cutoff:g} Hz
+low-pass: the error a perfect model of the filtered signal would still show).{sim}{est}</p>
+{html_table(val.table_headers(), val.table_rows())}
+{f"<ul>{notes}</ul>" if notes else ""}
+{"".join(imgs)}"""
+
+
+def parameter_table(ident: Any) -> str:
+    """The identified base parameters with standard deviations, as an HTML table."""
+    bp = ident.base_parameters
+    rows = []
+    for i, name in enumerate(bp.names):
+        rows.append([name, f"{bp.values[i]:.6g}", f"{bp.std[i]:.3g}",
+                     f"{bp.relative_std[i]:.3g}", f"{bp.nominal[i]:.6g}",
+                     "yes" if bp.identifiable[i] else "NO", str(bp.relations[i])])
+    headers = ("parameter", "estimate", "std", "rel. std / %", "description", "excited",
+               "combination of standard parameters")
+    return html_table(headers, rows)
+
+
+def identification_html(ident: Any, validations: Sequence[tuple[str, Validation]], out: Path,
+                        sources: Sequence[str], name: str = "report.html") -> Path:
+    """Write the HTML report of an identification and its validations into ``out``.
+
+    Parameters
+    ----------
+    ident : Identification
+    validations : sequence of (str, Validation)
+        Heading and result, e.g. the training runs and the held-out ``--validate`` runs.
+    out : Path
+    sources : sequence of str
+        The identification data files.
+    name : str
+        File name of the page.
+    """
+    sections = "\n".join(validation_section(v, out, "figures", f"val{i}_{_slug(v.source)}", head)
+                         for i, (head, v) in enumerate(validations))
+    gains = ", ".join(f"{g:.4g}" for g in ident.gains)
+    body = f"""<h1>Identification of {html.escape(ident.robot.name)}</h1>
+<p class="meta">Method <b>{html.escape(ident.method)}</b>, target {html.escape(ident.target)},
+{ident.samples} samples from {html.escape(", ".join(sources))}. Condition number
+{ident.condition:.3g}; Tikhonov weight toward the description {ident.regularization:.3g};
+drive gains ({html.escape(ident.gains_source)}): {gains} N m/A; filter cut-off
+{_cutoff(ident)}.</p>
+<h2>Base parameters</h2>
+<p>Standard deviations from the residual variance; parameters the data do not excite keep the
+description's value (std inf).</p>
+{parameter_table(ident)}
+<h2>Validation</h2>
+{sections}"""
+    path = out / name
+    path.write_text(page(f"robodyn identification: {ident.robot.name}", body), encoding="utf-8")
+    return path
+
+
+def validation_html(val: Validation, out: Path, name: str = "validation.html") -> Path:
+    """Write a one-page HTML report of one validation (figures in ``out/figures``)."""
+    body = (f"<h1>Validation of {html.escape(val.robot)}</h1>\n"
+            + validation_section(val, out, "figures", _slug(val.source), "Measured against model",
+                                 level=2))
+    path = out / name
+    path.write_text(page(f"robodyn validation: {val.robot}", body), encoding="utf-8")
+    return path
+
+
+def _cutoff(ident: Any) -> str:
+    c = getattr(getattr(ident, "preprocess", None), "cutoff", None)
+    return "none" if c is None else f"{c:.3g} Hz"
+
+
+def _slug(text: str) -> str:
+    stem = Path(text).name.split(".")[0] or "recording"
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in stem)
+
+
+# ----------------------------------------------------------------------------------------------
+# Kinova Gen3 demo section
+# ----------------------------------------------------------------------------------------------
+
+
+def kinova_section(out: Path, data_dir: Path | None = None, method: str = "wls") -> tuple[str, bool]:
+    """The demo's Kinova Gen3 section: identify on whole-arm runs, validate on held-out data.
+
+    Identification on the first 70 % of each whole-arm run (``identification_data``), validation
+    on the last 30 % of each and on every jointwise run (``jointwise_motion``; errors of the
+    moving joint), beside the manufacturer's URDF model with the controller's current-to-torque
+    gains, and a per-joint table against the URDF's parameters.
+
+    Parameters
+    ----------
+    out : Path
+        The demo's folder; figures go to ``out/kinova``.
+    data_dir : Path, optional
+        The recordings (default: ``../shared/data/kinova-gen3`` beside the repository root).
+    method : {"ols", "wls", "consistent"}
+
+    Returns
+    -------
+    (str, bool)
+        The HTML section, and whether it ran (True also when the data are absent: it says so).
+    """
+    import robodyn as rd
+    from robodyn.report.text import progress
+
+    data_dir = Path(data_dir) if data_dir is not None else _default_data_dir()
+    head = "<h2>Validation against measurements: Kinova Gen3 (chapter 5)</h2>"
+    runs = sorted((data_dir / "identification_data").glob("*.csv.gz"))
+    jointwise = sorted((data_dir / "jointwise_motion").glob("joint_*_trapez.csv.gz"))
+    if not runs:
+        return (f"{head}\n<p>The Kinova Gen3 recordings were not found in "
+                f"<code>{html.escape(str(data_dir))}</code>; this section is skipped.</p>", True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the URDF's plausibility notes are shown by 'robodyn show'
+        robot = rd.load("kinova_gen3")
+        model = rd.compile_model(robot)
+        train, test = [], []
+        for path in runs:
+            rec = rd.read_recording(path, spec="kinova_gen3", robot=robot)
+            cut = rec.t[0] + 0.7 * (rec.t[-1] - rec.t[0])
+            train.append(rec.slice(rec.t[0], cut))
+            test.append(rec.slice(cut, rec.t[-1]))
+        with progress(f"Kinova Gen3: identify ({method}, current) on the first 70 % of "
+                      f"{len(runs)} whole-arm runs"):
+            ident = rd.identify(robot, train, target="current", method=method)
+        gains = KINOVA_CONTROLLER_GAINS
+        folder = out / "kinova"
+        held_id, held_urdf, parts = [], [], []
+        with progress("Kinova Gen3: validating on the held-out 30 % and the jointwise runs"):
+            for rec in test:
+                v_id = rd.validate(ident.robot, rec, "current", ident=ident)
+                v_urdf = rd.validate(robot, rec, "current", model=model, gains=gains)
+                held_id.append(v_id)
+                held_urdf.append(v_urdf)
+                parts.append(validation_section(v_id, out, "kinova", f"heldout_{_slug(rec.source)}",
+                                                f"Held-out last 30 % of {rec.source}, identified "
+                                                "model", kinds=("prediction", "friction"), level=4))
+            joint_rows = []
+            jw_id: dict[int, Validation] = {}
+            jw_urdf: dict[int, Validation] = {}
+            for path in jointwise:
+                rec = rd.read_recording(path, spec="kinova_gen3", robot=robot)
+                j = int(path.name.split("_")[1]) - 1
+                jw_id[j] = rd.validate(ident.robot, rec, "current", ident=ident)
+                jw_urdf[j] = rd.validate(robot, rec, "current", model=model, gains=gains)
+                parts.append(validation_section(jw_id[j], out, "kinova", f"jointwise_{j + 1}",
+                                                f"{rec.source}: joint {j + 1} moves, identified "
+                                                "model", kinds=("prediction",), level=4))
+        folder.mkdir(parents=True, exist_ok=True)
+    raw, filt = combined_relative(held_id), combined_relative(held_id, filtered=True)
+    raw_u, filt_u = combined_relative(held_urdf), combined_relative(held_urdf, filtered=True)
+    noise = float(np.sqrt(sum(np.nansum((v.measured - v.filtered) ** 2) for v in held_id)
+                          / sum(np.nansum(v.measured**2) for v in held_id)))
+    base_raw, base_filt = KINOVA_BASELINE
+    summary = [["identified (" + method + ")", f"{raw:.3f}", f"{filt:.3f}", f"{noise:.3f}",
+                "below" if raw < base_raw else "NOT below"],
+               ["manufacturer URDF", f"{raw_u:.3f}", f"{filt_u:.3f}", f"{noise:.3f}",
+                "below" if raw_u < base_raw else "NOT below"]]
+    for j in range(robot.dof):
+        joint_rows.append(_joint_row(j, robot, ident, held_id, held_urdf, jw_id.get(j),
+                                     jw_urdf.get(j)))
+    line = (f"Kinova Gen3 held-out relative current error: identified ({method}) {raw:.4f} "
+            f"(filtered {filt:.4f}), manufacturer {raw_u:.4f} (filtered {filt_u:.4f}); noise floor "
+            f"{noise:.4f}; README baseline {base_raw} ({base_filt} filtered)")
+    (folder / "summary.txt").write_text(line + "\n", encoding="utf-8")
+    print(line)
+    section = f"""{head}
+<p>Real recordings of a Kinova Gen3 (<code>{html.escape(str(data_dir))}</code>; see its README:
+the <code>Torque</code> columns are a model output, so the target is the measured motor current).
+Identification: <code>rd.identify(robot, runs, target="current", method="{method}")</code> on the
+first 70 % of each whole-arm run ({", ".join(html.escape(p.name) for p in runs)}); condition number
+{ident.condition:.3g}, Tikhonov weight {ident.regularization:.3g}, drive gains
+{html.escape(ident.gains_source)}. Validation: <code>rd.validate</code> on the last 30 % of each
+run and on every jointwise run. The manufacturer's model is the URDF's inertial parameters with
+the controller's current-to-torque constants (9.13 N m/A joints 1&ndash;4, 5.852 N m/A joints
+5&ndash;7), no friction and no rotor inertia.</p>
+<h3>Held-out current error (last 30 % of the whole-arm runs, all joints together)</h3>
+{html_table(("model", "relative error (raw)", "against filtered", "noise floor",
+             f"vs README baseline {base_raw} / {base_filt}"), summary)}
+<h3>Per joint, against the manufacturer's URDF</h3>
+<p>Relative current error of each joint on the held-out data and on the jointwise run in which
+only that joint moves (for its own current), for the identified and the manufacturer's model;
+beside them the identified drive gain and friction, and the URDF's and the identified link
+mass.</p>
+{html_table(_JOINT_HEADERS, joint_rows)}
+<details><summary>Identified base parameters</summary>{parameter_table(ident)}</details>
+{"".join(parts)}"""
+    return section, True
+
+
+_JOINT_HEADERS = ("joint", "held-out: identified", "held-out: URDF", "jointwise: identified",
+                  "jointwise: URDF", "jointwise noise floor", "gain / (N m/A)",
+                  "controller gain", "viscous / (N m s)", "Coulomb +/- / N m",
+                  "URDF mass / kg", "identified mass / kg")
+
+
+def _joint_row(j: int, robot: Any, ident: Any, held_id: Sequence[Validation],
+               held_urdf: Sequence[Validation], jw_id: Validation | None,
+               jw_urdf: Validation | None) -> list[object]:
+    fr = ident.robot.joints[j].friction
+
+    def num(x: object) -> float:
+        return float(x.subs(ident.robot.defaults()) if hasattr(x, "subs") else x)
+
+    def jw(v: Validation | None, attr: str) -> str:
+        if v is None:
+            return "-"
+        return f"{v.noise.relative[j]:.3f}" if attr == "noise" else f"{v.prediction.relative[j]:.3f}"
+
+    return [robot.joint_names[j], f"{combined_relative(held_id, joints=[j]):.3f}",
+            f"{combined_relative(held_urdf, joints=[j]):.3f}", jw(jw_id, "id"), jw(jw_urdf, "id"),
+            jw(jw_id, "noise"), f"{ident.gains[j]:.4g}", f"{KINOVA_CONTROLLER_GAINS[j]:.4g}",
+            f"{num(fr.viscous):.4g}",
+            f"{num(fr.coulomb_positive):.3g} / {num(fr.coulomb_negative):.3g}",
+            f"{num(robot.links[j].mass):.4g}", f"{num(ident.robot.links[j].mass):.4g}"]
+
+
+def _default_data_dir() -> Path:
+    """``../shared/data/kinova-gen3`` beside the repository root (this file is in src/robodyn/)."""
+    return Path(__file__).resolve().parents[3].parent / "shared" / "data" / "kinova-gen3"
