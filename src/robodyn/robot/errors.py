@@ -9,6 +9,7 @@ __all__ = [
     "IdentificationError",
     "SimulationError",
     "SingularMassMatrixError",
+    "StudyError",
     "ValidationError",
 ]
 
@@ -71,6 +72,16 @@ class IdentificationError(ValueError):
     field or joint, the row where one matters, and the reason (joints that do not match the
     robot, too few samples for the parameters, values that are not finite, an infeasible or
     failed semidefinite program).
+    """
+
+
+class StudyError(ValueError):
+    """A parameter study (``rd.sweep`` or a study file) cannot run as given.
+
+    The message names the study file and field where one applies (e.g. ``"study.yaml:
+    parameters.payload: min 50 > max 10"``), the task or case, and the reason (an unknown
+    parameter, an empty or reversed range, a task that cannot be sent to Dask workers, a
+    scheduler that cannot be reached).
     """
 
 
