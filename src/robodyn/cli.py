@@ -1,8 +1,9 @@
 """``robodyn`` command line: parse, call the public API, print.
 
 Subcommands: ``list``, ``show``, ``derive``, ``check``, ``codegen``, ``export``, ``simulate``,
-``calibrate``, ``iso9283`` and ``demo`` (``robodyn --help``); the last three of those before
-``demo`` live in :mod:`robodyn.cli_workflows`.
+``calibrate``, ``iso9283``, ``identify``, ``validate`` and ``demo`` (``robodyn --help``);
+``simulate``, ``calibrate`` and ``iso9283`` live in :mod:`robodyn.cli_workflows`, ``identify`` and
+``validate`` in :mod:`robodyn.cli_identify`.
 Exit codes: 0 success; 1 the formulations disagree (check, demo) or the calibration did not
 converge (calibrate); 2 bad input (unknown robot, invalid description, unreadable data, unwritable
 output); 130 interrupted.
@@ -21,6 +22,7 @@ import sympy as sp
 
 import robodyn as rd
 from robodyn.cli_cache import add_cache_parser
+from robodyn.cli_identify import add_parsers as add_identify_parsers
 from robodyn.cli_record import add_record_parser
 from robodyn.cli_workflows import add_parsers
 from robodyn.report.agreement import (
@@ -36,6 +38,7 @@ from robodyn.report.agreement import (
 from robodyn.report.demo import run_demo
 from robodyn.report.text import err as _err
 from robodyn.report.text import progress as _progress
+from robodyn.report.text import steps as _steps
 from robodyn.report.text import table as _table
 from robodyn.robot.errors import DescriptionError
 from robodyn.symbolic.eom import METHODS
@@ -150,8 +153,11 @@ def _cmd_derive(args: argparse.Namespace) -> int:
 def _cmd_check(args: argparse.Namespace) -> int:
     robot = _load(args)
     print(f"{robot.name}: {robot.dof} joints ({_types(robot)}), {robot.source}")
-    eoms = derive_all(robot)
-    results = agreement(eoms, args.samples, args.seed, symbolic=robot.dof <= 2)
+    symbolic = robot.dof <= 2
+    # steps: derive and evaluate each formulation, and simplify each pair when symbolic
+    with _steps(2 * len(METHODS) + (3 if symbolic else 0), f"check {robot.name}"):
+        eoms = derive_all(robot)
+        results = agreement(eoms, args.samples, args.seed, symbolic=symbolic)
     print("\nderivation time and operations after common-subexpression elimination")
     print(_table(COUNT_HEADERS, count_rows(eoms)))
     print(f"\nagreement: max relative difference over {args.samples} random states "
@@ -297,6 +303,7 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_export)
 
     add_parsers(sub, fmt, _ROBOT_HELP)
+    add_identify_parsers(sub, fmt, _ROBOT_HELP)
     add_record_parser(sub, fmt, _ROBOT_HELP)
     add_cache_parser(sub, fmt)
 

@@ -1,0 +1,235 @@
+"""``robodyn identify`` and ``robodyn validate``: parsers and commands.
+
+Kept apart from :mod:`robodyn.cli` (which registers them); like the rest of the command line,
+these only parse, call the public API (``rd.read_recording``, ``rd.identify``, ``rd.validate``)
+and write or print the results.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+import robodyn as rd
+from robodyn.report.text import err, progress
+
+__all__ = ["add_parsers"]
+
+
+def _floats(text: str) -> np.ndarray:
+    """A comma-separated list of numbers (``9.13,9.13,5.85``); an argparse type."""
+    try:
+        return np.array([float(v) for v in text.replace(" ", "").split(",") if v], dtype=float)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
+
+
+def _gains(value: np.ndarray | None, n: int) -> np.ndarray | None:
+    if value is None:
+        return None
+    if value.size == 1:
+        return np.full(n, float(value[0]))
+    if value.size != n:
+        raise ValueError(f"--gains: expected 1 or {n} comma-separated values (one per joint), got "
+                         f"{value.size}")
+    return value
+
+
+def _read(paths: Sequence[str], spec: str | None, robot: rd.Robot, what: str) -> list:
+    recs = []
+    for path in tqdm(paths, desc=f"reading {what}", unit="file", leave=False, disable=len(paths) < 2):
+        recs.append(rd.read_recording(path, spec=spec, robot=robot))
+    return recs
+
+
+def _metric_rows(val: rd.Validation) -> list[list[object]]:
+    rows = []
+    for k, name in enumerate(val.joint_names):
+        drift = val.simulation.median_final[k] if val.simulation is not None else float("nan")
+        rows.append([val.source, name, val.target, val.unit, repr(float(val.prediction.rms[k])),
+                     repr(float(val.prediction.max[k])), repr(float(val.prediction.relative[k])),
+                     repr(float(val.prediction.nrmse[k])),
+                     repr(float(val.prediction_filtered.relative[k])),
+                     repr(float(val.noise.relative[k])), repr(float(drift)), int(val.moving[k])])
+    return rows
+
+
+_METRIC_HEADERS = ["source", "joint", "target", "unit", "rms", "max", "relative", "nrmse",
+                   "relative_filtered", "noise_floor", "median_drift_rad", "moving"]
+
+
+def _write_metrics(vals: Sequence[rd.Validation], path: Path) -> Path:
+    with path.open("w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(_METRIC_HEADERS)
+        for v in vals:
+            w.writerows(_metric_rows(v))
+    return path
+
+
+# ----------------------------------------------------------------------------------------------
+# identify
+# ----------------------------------------------------------------------------------------------
+
+
+def _cmd_identify(args: argparse.Namespace) -> int:
+    from robodyn.export.urdf import to_urdf
+    from robodyn.report.identification_report import identification_html
+    from robodyn.robot.yaml_writer import dump_yaml
+
+    robot = rd.load(args.robot)
+    out = Path(args.output)
+    out.mkdir(parents=True, exist_ok=True)
+    recs = _read(args.data, args.spec, robot, "identification data")
+    held = _read(args.validate or [], args.spec, robot, "validation data")
+    with progress(f"identifying {robot.name} ({args.method}, {len(recs)} recording(s))"):
+        ident = rd.identify(robot, recs, target=args.target, method=args.method,
+                            friction=args.friction)
+    stem = f"{robot.name}_identified"
+    paths = {"yaml": out / f"{stem}.yaml", "urdf": out / f"{stem}.urdf",
+             "parameters": out / "parameters.csv"}
+    paths["yaml"].write_text(dump_yaml(ident.robot), encoding="utf-8")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        paths["urdf"].write_text(to_urdf(ident.robot), encoding="utf-8")
+    for w in caught:
+        err(f"robodyn: note: URDF: {w.message}")
+    ident.base_parameters.to_frame().to_csv(paths["parameters"], index=False)
+    vals = []
+    jobs = [("identification data", r) for r in recs] + [("held-out (--validate)", r) for r in held]
+    for kind, rec in tqdm(jobs, desc="validating", unit="recording", leave=False):
+        vals.append((f"{kind}: {rec.source}", rd.validate(ident.robot, rec, ident=ident,
+                                                          window=args.window)))
+    paths["metrics"] = _write_metrics([v for _, v in vals], out / "validation.csv")
+    with progress("writing the report and its figures"):
+        paths["report"] = identification_html(ident, vals, out, [r.source for r in recs])
+    print(f"identified {len(ident.base_parameters)} base parameters of {robot.name} "
+          f"({args.method}, target {ident.target}); condition number {ident.condition:.3g}, "
+          f"Tikhonov weight {ident.regularization:.3g}")
+    print(ident.base_parameters)
+    for head, v in vals:
+        print(f"\n{head}")
+        print(v.summary())
+    print()
+    for kind, path in paths.items():
+        print(f"wrote {kind:<10} {path}")
+    return 0
+
+
+# ----------------------------------------------------------------------------------------------
+# validate
+# ----------------------------------------------------------------------------------------------
+
+
+def _cmd_validate(args: argparse.Namespace) -> int:
+    from robodyn.report.identification_report import validation_html
+
+    robot = rd.load(args.robot)
+    out = Path(args.output)
+    out.mkdir(parents=True, exist_ok=True)
+    recs = _read(args.data, args.spec, robot, "data")
+    with progress(f"compiling {robot.name}"):
+        model = rd.compile_model(robot)
+    gains = _gains(args.gains, robot.dof)
+    vals = []
+    for rec in tqdm(recs, desc="validating", unit="recording", leave=False, disable=len(recs) < 2):
+        vals.append(rd.validate(robot, rec, args.target, model=model, gains=gains,
+                                window=args.window, noise_cutoff=args.noise_cutoff))
+    paths = {"metrics": _write_metrics(vals, out / "validation.csv")}
+    with progress("writing the report and its figures"):
+        for i, v in enumerate(vals):
+            name = "validation.html" if len(vals) == 1 else f"validation_{i + 1}.html"
+            paths[f"report {i + 1}"] = validation_html(v, out, name)
+    for v in vals:
+        print(v.summary())
+        print()
+    for kind, path in paths.items():
+        print(f"wrote {kind:<10} {path}")
+    return 0
+
+
+# ----------------------------------------------------------------------------------------------
+# parsers
+# ----------------------------------------------------------------------------------------------
+
+
+def add_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
+    """Register ``identify`` and ``validate`` on the ``robodyn`` sub-parsers."""
+    _identify_parser(sub, fmt, robot_help)
+    _validate_parser(sub, fmt, robot_help)
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--spec", metavar="S",
+                   help="recording spec for CSV files: a built-in name (kinova_gen3, robodyn), or a "
+                        "spec YAML file (default: robodyn's own CSV layout; MCAP needs none)")
+    p.add_argument("--target", choices=("tau", "current"),
+                   help="joint torque or motor current (default: torque when every file has it)")
+    p.add_argument("--window", type=float, default=0.2, metavar="S",
+                   help="simulation window, s: simulate from the measured state under the "
+                        "measured torque and report the drift (default: %(default)s)")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
+
+
+def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
+    p = sub.add_parser(
+        "identify", help="identify inertial, drive and friction parameters from recordings",
+        formatter_class=fmt,
+        description="Identify a robot's base inertial parameters, drive (rotor inertia, gain) and "
+                    "friction parameters from measured runs (rd.identify), then validate the "
+                    "result on the same runs and on held-out ones (rd.validate). Writes the "
+                    "identified description (ROBOT_identified.yaml and .urdf, readable by "
+                    "robodyn), parameters.csv (estimates, standard deviations, the standard "
+                    "parameters each base parameter combines), validation.csv (per-joint "
+                    "errors) and report.html with the figures.",
+        epilog="examples:\n"
+               "  robodyn identify kinova_gen3 --spec kinova_gen3 --target current \\\n"
+               "      --data run1.csv.gz run2.csv.gz --validate run3.csv.gz -o ident/\n"
+               "  robodyn identify my_arm.yaml --data bag.mcap --method consistent -o ident/")
+    p.add_argument("robot", metavar="ROBOT", help=robot_help)
+    p.add_argument("--data", required=True, nargs="+", metavar="FILE",
+                   help="identification recordings (CSV, CSV.gz or MCAP)")
+    p.add_argument("--validate", nargs="+", metavar="FILE", help="held-out recordings to validate on")
+    p.add_argument("--method", choices=("ols", "wls", "consistent"), default="wls",
+                   help="estimator: ordinary or weighted least squares, or physically consistent "
+                        "(pseudo-inertia LMIs) (default: %(default)s)")
+    p.add_argument("--friction", default="linear", metavar="MODEL",
+                   help="friction model of the fit (default: %(default)s: viscous, Coulomb +/-, "
+                        "offset)")
+    _common(p)
+    p.set_defaults(func=_cmd_identify)
+
+
+def _validate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
+    p = sub.add_parser(
+        "validate", help="validate a robot's model against recordings",
+        formatter_class=fmt,
+        description="Compare a robot's model with measured data (rd.validate): predicted against "
+                    "measured torque or motor current per joint (RMS, maximum, relative error, "
+                    "NRMSE, against the raw and the low-pass filtered target, with the noise "
+                    "floor), and short simulations from the measured state under the measured "
+                    "torque (drift per window). Writes validation.csv and validation.html with "
+                    "figures (measured vs predicted, friction curves, error histograms, residual "
+                    "spectra).",
+        epilog="examples:\n"
+               "  robodyn validate ident/kinova_gen3_identified.yaml --spec kinova_gen3 \\\n"
+               "      --data joint_2_trapez.csv.gz -o val/\n"
+               "  robodyn validate kinova_gen3 --spec kinova_gen3 --target current \\\n"
+               "      --gains 9.13,9.13,9.13,9.13,5.852,5.852,5.852 --data run.csv.gz -o val/")
+    p.add_argument("robot", metavar="ROBOT", help=robot_help)
+    p.add_argument("--data", required=True, nargs="+", metavar="FILE",
+                   help="recordings (CSV, CSV.gz or MCAP)")
+    p.add_argument("--gains", type=_floats, metavar="K",
+                   help="joint torque per motor ampere, N m/A, one or one per joint (default: the "
+                        "description's gear ratio x torque constant)")
+    p.add_argument("--noise-cutoff", type=float, default=10.0, metavar="HZ",
+                   help="low-pass cut-off separating the target from its noise (default: "
+                        "%(default)s)")
+    _common(p)
+    p.set_defaults(func=_cmd_validate)
