@@ -110,3 +110,19 @@ def test_the_file_is_not_modified(tmp_path):
     with pytest.raises(DataFileError):
         read_calibration_csv(path, robot("puma560"))
     assert path.read_bytes() == data
+
+
+def test_iso9283_single_cycle_and_huge_values_are_data_errors(tmp_path):
+    # found by tests/fuzz: a bare ValueError from the formulas, and an overflow RuntimeWarning
+    # (1.3e154 squared) turning into non-finite AP/RP
+    read = pose_characteristics_from_csv
+    raises(write(tmp_path, ISO_HEADER + ISO_ROWS[0] + ISO_ROWS[2]),
+           r"one cycle per pose; repeatability needs at least 2$", read)
+    huge = ISO_HEADER + ISO_ROWS[0] + ISO_ROWS[1].replace("0.5002", "1.3407807929942597e+154")
+    raises(write(tmp_path, huge), r"line 3, column 'z': 1\.3407807929942597e\+154 is out of range "
+           r"\(at most 1e\+06 in magnitude\)$", read)
+
+
+def test_calibration_values_beyond_1000_km_are_refused(tmp_path):
+    raises(write(tmp_path, HEADER + ROW.replace("1.0,", "2e6,")),
+           r"line 2, column 'x': 2e6 is out of range \(at most 1e\+06 in magnitude\)$")

@@ -30,11 +30,16 @@ from robodyn.output_names import output_path
 from robodyn.robot.errors import DataFileError
 from robodyn.robot.model import Robot
 
-__all__ = ["CalibrationData", "read_calibration_csv", "read_table", "write_calibration"]
+__all__ = ["MAX_ABS_VALUE", "CalibrationData", "read_calibration_csv", "read_table",
+           "write_calibration"]
+
+#: Largest magnitude of a measured value (m, rad, or a quaternion component) in a calibration or
+#: ISO 9283 file: 1000 km; beyond it squares overflow and nothing physical is measured.
+MAX_ABS_VALUE = 1e6
 
 
 def read_table(path: str | Path, required: Sequence[str], *, optional: Sequence[str] = (),
-               text_columns: Sequence[str] = ()) -> dict[str, list]:
+               text_columns: Sequence[str] = (), max_abs: float = math.inf) -> dict[str, list]:
     """Columns of a CSV file with a header row, as lists (numbers as floats).
 
     The file is UTF-8 text (a leading byte-order mark is accepted); blank lines and lines starting
@@ -50,6 +55,8 @@ def read_table(path: str | Path, required: Sequence[str], *, optional: Sequence[
         Columns read when present.
     text_columns : sequence of str
         Columns kept as text.
+    max_abs : float
+        Largest magnitude a number may have (a value beyond it is refused as out of range).
 
     Returns
     -------
@@ -63,14 +70,15 @@ def read_table(path: str | Path, required: Sequence[str], *, optional: Sequence[
         No such file.
     DataFileError
         Not a UTF-8 text file, no header or no data rows, a missing or repeated column, a row
-        with more or fewer values than the header, a value that is not a finite number: the
-        message names the file, the line and the column.
+        with more or fewer values than the header, a value that is not a finite number or is
+        out of range: the message names the file, the line and the column.
     """
-    return _read_table(path, required, optional, text_columns)[0]
+    return _read_table(path, required, optional, text_columns, max_abs)[0]
 
 
 def _read_table(path: str | Path, required: Sequence[str], optional: Sequence[str],
-                text_columns: Sequence[str]) -> tuple[dict[str, list], list[int]]:
+                text_columns: Sequence[str], max_abs: float = math.inf,
+                ) -> tuple[dict[str, list], list[int]]:
     """:func:`read_table` and the line number of each data row."""
     path = Path(path)
     if not path.exists():
@@ -111,6 +119,9 @@ def _read_table(path: str | Path, required: Sequence[str], optional: Sequence[st
             if not math.isfinite(value):
                 raise DataFileError(f"{path}: line {lineno}, column {c!r}: {text} is not a "
                                     "finite number")
+            if abs(value) > max_abs:
+                raise DataFileError(f"{path}: line {lineno}, column {c!r}: {text} is out of "
+                                    f"range (at most {max_abs:g} in magnitude)")
             out[c].append(value)
     return out, [lineno for lineno, _ in lines[1:]]
 
@@ -170,7 +181,7 @@ def read_calibration_csv(path: str | Path, robot: Robot) -> CalibrationData:
     """Read measured poses for ``robot`` from a calibration CSV (module docstring)."""
     joints = list(robot.joint_names)
     table, lines = _read_table(path, joints + ["x", "y", "z"],
-                               ["qw", "qx", "qy", "qz", "sigma"], ())
+                               ["qw", "qx", "qy", "qz", "sigma"], (), MAX_ABS_VALUE)
     q = np.column_stack([table[j] for j in joints])
     points = np.column_stack([table[c] for c in ("x", "y", "z")])
     orientations = None

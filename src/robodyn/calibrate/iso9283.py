@@ -257,12 +257,20 @@ def pose_characteristics_from_csv(path: str | Path) -> PoseCharacteristics:
 
     Columns (header row, any order; ``#`` lines are comments): ``pose`` (a label), ``x_cmd``,
     ``y_cmd``, ``z_cmd`` (commanded position, m) and ``x``, ``y``, ``z`` (attained, m); one row per
-    measurement; every pose needs the same number (>= 2) of cycles and one commanded position.
+    measurement; every pose needs the same number (>= 2) of cycles and one commanded position;
+    values are at most :data:`robodyn.calibrate.io.MAX_ABS_VALUE` in magnitude.
+
+    Raises
+    ------
+    FileNotFoundError, DataFileError
+        See :func:`robodyn.calibrate.io.read_table`; also a pose with two commanded positions,
+        poses with different numbers of cycles, or a single cycle.
     """
-    from robodyn.calibrate.io import read_table
+    from robodyn.calibrate.io import MAX_ABS_VALUE, read_table
     from robodyn.robot.errors import DataFileError
 
-    table = read_table(path, ["pose", "x_cmd", "y_cmd", "z_cmd", "x", "y", "z"], text_columns=("pose",))
+    table = read_table(path, ["pose", "x_cmd", "y_cmd", "z_cmd", "x", "y", "z"], text_columns=("pose",),
+                       max_abs=MAX_ABS_VALUE)
     labels = list(dict.fromkeys(table["pose"]))
     cmd, att = [], []
     for lab in labels:
@@ -275,5 +283,7 @@ def pose_characteristics_from_csv(path: str | Path) -> PoseCharacteristics:
     counts = {len(a) for a in att}
     if len(counts) != 1:
         raise DataFileError(f"{path}: poses have different numbers of cycles ({sorted(counts)})")
+    if counts == {1}:
+        raise DataFileError(f"{path}: one cycle per pose; repeatability needs at least 2")
     return pose_characteristics(np.array(cmd), np.array(att), labels=labels)
 
