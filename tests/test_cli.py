@@ -169,6 +169,9 @@ def test_demo_writes_report(tmp_path, capsys):
     assert page.startswith("<!DOCTYPE html>") and "<math" in page and "<script" not in page
     assert "http://" not in page and "https://" not in page  # opens without network
     assert "the three formulations agree" in page
+    # self-contained: every figure is embedded, none is a file beside the page
+    assert page.count("<img ") >= 3 and page.count("<img ") == page.count('<img src="data:image/')
+    assert "seed" not in page.lower()  # no internal jargon: "the thesis"
 
 
 # ----------------------------------------------------------------------------------------------

@@ -10,7 +10,7 @@ import numpy as np
 
 from robodyn.calibrate.result import Calibration, ErrorStats
 from robodyn.calibrate.simulate_study import StudyResult
-from robodyn.report.html import html_table, page
+from robodyn.report.html import figure, html_table, page
 
 __all__ = ["calibration_figure", "calibration_html", "study_section"]
 
@@ -110,7 +110,7 @@ right).</p>
 <p>"Before" is the nominal kinematics with only the instrument placement and the target offset
 fitted.</p>
 {html_table(_STATS_HEADERS, _stats_rows(stats))}
-<img src="{fig.name}" alt="errors before and after" style="max-width:100%">
+{figure(fig, "errors before and after")}
 <h2>Identified parameters</h2>
 {html_table(("parameter", "initial", "estimate", "std", "unit"), params)}
 <h2>Not identifiable</h2>
@@ -139,8 +139,7 @@ def study_section(study: StudyResult, folder: str) -> str:
                      f"{c.test_after.rms / noise_rms:.3f}"])
     headers = ("model", "initial", "noise / mm", "poses", "before RMS / mm", "after RMS / mm",
                "after max / mm", "vs truth RMS / mm", "after / noise RMS")
-    imgs = "".join(f'<img src="{folder}/{p.name}" alt="{p.stem}" style="max-width:100%">'
-                   for p in study.figures)
+    imgs = "".join(figure(p, p.stem) for p in study.figures)
     notes = "".join(f"<li>{html.escape(n)}</li>" for n in study.notes)
     n_test = len(study.test_q)
     return f"""<h2>Kinematic calibration of the PUMA 560 (simulation study, chapter 4)</h2>

@@ -1,15 +1,22 @@
-"""``make demo``: the PUMA 560 three ways, generated code, simulations, and an HTML report."""
+"""``make demo``: the PUMA 560 three ways, generated code, simulations, and an HTML report.
+
+The report is the ``demo.html.j2`` template around a list of sections. Each section comes from a
+:class:`DemoSection`: a function that runs one analysis, writes its files into the output folder
+and returns its HTML fragment and whether its checks passed. To add an analysis to the demo,
+write such a function and append one entry to :data:`SECTIONS`.
+"""
 
 from __future__ import annotations
 
 import csv
-import html
 import io
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 
 import sympy as sp
+from markupsafe import Markup
 
 import robodyn as rd
 from robodyn.report.agreement import (
@@ -21,12 +28,96 @@ from robodyn.report.agreement import (
     agreement_rows,
     count_rows,
     derive_all,
+    verdict,
 )
-from robodyn.report.html import CSS as _CSS
-from robodyn.report.html import html_table
+from robodyn.report.html import html_table, render
 from robodyn.report.simulation_sections import simulation_sections
-from robodyn.report.text import progress, table
+from robodyn.report.text import progress, steps, table
 from robodyn.symbolic.render import render_json, render_latex, render_mathml, render_text
+
+#: The thesis the demo re-creates, cited in the report.
+CITATION = ("The thesis: a PhD thesis on robotic manipulator modelling (dynamic formulations, "
+            "modelling packages, instrumentation of a PUMA 560, model validation, kinematic "
+            "calibration, underwater manipulators), whose abstract opens \"The accuracy and "
+            "performance of robotic manipulators are crucial to their commercial viability\"; its "
+            "author and title are not recorded in this project. Equation, figure and table numbers "
+            "in this report (eqs. 2.46-2.47, Fig. 3.1, Tables 3.1-3.2) are the thesis'.")
+
+
+@dataclass(frozen=True)
+class DemoContext:
+    """What every section builder gets: the output folder, the demo robot and the backend.
+
+    Attributes
+    ----------
+    out : Path
+        Output folder (exists); a section writes its files here or in a subfolder.
+    robot : Robot
+        The PUMA 560.
+    backend : str
+        "c" (compiled) or "numpy" (no compiler found) for every simulated model.
+    """
+
+    out: Path
+    robot: rd.Robot
+    backend: str
+
+
+@dataclass(frozen=True)
+class DemoSection:
+    """One analysis of the demo report.
+
+    Attributes
+    ----------
+    name : str
+        Printed at the end of the demo with "ok" or "FAILED".
+    build : callable
+        ``build(context: DemoContext) -> (html_fragment, ok)``; the fragment is trusted HTML
+        (escape anything that comes from data), its figures embedded with
+        :func:`robodyn.report.html.figure`.
+    steps : int
+        Number of :func:`robodyn.report.text.progress` steps it runs (for the progress bar).
+    """
+
+    name: str
+    build: Callable[[DemoContext], tuple[str, bool]]
+    steps: int = 1
+
+
+def _simulation(ctx: DemoContext) -> tuple[str, bool]:
+    return simulation_sections(ctx.robot, ctx.out, ctx.backend)
+
+
+def _calibration(ctx: DemoContext) -> tuple[str, bool]:
+    """Run the PUMA 560 calibration study into ``out/calibration``; (HTML section, all ok)."""
+    from robodyn.calibrate.simulate_study import puma_study
+    from robodyn.report.calibration_report import study_section
+
+    with progress("PUMA 560 calibration study (DH, Hayati, S-model, POE; 2 tracker noises)"):
+        study = puma_study(ctx.out / "calibration")
+    (ctx.out / "calibration" / "study.txt").write_text(study.table() + "\n\n"
+                                                       + "\n".join(study.notes) + "\n")
+    # every model but standard DH from the nominal start must explain all but the noise
+    ok = all(c.test_after.rms < 1.3 * c.sigma * 3**0.5 for c in study.cases
+             if (c.model, c.initial) != ("dh", "nominal"))
+    return study_section(study, "calibration"), ok
+
+
+def _kinova(ctx: DemoContext) -> tuple[str, bool]:
+    from robodyn.report.identification_report import kinova_section
+
+    return kinova_section(ctx.out)
+
+
+#: The report's analyses after the formulations, in page order.
+SECTIONS: list[DemoSection] = [
+    DemoSection("chapter 3 (computed torque, balance)", _simulation, steps=4),
+    DemoSection("chapter 4 (calibration study, held-out error within 1.3x the noise)", _calibration),
+    DemoSection("chapter 5 (Kinova Gen3 identification and validation)", _kinova, steps=2),
+]
+
+#: progress steps of run_demo itself: derive 3, evaluate 3, write 5, trolley 1
+_OWN_STEPS = 12
 
 
 def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
@@ -34,53 +125,39 @@ def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
     out = Path(output)
     out.mkdir(parents=True, exist_ok=True)
     robot = rd.load("puma560")
-    backend = demo_backend()
-    eoms = derive_all(robot)
-    results = agreement(eoms, samples, seed)
-    by_method = {e.method: e for e in eoms}
-    with progress("writing puma560_newton_euler.txt"):
-        (out / "puma560_newton_euler.txt").write_text(render_text(by_method["newton_euler"]))
-    for eom in eoms:
-        with progress(f"writing puma560_{eom.method}.json"):
-            (out / f"puma560_{eom.method}.json").write_text(render_json(eom))
-    with progress("writing puma560_equations.tex"):
-        (out / "puma560_equations.tex").write_text(render_latex(by_method["newton_euler"]))
-    trolley = rd.load("trolley_pendulum")
-    with progress("deriving trolley_pendulum (kane) and checking eqs. 2.46-2.47"):
-        teom = rd.derive(trolley, "kane")
-        closed = _trolley_closed_form_ok(teom)
-        (out / "trolley_pendulum.tex").write_text(render_latex(teom))
-    counts = count_rows(eoms)
-    csv_text = io.StringIO()
-    writer = csv.writer(csv_text, lineterminator="\n")
-    writer.writerow(["method", "derivation_time_s"] + [
-        f"{k}_{op}" for k in ("tau", "M", "g")
-        for op in ("additions", "multiplications", "functions")])
-    writer.writerows(counts)
-    (out / "comparison.csv").write_text(csv_text.getvalue())
-    (out / "comparison.md").write_text(_markdown(robot, counts, results, samples))
-    sections, sim_ok = simulation_sections(robot, out, backend)
-    cal_section, cal_ok = _calibration_section(out)
-    sections += "\n" + cal_section
-    from robodyn.report.identification_report import kinova_section
-
-    kinova_html, kinova_ok = kinova_section(out)
-    sections += "\n" + kinova_html
-    page = _html_page(robot, counts, results, samples, teom, closed,
-                      render_mathml(teom), render_latex(teom), render_text(teom))
-    page = page.replace("</body></html>", sections + "\n</body></html>")
+    ctx = DemoContext(out, robot, demo_backend())
+    with steps(_OWN_STEPS + sum(s.steps for s in SECTIONS), "demo"):
+        eoms = derive_all(robot)
+        results = agreement(eoms, samples, seed)
+        by_method = {e.method: e for e in eoms}
+        with progress("writing puma560_newton_euler.txt"):
+            (out / "puma560_newton_euler.txt").write_text(render_text(by_method["newton_euler"]))
+        for eom in eoms:
+            with progress(f"writing puma560_{eom.method}.json"):
+                (out / f"puma560_{eom.method}.json").write_text(render_json(eom))
+        with progress("writing puma560_equations.tex"):
+            (out / "puma560_equations.tex").write_text(render_latex(by_method["newton_euler"]))
+        with progress("deriving trolley_pendulum (kane) and checking eqs. 2.46-2.47"):
+            teom = rd.derive(rd.load("trolley_pendulum"), "kane")
+            closed = _trolley_closed_form_ok(teom)
+            (out / "trolley_pendulum.tex").write_text(render_latex(teom))
+        counts = count_rows(eoms)
+        (out / "comparison.csv").write_text(_csv(counts))
+        (out / "comparison.md").write_text(_markdown(robot, counts, results, samples))
+        built = [(s, *s.build(ctx)) for s in SECTIONS]
+    page = render("demo.html.j2", **_page_context(robot, counts, results, samples, teom, closed),
+                  sections=[Markup(fragment) for _, fragment, _ in built])
     (out / "report.html").write_text(page, encoding="utf-8")
     print(table(COUNT_HEADERS, counts))
     print()
     print(table(AGREEMENT_HEADERS, agreement_rows(results)))
-    print("\ntrolley pendulum (kane) equals the seed's eqs. 2.46-2.47: "
-          + ("yes" if closed else "NO"))
+    print("\ntrolley pendulum (kane) equals the thesis' eqs. 2.46-2.47: " + ("yes" if closed else "NO"))
     print(f"wrote {', '.join(sorted(p.name for p in out.iterdir()))} in {out}")
-    print(f"report: {(out / 'report.html').resolve()}")
-    print("chapter 3 (computed torque, balance): " + ("ok" if sim_ok else "FAILED"))
-    print("chapter 4 (calibration study, held-out error within 1.3x the noise): "
-          + ("ok" if cal_ok else "FAILED"))
-    return 0 if all(r.ok for r in results) and closed and sim_ok and cal_ok and kinova_ok else 1
+    print(f"report: {(out / 'report.html').resolve()} (self-contained: figures embedded)")
+    for section, _, ok in built:
+        print(f"{section.name}: " + ("ok" if ok else "FAILED"))
+    every = all(r.ok for r in results) and closed and all(ok for _, _, ok in built)
+    return 0 if every else 1
 
 
 def demo_backend() -> str:
@@ -96,23 +173,8 @@ def demo_backend() -> str:
     return "c"
 
 
-def _calibration_section(out: Path) -> tuple[str, bool]:
-    """Run the PUMA 560 calibration study into ``out/calibration``; (HTML section, all ok)."""
-    from robodyn.calibrate.simulate_study import puma_study
-    from robodyn.report.calibration_report import study_section
-
-    with progress("PUMA 560 calibration study (DH, Hayati, S-model, POE; 2 tracker noises)"):
-        study = puma_study(out / "calibration")
-    (out / "calibration" / "study.txt").write_text(study.table() + "\n\n"
-                                                   + "\n".join(study.notes) + "\n")
-    # every model but standard DH from the nominal start must explain all but the noise
-    ok = all(c.test_after.rms < 1.3 * c.sigma * 3**0.5 for c in study.cases
-             if (c.model, c.initial) != ("dh", "nominal"))
-    return study_section(study, "calibration"), ok
-
-
 def _trolley_closed_form_ok(eom: rd.EquationsOfMotion) -> bool:
-    """tau of the trolley pendulum equals the seed's eqs. 2.46-2.47 (solved for F and tau)."""
+    """tau of the trolley pendulum equals the thesis' eqs. 2.46-2.47 (solved for F and tau)."""
     big_m, m, length, g = (sp.Symbol(k, real=True) for k in ("M", "m", "l", "g"))
     q2 = eom.q[1]
     x_dd, th_dd, th_d = eom.qdd[0], eom.qdd[1], eom.qd[1]
@@ -128,6 +190,15 @@ def _trolley_closed_form_ok(eom: rd.EquationsOfMotion) -> bool:
 
 _CSV_NOTE = ("tau, M, g: additions (+), multiplications (*) and function calls (fn) after "
              "common-subexpression elimination (tau in its recursive form where there is one)")
+
+
+def _csv(counts: list[list[object]]) -> str:
+    text = io.StringIO()
+    writer = csv.writer(text, lineterminator="\n")
+    writer.writerow(["method", "derivation_time_s"] + [
+        f"{k}_{op}" for k in ("tau", "M", "g") for op in ("additions", "multiplications", "functions")])
+    writer.writerows(counts)
+    return text.getvalue()
 
 
 def _markdown(robot: rd.Robot, counts: list[list[object]], results: Sequence[Agreement],
@@ -146,43 +217,25 @@ def _markdown(robot: rd.Robot, counts: list[list[object]], results: Sequence[Agr
     return "\n".join(lines) + "\n"
 
 
-def _html_page(robot: rd.Robot, counts: list[list[object]], results: Sequence[Agreement],
-               samples: int, trolley: rd.EquationsOfMotion, closed_ok: bool, mathml: str,
-               latex: str, text: str) -> str:
-    ok = all(r.ok for r in results)
-    verdict = ('<span class="ok">the three formulations agree</span>' if ok
-               else '<span class="bad">the formulations disagree</span>')
-    closed = ('<span class="ok">yes</span>' if closed_ok else '<span class="bad">no</span>')
-    stamp = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8">
-<title>robodyn report: {html.escape(robot.name)}</title>
-<style>{_CSS}</style></head>
-<body>
-<h1>robodyn: equations of motion of the {html.escape(robot.name)}, three ways</h1>
-<p class="meta">robodyn {html.escape(rd.__version__)}, {stamp}. Source
-<code>{html.escape(robot.source)}</code>, description sha256
-<code>{robot.description_hash}</code>.</p>
-
-<h2>Efficiency of the formulations</h2>
-<p>Derivation time in seconds, and {html.escape(_CSV_NOTE)}.</p>
-{html_table(COUNT_HEADERS, counts)}
-
-<h2>Agreement</h2>
-<p>Largest relative difference of M(q), g(q) and the full inverse dynamics tau between each pair
-of formulations over {samples} random states (q in [&minus;&pi;, &pi;], qd in [&minus;2, 2],
-qdd in [&minus;3, 3]); tolerance {TOLERANCE:g}. Result: {verdict}.</p>
-{html_table(AGREEMENT_HEADERS, agreement_rows(results))}
-
-<h2>Trolley pendulum (the seed's worked example), Kane's method</h2>
-<p>q<sub>1</sub> = x (trolley position, prismatic), q<sub>2</sub> = &theta; (rod angle from the
-upward vertical). tau<sub>1</sub> is the driving force F of eq. 2.46, tau<sub>2</sub> the
-torque that eq. 2.47 sets to zero. Equal to eqs. 2.46&ndash;2.47 after simplification: {closed}.
-Derived in {trolley.derivation_time:.3f} s.</p>
-{mathml}
-<details><summary>Plain text (<code>robodyn derive trolley_pendulum --method kane</code>)
-</summary><pre>{html.escape(text)}</pre></details>
-<details><summary>LaTeX source (<code>trolley_pendulum.tex</code>)</summary>
-<pre>{html.escape(latex)}</pre></details>
-</body></html>
-"""
+def _page_context(robot: rd.Robot, counts: list[list[object]], results: Sequence[Agreement],
+                  samples: int, trolley: rd.EquationsOfMotion, closed_ok: bool) -> dict[str, object]:
+    """The values of ``demo.html.j2`` before its sections (strings are escaped by the template)."""
+    return {
+        "title": f"robodyn report: {robot.name}",
+        "robot": robot,
+        "version": rd.__version__,
+        "stamp": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
+        "count_note": _CSV_NOTE,
+        "count_table": Markup(html_table(COUNT_HEADERS, counts)),
+        "samples": samples,
+        "tolerance": f"{TOLERANCE:g}",
+        "agree": all(r.ok for r in results),
+        "verdict": verdict(results),
+        "agreement_table": Markup(html_table(AGREEMENT_HEADERS, agreement_rows(results))),
+        "closed_ok": closed_ok,
+        "trolley_time": trolley.derivation_time,
+        "mathml": Markup(render_mathml(trolley)),
+        "text": render_text(trolley),
+        "latex": render_latex(trolley),
+        "citation": CITATION,
+    }

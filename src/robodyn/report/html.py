@@ -1,53 +1,94 @@
-"""HTML building blocks shared by the reports: the style sheet, tables and a page frame."""
+"""HTML building blocks shared by the reports, rendered from the Jinja2 templates in ``templates/``.
+
+A report is a page template around *sections*: each section is an HTML fragment (a ``str``)
+returned by a section-builder function, so that a new analysis adds a section by returning one.
+Fragments are plain ``str`` of trusted HTML (wrap them in :class:`markupsafe.Markup` to pass
+them to a template); every value put into them from outside (names, paths, messages) is
+escaped, by the templates' autoescaping or by :func:`html.escape` where a fragment is built in
+Python. Figures are embedded as ``data:`` URIs (:func:`figure`), so a written page is really
+self-contained: one file, nothing fetched, no scripts.
+"""
 
 from __future__ import annotations
 
-import html
+import base64
 from collections.abc import Sequence
+from functools import cache
+from pathlib import Path
+
+import jinja2
+from markupsafe import Markup
 
 from robodyn.report.text import is_number
 
-__all__ = ["CSS", "html_table", "page"]
+__all__ = ["CSS", "data_uri", "figure", "html_table", "page", "render"]
 
-CSS = """
-body { font-family: system-ui, sans-serif; max-width: 70rem; margin: 2rem auto; padding: 0 1rem;
-       color: #222; line-height: 1.45; }
-h1 { font-size: 1.6rem; border-bottom: 2px solid #345; padding-bottom: .3rem; }
-h2 { font-size: 1.25rem; margin-top: 2rem; color: #234; }
-h4 { margin: 1rem 0 .2rem; }
-table { border-collapse: collapse; margin: .5rem 0; font-variant-numeric: tabular-nums; }
-th, td { border: 1px solid #bbc; padding: .25rem .6rem; }
-th { background: #e8edf3; }
-td.num { text-align: right; }
-.ok { color: #176117; font-weight: 600; }
-.bad { color: #a01010; font-weight: 600; }
-pre { background: #f5f6f8; padding: .6rem; overflow-x: auto; font-size: .85rem; }
-math { font-size: 1.1rem; }
-.meta { color: #555; font-size: .9rem; }
-"""
+#: Media types of the figure files a report embeds, by suffix.
+_MEDIA_TYPES = {".png": "image/png", ".gif": "image/gif", ".svg": "image/svg+xml",
+                ".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".webp": "image/webp"}
+
+
+@cache
+def _environment() -> jinja2.Environment:
+    """The template environment: package templates, autoescaping, undefined names are errors."""
+    return jinja2.Environment(
+        loader=jinja2.PackageLoader("robodyn.report", "templates"),
+        autoescape=jinja2.select_autoescape(enabled_extensions=("html", "j2"), default=True),
+        undefined=jinja2.StrictUndefined,
+        keep_trailing_newline=True,
+    )
+
+
+def render(template: str, **context: object) -> str:
+    """Render the package template ``template`` (e.g. ``"page.html.j2"``) with ``context``.
+
+    Strings in ``context`` are escaped; wrap trusted HTML fragments in :class:`markupsafe.Markup`.
+    """
+    return _environment().get_template(template).render(**context)
+
+
+#: The shared style sheet (``templates/style.css``).
+CSS = _environment().loader.get_source(_environment(), "style.css")[0]
+
+
+def _cell_class(value: object) -> str:
+    """CSS class of a table cell: "ok"/"yes" green, "DISAGREE"/"NO" red, numbers right-aligned."""
+    text = str(value)
+    if text in ("ok", "yes"):
+        return "ok"
+    if text in ("DISAGREE", "NO"):
+        return "bad"
+    return "num" if is_number(value) else ""
 
 
 def html_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
-    """An HTML table; numbers right-aligned, "ok"/"yes" green, "DISAGREE"/"NO" red."""
-    head = "".join(f"<th>{html.escape(str(h))}</th>" for h in headers)
-    body = []
-    for row in rows:
-        cells = []
-        for c in row:
-            text = html.escape(str(c))
-            if text in ("ok", "yes"):
-                cells.append(f'<td class="ok">{text}</td>')
-            elif text in ("DISAGREE", "NO"):
-                cells.append(f'<td class="bad">{text}</td>')
-            else:
-                cells.append(f'<td class="num">{text}</td>' if is_number(c)
-                             else f"<td>{text}</td>")
-        body.append("<tr>" + "".join(cells) + "</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+    """An HTML table fragment (escaped text); numbers right-aligned, "ok"/"yes" green,
+    "DISAGREE"/"NO" red."""
+    cells = [[(str(c), _cell_class(c)) for c in row] for row in rows]
+    return render("table.html.j2", headers=[str(h) for h in headers], rows=cells).strip()
+
+
+def data_uri(path: str | Path) -> str:
+    """The file at ``path`` as a base64 ``data:`` URI (media type from the suffix).
+
+    Raises
+    ------
+    ValueError
+        For a suffix that is not a known image type (the message names the file).
+    """
+    path = Path(path)
+    media = _MEDIA_TYPES.get(path.suffix.lower())
+    if media is None:
+        raise ValueError(f"{path}: cannot embed a {path.suffix or 'suffix-less'} file as an image "
+                         f"(known: {', '.join(sorted(_MEDIA_TYPES))})")
+    return f"data:{media};base64,{base64.b64encode(path.read_bytes()).decode('ascii')}"
+
+
+def figure(path: str | Path, alt: str) -> str:
+    """``<img>`` fragment of the image file ``path`` embedded in the page (the file stays on disk)."""
+    return render("figure.html.j2", uri=data_uri(path), alt=alt).strip()
 
 
 def page(title: str, body: str) -> str:
-    """A complete HTML document with the shared style sheet around ``body``."""
-    return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">\n'
-            f"<title>{html.escape(title)}</title>\n<style>{CSS}</style></head>\n<body>\n"
-            f"{body}\n</body></html>\n")
+    """A complete HTML document with the shared style sheet around the trusted fragment ``body``."""
+    return render("page.html.j2", title=title, body=Markup(body))

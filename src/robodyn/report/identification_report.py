@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from robodyn.report.html import html_table, page
+from robodyn.report.html import figure, html_table, page
 from robodyn.validate.validation import Validation
 
 __all__ = ["KINOVA_CONTROLLER_GAINS", "combined_relative", "identification_html",
@@ -76,8 +76,7 @@ def validation_section(val: Validation, out: Path, folder: str, stem: str, headi
     imgs = []
     for kind in kinds:
         path = draw[kind](val, out / folder / f"{stem}_{kind}.png")
-        imgs.append(f'<img src="{html.escape(folder)}/{html.escape(path.name)}" alt="{kind}" '
-                    'style="max-width:100%">')
+        imgs.append(figure(path, kind))
     notes = "".join(f"<li>{html.escape(n)}</li>" for n in val.notes)
     sim = ""
     if val.simulation is not None:

@@ -9,6 +9,7 @@ import numpy as np
 
 import robodyn as rd
 from robodyn.codegen.emit import generate
+from robodyn.report.html import figure
 from robodyn.report.text import progress
 from robodyn.simulate.aa300_study import run_study
 from robodyn.simulate.balance import balance_double_pendulum
@@ -48,10 +49,13 @@ def simulation_sections(robot: rd.Robot, out: Path, backend: str = "c") -> tuple
         "<h2>Computed torque, PUMA 560</h2><p>Quintic move from zero to "
         f"{html.escape(np.array2string(q1, precision=2))} rad in 2 s, RK4 at 1 ms in {where}, "
         f"K<sub>p</sub> = 400, K<sub>d</sub> = 40. Law evaluated at every RK4 stage (a "
-        f"continuous-time controller): largest joint tracking error {err:.2e} rad, the "
-        "integrator's own error ("
+        f"continuous-time controller) whose model is exactly the simulated plant's (rotor "
+        f"inertia and friction included): largest joint tracking error {err:.2e} rad ("
         + ('<span class="ok">below 1e-8: ok</span>' if ok_track else '<span class="bad">no</span>')
-        + f"). The same law sampled once per step and held (a 1 kHz digital controller): "
+        + "). That figure is RK4's own integration error with the exact model, not a measure "
+        "of tracking with a real controller: with a model that differs from the plant the "
+        "error is set by the mismatch instead. The same law sampled once per step and held "
+        "(a 1 kHz digital controller): "
         f"{err_held:.2e} rad"
         + f"; peak torques {html.escape(np.array2string(np.abs(sim.tau).max(axis=0), precision=1))}"
         " N m.</p>")
@@ -61,21 +65,19 @@ def simulation_sections(robot: rd.Robot, out: Path, backend: str = "c") -> tuple
             model=rd.compile_model(rd.load("trolley_double_pendulum"), backend=backend))
         fig = balance_figure(bal, out / "balance.png")
     parts.append(
-        "<h2>Double inverted pendulum on a trolley (seed Fig. 3.1), LQR</h2>"
+        "<h2>Double inverted pendulum on a trolley (the thesis' Fig. 3.1), LQR</h2>"
         f"<p>From rod angles (0.1, &minus;0.05) rad; largest tilt {bal.max_tilt:.3f} rad, final "
         f"tilt {bal.final_tilt:.1e} rad, peak force {bal.peak_force:.1f} N: "
         + ('<span class="ok">kept upright</span>' if bal.upright else '<span class="bad">fell</span>')
-        + f'</p><img src="{fig.name}" alt="balance" style="max-width:100%">')
+        + "</p>" + figure(fig, "balance"))
 
     with progress("AA300 study: plan, PD tracking, actuator sizing, animation"):
         study = run_study(out / "aa300", animate=True, backend=backend)
-    imgs = "".join(f'<img src="aa300/{p.name}" alt="{p.stem}" style="max-width:100%">'
-                   for p in study.figures)
-    anim = (f'<img src="aa300/{study.animation.name}" alt="AA300 animation">'
-            if study.animation else "")
+    imgs = "".join(figure(p, p.stem) for p in study.figures)
+    anim = figure(study.animation, "AA300 animation") if study.animation else ""
     parts.append(
         "<h2>AA300: pick-and-place cycle and actuator sizing</h2>"
         f"<p>Payload {study.payload:g} kg, controller {html.escape(study.controller)}. Peak "
-        "actuator demand per joint (the motor-sizing question of the seed):</p>"
+        "actuator demand per joint (the motor-sizing question of the thesis' section 3.8):</p>"
         f"<pre>{html.escape(study.table())}</pre>{imgs}{anim}")
     return "\n".join(parts), ok_track and bal.upright

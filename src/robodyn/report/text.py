@@ -1,4 +1,4 @@
-"""Terminal output helpers: progress lines on stderr and aligned text tables."""
+"""Terminal output helpers: progress lines and bars on stderr, aligned text tables."""
 
 from __future__ import annotations
 
@@ -8,17 +8,51 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 
 import numpy as np
+from tqdm import tqdm
 
 
 def err(*args: object) -> None:
     print(*args, file=sys.stderr, flush=True)
 
 
+#: The progress bar of the innermost :func:`steps` block (empty when none is shown).
+_BARS: list[tqdm] = []
+
+
+@contextmanager
+def steps(total: int, desc: str) -> Iterator[None]:
+    """A tqdm progress bar on stderr that counts the :func:`progress` steps run inside the block.
+
+    Shown on a terminal only; elsewhere (pipes, logs, tests) each step prints its plain
+    ``label... 2.1 s`` line as without a bar.
+    """
+    bar = tqdm(total=total, desc=desc, unit="step", file=sys.stderr, disable=not sys.stderr.isatty(),
+               bar_format="{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} [{elapsed}] {postfix}")
+    if bar.disable:
+        yield
+        return
+    _BARS.append(bar)
+    try:
+        yield
+    finally:
+        _BARS.remove(bar)
+        bar.close()
+
+
 @contextmanager
 def progress(label: str) -> Iterator[None]:
-    """``label... 2.1 s`` on stderr around a long step."""
-    print(f"{label}...", end=" ", file=sys.stderr, flush=True)
+    """``label... 2.1 s`` on stderr around a long step (a step of the bar inside :func:`steps`)."""
     start = time.perf_counter()
+    if _BARS:
+        bar = _BARS[-1]
+        bar.set_postfix_str(label)
+        try:
+            yield
+        finally:
+            bar.update(1)
+            tqdm.write(f"{label}: {time.perf_counter() - start:.1f} s", file=sys.stderr)
+        return
+    print(f"{label}...", end=" ", file=sys.stderr, flush=True)
     try:
         yield
     finally:
