@@ -53,8 +53,11 @@ def simulation_program(kset: KernelSet, prefix: str, header_name: str) -> str:
         f"// Standalone simulator of {kset.robot_name}: passive motion (zero joint torques), RK4.",
         f"// Build: cc -O2 -std=c99 {kset.robot_name}_sim.c {kset.robot_name}.c -lm "
         f"-o {identifier(kset.robot_name)}_sim",
-        "// Usage: sim [duration [dt [x0_1 ... x0_2n]]]   (x0 = [q; qd], or q alone; default 1 s, 1 ms, 0)",
-        f"// Output: CSV {cols} on stdout, one row per step, the initial state first.",
+        f"// Usage: {identifier(kset.robot_name)}_sim [duration [dt [x0_1 ... x0_{2 * n}]]]   "
+        f"(x0 = [q; qd] ({2 * n} values) or q alone ({n}); default 1 s, 1 ms, 0)",
+        f"// Output: CSV on stdout; header row t,{cols}; then one row per step, the initial state "
+        "first:",
+        f"//   t in s, q1..q{n} joint positions (rad or m), qd1..qd{n} joint velocities (rad/s or m/s).",
         "#include <errno.h>",
         "#include <math.h>",
         "#include <stdio.h>",
