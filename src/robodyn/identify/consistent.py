@@ -29,7 +29,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from robodyn.identify.base import BaseRelations
-from robodyn.identify.estimate import LinearFit
+from robodyn.identify.estimate import LinearFit, thin_svd
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
 from robodyn.robot.validation import inertia_problems
@@ -100,7 +100,7 @@ def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray,
     norms = np.linalg.norm(a, axis=0)
     scale = np.where(norms > 0, norms, 1.0)
     # |A theta - b|^2 = |S V^T theta - U^T b|^2 + const (thin SVD keeps the program small)
-    u, s, vt = np.linalg.svd(a, full_matrices=False)
+    u, s, vt = thin_svd(a)
     r_mat = s[:, None] * vt
     r_rhs = u.T @ b
     k = relations.matrix

@@ -76,10 +76,20 @@ class LinearFit:
     cv_errors: np.ndarray
 
 
+def thin_svd(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Thin SVD ``(u, s, vt)`` of a tall matrix (m, p) through its QR factorisation, ``A = Q R``,
+    ``R = U_r S V^T`` (much faster than LAPACK's direct SVD of a tall matrix)."""
+    if a.shape[0] <= 2 * a.shape[1]:
+        return np.linalg.svd(a, full_matrices=False)
+    q, r = np.linalg.qr(a)
+    u_r, s, vt = np.linalg.svd(r)
+    return q @ u_r, s, vt
+
+
 def _solve(a: np.ndarray, b: np.ndarray, z0: np.ndarray, lams: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``z`` for each weight (len(lams), p), and the SVD ``(u, s, vt)`` of ``a``."""
-    u, s, vt = np.linalg.svd(a, full_matrices=False)
+    u, s, vt = thin_svd(a)
     keep = s > RANK_RTOL * (s[0] if s.size else 1.0)
     c = u.T @ (b - a @ z0)
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -241,5 +241,5 @@ def _complete(relations: Any, theta: np.ndarray, nominal: np.ndarray) -> np.ndar
 def _table(relations: Any, theta: np.ndarray, fit: LinearFit, theta0: np.ndarray) -> BaseParameters:
     std = np.sqrt(np.clip(np.diag(fit.cov), 0.0, np.inf))
     return BaseParameters(names=relations.names, values=theta, std=std, nominal=theta0,
-                          relations=relations.expressions, identifiable=~fit.unexcited)
+                          base=relations, identifiable=~fit.unexcited)
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -28,9 +29,10 @@ class BaseParameters:
     std : numpy.ndarray, shape (b,)
         Standard deviations (inf: not identifiable from these data; the value is then the prior).
     nominal : numpy.ndarray, shape (b,)
-        The description's values of the same combinations.
-    relations : tuple of sympy.Expr, length b
-        Each base parameter in the standard parameter symbols (``XX1``, ``MY2``, ...).
+        The prior's values of the same combinations (the description completed by the
+        per-joint drive and friction fit, :mod:`robodyn.identify.prior`).
+    base : BaseRelations
+        The numerical relations (:attr:`relations` gives them symbolically).
     identifiable : numpy.ndarray of bool, shape (b,)
         False where the data do not excite the parameter (it keeps its prior value).
     """
@@ -39,8 +41,13 @@ class BaseParameters:
     values: np.ndarray
     std: np.ndarray
     nominal: np.ndarray
-    relations: tuple[sp.Expr, ...]
+    base: BaseRelations
     identifiable: np.ndarray
+
+    @cached_property
+    def relations(self) -> tuple[sp.Expr, ...]:
+        """Each base parameter in the standard parameter symbols (``XX1``, ``MY2``, ...)."""
+        return self.base.expressions
 
     @property
     def relative_std(self) -> np.ndarray:
