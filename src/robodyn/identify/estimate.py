@@ -128,7 +128,7 @@ def _one(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, joint: np.ndarray, 
     keep = s > RANK_RTOL * s[0]
     m, p = a.shape
     r = b - a @ z
-    with np.errstate(divide="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore"):
         hat = np.where(keep, s**2 / (s**2 + lam), 0.0)
         sigma2 = float(r @ r) / max(m - float(hat.sum()), 1.0)
         inv = np.where(keep | (lam > 0), 1.0 / (s**2 + lam), np.inf)
