@@ -1,0 +1,304 @@
+"""``sweep``: run a picklable task over the cases of a study on Dask, results as a pandas table.
+
+The cases are cut into batches (many cases per Dask task: a fast simulation costs less than one
+Dask task's scheduling) and mapped over the workers of a Dask cluster:
+
+* no ``client`` and no ``scheduler``: a :class:`distributed.LocalCluster` on 127.0.0.1 with one
+  single-threaded worker process per CPU core (or ``workers``), closed when the sweep ends;
+* ``client``: that :class:`distributed.Client` (left open);
+* ``scheduler="tcp://host:8786"``: a client of that cluster, closed when the sweep ends; a
+  scheduler that cannot be reached within ``timeout`` seconds is a :class:`StudyError`.
+
+Dask reruns the batches of a worker that dies; a case whose task raises is recorded with its
+message (``on_error="record"``) or stops the study (``"raise"``); an interrupted sweep raises
+:class:`SweepInterrupted` carrying the table of the cases that finished. Nothing here is a
+scheduler, a pool or a store of its own: Dask schedules, pandas/pyarrow store.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import uuid
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from robodyn.robot.errors import StudyError
+from robodyn.study.cases import expand_cases
+
+__all__ = ["ERROR_COLUMN", "SweepInterrupted", "batches", "default_workers", "run_batch", "run_serial",
+           "sweep", "table", "write_table"]
+
+#: Column holding a failed case's error message (None where the case succeeded).
+ERROR_COLUMN = "error"
+
+#: One finished case: (case index, flat result columns, error message or None).
+Row = tuple[int, dict[str, Any], str | None]
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """A sweep stopped by the user (Ctrl-C); ``table`` holds the cases that finished.
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        Same layout as a finished sweep's table, only the finished cases (in case order).
+    """
+
+    def __init__(self, table: pd.DataFrame) -> None:
+        super().__init__(f"sweep interrupted: {len(table)} cases finished")
+        self.table = table
+
+
+def default_workers() -> int:
+    """Worker processes of the default LocalCluster: the CPU cores this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def batches(n_cases: int, batch: int) -> list[range]:
+    """Consecutive case-index ranges of ``batch`` cases (the last one shorter), shape-free."""
+    return [range(s, min(s + batch, n_cases)) for s in range(0, n_cases, batch)]
+
+
+def _flatten(result: Any, case: int) -> dict[str, Any]:
+    """A task's dict of scalars or small 1-D arrays as flat columns (``name[i]`` for arrays)."""
+    if not isinstance(result, Mapping):
+        raise TypeError(f"case {case}: the task returned {type(result).__name__}, expected a dict "
+                        "of scalars or small arrays")
+    out: dict[str, Any] = {}
+    for key, value in result.items():
+        if not isinstance(key, str):
+            raise TypeError(f"case {case}: result names must be text, got {key!r}")
+        arr = np.asarray(value)
+        if arr.ndim == 0:
+            out[key] = arr.item() if isinstance(value, np.generic | np.ndarray) else value
+        elif arr.ndim == 1:
+            for i, v in enumerate(arr.tolist()):
+                out[f"{key}[{i}]"] = v
+        else:
+            raise TypeError(f"case {case}: result {key!r} has shape {arr.shape}; return scalars or "
+                            "1-D arrays")
+    return out
+
+
+def run_batch(task: Callable[[dict[str, Any]], Mapping[str, Any]],
+              cases: Sequence[tuple[int, dict[str, Any]]], on_error: str = "record") -> list[Row]:
+    """Run ``task`` on each ``(index, case)``; what one Dask task (or pool task) executes.
+
+    Parameters
+    ----------
+    task : callable
+        ``task(case) -> dict``; gets a copy of each case.
+    cases : sequence of (int, dict)
+    on_error : {"record", "raise"}
+        "record": a case that raises gives ``(index, {}, "TypeName: message")``; "raise": the
+        exception propagates with a note naming the case.
+
+    Returns
+    -------
+    list of (int, dict, str or None)
+    """
+    rows: list[Row] = []
+    for index, case in cases:
+        try:
+            rows.append((index, _flatten(task(dict(case)), index), None))
+        except Exception as exc:
+            if on_error == "raise":
+                exc.add_note(f"robodyn.sweep: case {index}: {case}")
+                raise
+            rows.append((index, {}, f"{type(exc).__name__}: {' '.join(str(exc).split())}"))
+    return rows
+
+
+def _run_part(cases: Sequence[tuple[int, dict[str, Any]]], task: Callable[[dict[str, Any]], Any],
+              on_error: str) -> list[Row]:
+    """:func:`run_batch` with the batch first (what ``Client.map`` passes)."""
+    return run_batch(task, cases, on_error)
+
+
+def table(cases: Sequence[Mapping[str, Any]], rows: Sequence[Row] | Mapping[int, Row]) -> pd.DataFrame:
+    """The study table: one row per finished case, in case order.
+
+    Columns: the case parameters (first-seen order), the result columns (first-seen order; one
+    that repeats a parameter name gets the suffix ``" (result)"``), then ``"error"``. Index:
+    ``case`` (the case number).
+    """
+    done = sorted(rows.values() if isinstance(rows, Mapping) else rows, key=lambda r: r[0])
+    names = list(dict.fromkeys(k for c in cases for k in c))
+    records = []
+    for index, result, error in done:
+        record = dict(cases[index])
+        for k, v in result.items():
+            record[f"{k} (result)" if k in names else k] = v
+        record[ERROR_COLUMN] = error
+        records.append(record)
+    out = pd.DataFrame.from_records(records, index=pd.Index([r[0] for r in done], name="case"))
+    results = [c for c in out.columns if c not in names and c != ERROR_COLUMN]
+    cols = [c for c in names if c in out.columns] + results + [ERROR_COLUMN]
+    if out.empty:
+        return pd.DataFrame(columns=names + [ERROR_COLUMN], index=pd.Index([], name="case"))
+    return out[cols]
+
+
+def _task_name(task: object) -> str:
+    return getattr(task, "__qualname__", None) or type(task).__qualname__
+
+
+def _check_task(task: object) -> None:
+    """Refuse a task that is not callable or cannot be sent to a worker (named)."""
+    if not callable(task):
+        raise StudyError(f"task {task!r} is not callable: expected a function of one case (dict)")
+    import cloudpickle
+
+    try:
+        cloudpickle.dumps(task)
+    except Exception as exc:
+        raise StudyError(
+            f"task {_task_name(task)!r} cannot be sent to Dask workers: it does not pickle "
+            f"({type(exc).__name__}: {exc}); use a module-level function or a dataclass of plain "
+            "values (robot description text, not a loaded model)") from None
+
+
+def _check_options(on_error: str, batch: int | None, workers: int | None) -> None:
+    if on_error not in ("record", "raise"):
+        raise StudyError(f"on_error must be 'record' or 'raise', got {on_error!r}")
+    for name, v in (("batch", batch), ("workers", workers)):
+        if v is not None and (isinstance(v, bool) or not isinstance(v, int) or v < 1):
+            raise StudyError(f"{name} must be a positive integer, got {v!r}")
+
+
+def run_serial(task: Callable[[dict[str, Any]], Mapping[str, Any]], cases: Any, *, seed: int | None = 0,
+               on_error: str = "record") -> pd.DataFrame:
+    """:func:`sweep` in this process, without Dask (same cases, seeds and table)."""
+    _check_options(on_error, None, None)
+    expanded = expand_cases(cases, seed)
+    return table(expanded, run_batch(task, list(enumerate(expanded)), on_error))
+
+
+@contextmanager
+def _connect(client: Any, scheduler: str | None, workers: int | None, timeout: float) -> Iterator[Any]:
+    """The Dask client to use; those opened here are closed on exit."""
+    from distributed import Client, LocalCluster
+
+    if client is not None:
+        yield client
+        return
+    if scheduler is not None:
+        try:
+            own = Client(scheduler, timeout=timeout, set_as_default=False)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise StudyError(f"cannot reach the Dask scheduler at {scheduler!r} within {timeout:g} s "
+                             f"({type(exc).__name__}: {' '.join(str(exc).split())}); check the "
+                             "address (tcp://host:8786) and that the scheduler is running") from None
+        try:
+            yield own
+        finally:
+            own.close()
+        return
+    with LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
+                      host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR) as cluster, \
+            Client(cluster, set_as_default=False) as own:
+        yield own
+
+
+def sweep(task: Callable[[dict[str, Any]], Mapping[str, Any]], cases: Any, *, client: Any = None,
+          scheduler: str | None = None, workers: int | None = None, batch: int | None = None,
+          seed: int | None = 0, on_error: str = "record", progress: bool = False,
+          timeout: float = 10.0, on_batch: Callable[[list[Row]], None] | None = None) -> pd.DataFrame:
+    """Run ``task`` over ``cases`` on Dask; the table of cases and results, in case order.
+
+    Parameters
+    ----------
+    task : callable
+        ``task(case: dict) -> dict`` of scalars or 1-D arrays (array ``x`` of length k becomes
+        columns ``x[0]`` .. ``x[k-1]``). Must pickle (cloudpickle): a module-level function or a
+        dataclass such as :class:`robodyn.study.ActuatorSizing` carrying a robot's description
+        text, never a loaded compiled model.
+    cases : list of dict, dict of lists (grid), Grid, LatinHypercube or RandomSampler
+        See :func:`robodyn.study.expand_cases`.
+    client : distributed.Client, optional
+        Run on this client's cluster (not closed).
+    scheduler : str, optional
+        Address of a running scheduler (``"tcp://host:8786"``); ignored when ``client`` is given.
+    workers : int, optional
+        Worker processes of the LocalCluster started when neither is given (default: the CPU
+        cores available).
+    batch : int, optional
+        Cases per Dask task (default: the cases split into about 4 tasks per worker thread).
+    seed : int or None
+        Study seed; case ``i`` gets the column ``seed = case_seed(seed, i)`` (None: no column).
+    on_error : {"record", "raise"}
+        A case whose task raises: its message in the ``error`` column (the others go on), or the
+        exception stops the study.
+    progress : bool
+        Show a tqdm progress bar (cases) on stderr.
+    timeout : float
+        Seconds to wait for a ``scheduler`` to answer.
+    on_batch : callable, optional
+        Called in this process with each finished batch's rows ``[(index, results, error)]``
+        (e.g. to save partial results).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Index ``case``; case columns, result columns, ``error``.
+
+    Raises
+    ------
+    StudyError
+        Bad cases or options, a task that does not pickle, an unreachable scheduler.
+    SweepInterrupted
+        On Ctrl-C (or a KeyboardInterrupt from ``on_batch``); its ``table`` has the finished cases.
+    """
+    _check_options(on_error, batch, workers)
+    _check_task(task)
+    expanded = expand_cases(cases, seed)
+    if not expanded:
+        return table(expanded, [])
+    from distributed import as_completed
+    from tqdm import tqdm
+
+    rows: dict[int, Row] = {}
+    with _connect(client, scheduler, workers, timeout) as dask:
+        threads = max(1, sum(dask.nthreads().values()))
+        size = batch or max(1, math.ceil(len(expanded) / (4 * threads)))
+        parts = [[(i, expanded[i]) for i in r] for r in batches(len(expanded), size)]
+        token = uuid.uuid4().hex[:12]
+        futures = dask.map(_run_part, parts, task=task, on_error=on_error, pure=False,
+                           key=[f"robodyn-sweep-{token}-{k}" for k in range(len(parts))])
+        bar = tqdm(total=len(expanded), unit="case", disable=not progress, desc="sweep")
+        try:
+            for _, out in as_completed(futures, with_results=True, loop=dask.loop):
+                for row in out:
+                    rows[row[0]] = row
+                bar.update(len(out))
+                if on_batch is not None:
+                    on_batch(out)
+        except KeyboardInterrupt:
+            dask.cancel(futures)
+            raise SweepInterrupted(table(expanded, rows)) from None
+        except BaseException:
+            dask.cancel(futures)
+            raise
+        finally:
+            bar.close()
+    return table(expanded, rows)
+
+
+def write_table(frame: pd.DataFrame, directory: str | Path, stem: str = "results") -> tuple[Path, Path]:
+    """Write a study table as ``DIR/STEM.parquet`` (pyarrow) and ``DIR/STEM.csv``; their paths."""
+    out = Path(directory)
+    out.mkdir(parents=True, exist_ok=True)
+    parquet, csv = out / f"{stem}.parquet", out / f"{stem}.csv"
+    frame.to_parquet(parquet, engine="pyarrow")
+    frame.to_csv(csv)
+    return parquet, csv
