@@ -134,6 +134,18 @@ def test_joints_are_matched_by_name_and_input_is_not_modified(puma):
     assert rec.joint_names == names
 
 
+def test_joints_the_robot_lacks_are_left_out_with_a_note(tmp_path):
+    robot = slider(tmp_path)
+    t = np.arange(200) * 1e-3
+    q = np.column_stack([0.1 * np.sin(2 * np.pi * t), 0.2 * t])
+    qdd = np.column_stack([-0.1 * (2 * np.pi) ** 2 * np.sin(2 * np.pi * t), 0 * t])
+    rec = recording(t=t, q=q, qdd=qdd, tau=SLIDER_MASS * qdd, joint_names=("finger", "x"))
+    val = validate(robot, rec, window=None)
+    assert val.joint_names == ("x",)
+    assert any("left out of the recording: finger" in n for n in val.notes)
+    np.testing.assert_allclose(val.measured[:, 0], rec.tau[:, 1])
+
+
 def test_a_joint_without_a_sensor_and_a_joint_held_still(tmp_path, puma):
     robot, model, sim = puma
     tau = sim.tau.copy()

@@ -16,8 +16,8 @@ import sympy as sp
 from robodyn.robot.errors import ValidationError
 from robodyn.robot.model import Robot
 
-__all__ = ["MIN_SAMPLES", "Target", "check_finite", "drive_gains", "friction_torque", "in_chain_order",
-           "measured_target", "resolve_target", "target_unit"]
+__all__ = ["MIN_SAMPLES", "Target", "check_finite", "drive_gains", "friction_torque",
+           "ignored_joints", "in_chain_order", "measured_target", "resolve_target", "target_unit"]
 
 Target = Literal["tau", "current"]
 
@@ -142,8 +142,9 @@ def friction_torque(robot: Robot, qd: np.ndarray,
 def in_chain_order(robot: Robot, rec: Any) -> Any:
     """The recording with its joints in the robot's chain order.
 
-    Joints are matched by name. A recording with the generic names ``q1 .. qn`` (no names
-    given) and as many joints as the robot is taken in chain order as it is.
+    Joints are matched by name; joints the robot does not have (a gripper's, say) are left out
+    (:func:`ignored_joints` names them). A recording with the generic names ``q1 .. qn`` (no
+    names given) and as many joints as the robot is taken in chain order as it is.
 
     Raises
     ------
@@ -160,12 +161,17 @@ def in_chain_order(robot: Robot, rec: Any) -> Any:
     missing = [n for n in want if n not in names]
     extra = [n for n in names if n not in want]
     if not missing and hasattr(rec, "select"):
-        return rec.select(list(want))
+        return rec.select(list(want))  # extra joints (a gripper's, say) are left out
     raise ValidationError(
         f"{_where(rec)}: joint_names: the recording's joints do not match robot {robot.name!r} "
         f"({robot.dof} joints: {', '.join(want)}); recording has {len(names)}: {', '.join(names)}"
         + (f"; missing {', '.join(missing)}" if missing else "")
         + (f"; not in the robot {', '.join(extra)}" if extra else ""))
+
+
+def ignored_joints(robot: Robot, rec: Any) -> list[str]:
+    """The recording's joints that the robot does not have."""
+    return [n for n in (getattr(rec, "joint_names", ()) or ()) if n not in robot.joint_names]
 
 
 def measured_target(rec: Any, target: Target) -> np.ndarray:

@@ -28,6 +28,7 @@ from robodyn.validate.effort import (
     check_finite,
     drive_gains,
     friction_torque,
+    ignored_joints,
     in_chain_order,
     measured_target,
     resolve_target,
@@ -264,6 +265,9 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
              "exercised by this recording" for name, m in zip(robot.joint_names, moving, strict=True)
              if not m]
     simulation = None
+    extra = ignored_joints(robot, recording) if rec is not recording else []
+    if extra:
+        notes.append(f"joints not in {robot.name} left out of the recording: {', '.join(extra)}")
     notes += [f"{name} has no {tgt} measurement: its errors are NaN"
               for name, h in zip(robot.joint_names, has, strict=True) if not h]
     if window is not None and not has.all():
