@@ -4,8 +4,10 @@ Public entry point: :func:`identify` (``rd.identify``), returning an :class:`Ide
 """
 
 from robodyn.identify.base import BaseRelations, base_relations
+from robodyn.identify.friction import FrictionFit, fit_friction, friction_table
 from robodyn.identify.pipeline import identify
 from robodyn.identify.preprocess import Preprocess
 from robodyn.identify.result import BaseParameters, Identification
 
-__all__ = ["BaseParameters", "BaseRelations", "Identification", "Preprocess", "base_relations", "identify"]
+__all__ = ["BaseParameters", "BaseRelations", "FrictionFit", "Identification", "Preprocess", "base_relations",
+           "fit_friction", "friction_table", "identify"]

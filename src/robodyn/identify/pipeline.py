@@ -19,13 +19,15 @@ Steps (each a function of its own module):
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 import sympy as sp
 
-from robodyn.identify.base import base_relations
+from robodyn.identify.base import BaseRelations, base_relations
 from robodyn.identify.estimate import FOLDS, LinearFit, fit_linear
+from robodyn.identify.friction import FRICTION_MODELS, NONLINEAR, fit_friction_samples, without_friction
 from robodyn.identify.preprocess import Preprocess, Samples, preprocess, resolve_preprocess
 from robodyn.identify.prior import joint_prior
 from robodyn.identify.result import BaseParameters, Identification
@@ -33,7 +35,7 @@ from robodyn.identify.to_robot import robot_with_parameters
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
-from robodyn.symbolic.regressor import parameter_values
+from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT, parameter_values
 
 __all__ = ["check_recording", "identify", "nominal_standard"]
 
@@ -136,9 +138,10 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         Default: ``"tau"`` when every recording has torques, else ``"current"``.
     method : {"ols", "wls", "consistent"}
         Ordinary or weighted least squares, or physically consistent (pseudo-inertia LMIs).
-    friction : {"linear"}
-        Friction in the fit: viscous, Coulomb (+/-) and offset per joint. Nonlinear models are
-        fitted after this linear step by :func:`robodyn.identify.friction.fit_friction`.
+    friction : {"linear", "none", "stribeck", "load", "polynomial"}
+        "linear": viscous, Coulomb (+/-) and offset per joint in the linear fit; "none": no
+        friction; the others: a nonlinear law fitted after the linear step
+        (:mod:`robodyn.identify.friction`).
     regularization : "auto", float or None
         Tikhonov weight toward the description's values (dimensionless, see
         :mod:`robodyn.identify.estimate`); "auto": chosen by time-block cross-validation on these
@@ -175,9 +178,8 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         raise IdentificationError(f"target: expected one of {TARGETS}, got {target!r}")
     if method not in METHODS:
         raise IdentificationError(f"method: expected one of {METHODS}, got {method!r}")
-    if friction != "linear":
-        raise IdentificationError(f"friction: rd.identify fits the linear model; fit {friction!r} "
-                                  f"afterwards with robodyn.identify.fit_friction")
+    if friction not in FRICTION_MODELS:
+        raise IdentificationError(f"friction: expected one of {FRICTION_MODELS}, got {friction!r}")
     if gains not in ("auto", "description", "absorbed"):
         raise IdentificationError(f"gains: expected 'auto', 'description' or 'absorbed', got {gains!r}")
     for i, rec in enumerate(recs):
@@ -185,6 +187,8 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     settings = resolve_preprocess(recs, cutoff, decimate, velocity)
     model = model if model is not None else compile_model(robot)
     relations = base_relations(model)
+    if friction == "none":
+        relations = _without_friction_columns(relations)
     samples = [_decimated(preprocess(r, settings, target), settings) for r in recs]
     y_full = [model.regressor(s.q, s.qd, s.qdd) for s in samples]
     count = sum(s.q.shape[0] for s in samples)
@@ -196,6 +200,8 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
             f"parameters (at least {2 * b} needed; record longer or pass decimate=1)")
     nominal = nominal_standard(robot)
     k, k_source, prior = joint_prior(robot, samples, y_full, nominal, target, gains)
+    if friction == "none":
+        prior = without_friction(prior)
     phi, y, joint, blocks = _stack(samples, y_full, relations.independent, k)
     theta0 = relations.to_base(prior)
     lin_method = "ols" if method == "ols" else "wls"
@@ -213,12 +219,22 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
                                         source=f"identified ({method}) from {robot.source}")
     s = fit.singular_values
     weak = fit.directions[:, s < UNEXCITED_RTOL * s[0]]
-    return Identification(
+    result = Identification(
         robot=ident_robot, base_parameters=table, standard=standard, preprocess=settings,
         target=target, method=method, gains=k, gains_source=k_source, regularization=fit.lam,
         condition=fit.condition, singular_values=s, unexcited_directions=weak,
         residual_std=fit.sigma / k, samples=count, relations=relations,
         _model=model)
+    if friction in NONLINEAR:
+        result = replace(result, friction_fit=fit_friction_samples(result, samples, friction))
+    return result
+
+
+def _without_friction_columns(relations: BaseRelations) -> BaseRelations:
+    """The base relations with the friction parameters (Fv, Fcp, Fcn, Fo) left out; they only
+    ever combine among themselves, so the other base parameters are unchanged."""
+    keep = np.array([c % PER_JOINT <= len(INERTIAL_NAMES) for c in relations.independent])
+    return replace(relations, independent=relations.independent[keep], beta=relations.beta[keep])
 
 
 def _decimated(s: Samples, settings: Preprocess) -> Samples:

@@ -20,7 +20,7 @@ estimated when the recording was built) and its raw target are used (simulated d
 
 Default cut-off (``cutoff="auto"``): the largest bandwidth of the moving joints' positions
 (:func:`robodyn.measure.filtering.bandwidth_cutoff`) over the recordings, clamped to
-``[AUTO_MIN_HZ, AUTO_MAX_HZ]`` = [2, 10] Hz and to 0.2 x the sampling rate: manipulator motion
+``[AUTO_MIN_HZ, AUTO_MAX_HZ]`` = [2, 5] Hz and to 0.2 x the sampling rate: manipulator motion
 (and with it the rigid-body torque) lives below a few hertz, while the second derivative of
 encoder noise grows with the square of frequency. Default decimation (``decimate="auto"``): the
 largest integer not above ``fs / (5 cutoff)``, i.e. about five samples per cut-off period.
@@ -39,7 +39,7 @@ from robodyn.robot.errors import IdentificationError
 __all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "Preprocess", "Samples", "preprocess", "resolve_preprocess"]
 
 AUTO_MIN_HZ = 2.0
-AUTO_MAX_HZ = 10.0
+AUTO_MAX_HZ = 5.0
 _MOVING_RAD = 1e-3  # a joint whose position spans less than this never moves (rad or m)
 
 

@@ -10,6 +10,7 @@ import numpy as np
 import sympy as sp
 
 from robodyn.identify.base import BaseRelations
+from robodyn.identify.friction import FrictionFit, without_friction
 from robodyn.identify.preprocess import Preprocess, preprocess
 from robodyn.numeric.model import Model
 from robodyn.robot.model import Robot
@@ -113,6 +114,10 @@ class Identification:
     samples : int
         Samples (after decimation) used in the fit.
     relations : BaseRelations
+    friction_fit : FrictionFit or None
+        A nonlinear friction law fitted after the linear step
+        (:func:`robodyn.identify.friction.fit_friction`); :meth:`predict` then uses it in place
+        of the linear friction.
     """
 
     robot: Robot
@@ -131,6 +136,7 @@ class Identification:
     samples: int
     relations: BaseRelations
     _model: Model
+    friction_fit: FrictionFit | None = None
 
     def predict(self, recording: Any) -> np.ndarray:
         """Predicted target at the recording's own samples.
@@ -153,5 +159,9 @@ class Identification:
         check_recording(self.robot, recording, 0, None)
         s = preprocess(recording, self.preprocess, None)
         y = self._model.regressor(s.q, s.qd, s.qdd)
-        tau = y @ self.standard  # tau = Y(q, qd, qdd) p
+        if self.friction_fit is None:
+            tau = y @ self.standard  # tau = Y(q, qd, qdd) p
+        else:
+            load = y @ without_friction(self.standard)  # rigid body and rotor inertia
+            tau = load + self.friction_fit.torque(s.qd, load)
         return tau / self.gains[None, :]
