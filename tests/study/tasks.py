@@ -1,0 +1,22 @@
+"""Picklable study tasks for the tests (module level, so Dask workers import them by name)."""
+
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+
+
+def noisy_square(case: dict) -> dict:
+    """``x**2`` plus a normal draw from the case's own seed; raises for ``x == 3``."""
+    if case["x"] == 3:
+        raise ValueError(f"x = {case['x']} is not allowed here")
+    rng = np.random.default_rng(case["seed"])
+    return {"y": float(case["x"]) ** 2, "noise": rng.normal(), "pair": np.array([case["x"], -1.0])}
+
+
+def slow_square(case: dict) -> dict:
+    """``noisy_square`` taking a while (so that a worker can be killed mid-study)."""
+    time.sleep(0.05)
+    return {**noisy_square(case), "pid": os.getpid()}
