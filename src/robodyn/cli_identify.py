@@ -178,6 +178,8 @@ def _common(p: argparse.ArgumentParser) -> None:
 
 
 def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
+    from robodyn.identify.friction import FRICTION_MODELS
+
     p = sub.add_parser(
         "identify", help="identify inertial, drive and friction parameters from recordings",
         formatter_class=fmt,
@@ -199,9 +201,10 @@ def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
     p.add_argument("--method", choices=("ols", "wls", "consistent"), default="wls",
                    help="estimator: ordinary or weighted least squares, or physically consistent "
                         "(pseudo-inertia LMIs) (default: %(default)s)")
-    p.add_argument("--friction", default="linear", metavar="MODEL",
-                   help="friction model of the fit (default: %(default)s: viscous, Coulomb +/-, "
-                        "offset)")
+    p.add_argument("--friction", default="linear", choices=FRICTION_MODELS,
+                   help="friction model: linear (viscous, Coulomb +/-, offset, in the linear fit), "
+                        "none, or a nonlinear law fitted after the linear step (default: "
+                        "%(default)s)")
     _common(p)
     p.set_defaults(func=_cmd_identify)
 
