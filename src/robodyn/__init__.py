@@ -16,6 +16,7 @@ from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.load import builtin_names, load
 from robodyn.robot.model import Drive, Friction, Joint, Link, Robot
 from robodyn.simulate import Trajectory, simulate
+from robodyn.study.sweep import sweep
 from robodyn.symbolic.eom import EquationsOfMotion, derive
 from robodyn.validate import Validation, validate
 
@@ -40,6 +41,7 @@ __all__ = [
     "load",
     "read_recording",
     "simulate",
+    "sweep",
     "validate",
 ]
 __version__ = "0.1.0"
