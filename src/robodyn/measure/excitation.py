@@ -1,0 +1,721 @@
+"""Optimal excitation trajectories for dynamic parameter identification (Swevers et al. 1997).
+
+Each joint follows a finite Fourier series with ``L`` harmonics of the base frequency
+``w_f = 2 pi f`` about an offset ``q0_i``::
+
+    q_i(t)   = q0_i + sum_l  a_il / (w_f l) sin(w_f l t) - b_il / (w_f l) cos(w_f l t)
+    qd_i(t)  =        sum_l  a_il cos(w_f l t) + b_il sin(w_f l t)
+    qdd_i(t) =        sum_l -a_il w_f l sin(w_f l t) + b_il w_f l cos(w_f l t)
+
+The motion is periodic with period ``T = 1 / f``, so it starts and ends at rest at the offset when,
+at ``t = 0``::
+
+    q_i(0) - q0_i = -sum_l b_il / (w_f l) = 0,   qd_i(0) = sum_l a_il = 0,
+    qdd_i(0) = sum_l b_il w_f l = 0.
+
+These three linear equalities are imposed *exactly by construction*: the coefficients are written
+as ``a_i = N_a z_a``, ``b_i = N_b z_b`` with ``N_a``, ``N_b`` orthonormal bases of the null spaces of
+the constraints (``L - 1`` free sine-side and ``L - 2`` free cosine-side numbers per joint), so no
+polynomial correction is added and every period (and the whole run, ``duration`` a whole number of
+periods) starts and ends with ``q = q0``, ``qd = qdd = 0``.
+
+The design maximises the information in the identification matrix ``W``: the compiled regressor
+``Y(q, qd, qdd)`` (``(n, 15 n)`` per sample, :meth:`robodyn.numeric.model.Model.regressor`) stacked
+over ``K`` samples of one period, restricted to the *base columns* (a maximal linearly independent
+set, found by QR with column pivoting on random states, :func:`base_columns`). The criterion is the
+condition number ``cond(W) = sigma_max / sigma_min`` (``criterion="cond"``; minimised as
+``log cond``) or ``-log det(W^T W)`` (``criterion="logdet"``, D-optimality). Both are minimised by
+SciPy's SLSQP under the *linear* joint position, velocity and acceleration limits on the ``K``
+samples, from several random feasible starts; the gradient is analytic in the Fourier
+coefficients and uses finite differences of the regressor only in the joint states (``3 n``
+batched regressor calls per gradient). Coulomb and offset friction columns are steps in ``qd``:
+their derivative is zero wherever it exists, and it is taken as zero.
+
+Limits are enforced exactly on the returned samples: after optimisation, the oscillating part is
+shrunk about the offset (a scale factor <= 1) until the finely sampled trajectory is within every
+limit.
+"""
+
+from __future__ import annotations
+
+import csv
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+import scipy.linalg
+from scipy.interpolate import BPoly, PPoly
+from scipy.optimize import minimize
+
+from robodyn.numeric.model import Model, compile_model
+from robodyn.robot.model import Robot
+from robodyn.simulate.trajectory import JointTrajectory
+from robodyn.symbolic.regressor import JOINT_NAMES, PER_JOINT, parameter_names
+
+Criterion = Literal["cond", "logdet"]
+
+#: Default joint speed and acceleration limits where the description gives none (rad/s, rad/s^2;
+#: m/s, m/s^2 for prismatic joints): moderate values that an industrial arm reaches safely.
+DEFAULT_VELOCITY = 1.0
+DEFAULT_ACCELERATION = 3.0
+#: Range assumed for a revolute joint without position limits (rad), about the zero position.
+DEFAULT_RANGE = np.pi
+
+# Regressor columns with zero derivative almost everywhere (Coulomb +/- and offset friction).
+_STEP_COLUMNS = tuple(PER_JOINT - len(JOINT_NAMES) + k for k in (2, 3, 4))
+
+
+# ----------------------------------------------------------------------------------------------
+# limits
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class ExcitationLimits:
+    """Box limits on joint position, speed and acceleration, (n,) arrays each.
+
+    Attributes
+    ----------
+    lower, upper : (n,) ndarray
+        Position limits, rad (m).
+    velocity, acceleration : (n,) ndarray
+        Symmetric limits ``|qd| <= velocity`` (rad/s, m/s), ``|qdd| <= acceleration`` (rad/s^2,
+        m/s^2); positive.
+    """
+
+    lower: np.ndarray
+    upper: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+
+    @property
+    def dof(self) -> int:
+        """Number of joints n."""
+        return self.lower.size
+
+    def violation(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> float:
+        """Largest excess over any limit of the samples ``(N, n)`` (<= 0 when all are respected)."""
+        return float(max(np.max(q - self.upper), np.max(self.lower - q),
+                         np.max(np.abs(qd) - self.velocity), np.max(np.abs(qdd) - self.acceleration)))
+
+
+def excitation_limits(robot: Robot, *, lower: Sequence[float] | None = None,
+                      upper: Sequence[float] | None = None,
+                      velocity: float | Sequence[float] | None = None,
+                      acceleration: float | Sequence[float] | None = None,
+                      margin: float = 0.05) -> ExcitationLimits:
+    """Limits for :func:`excitation` from the robot's description, with overrides.
+
+    Parameters
+    ----------
+    robot : Robot
+    lower, upper : (n,) array_like, optional
+        Position limits, rad (m). Default: the joint limits shrunk by ``margin`` of their range
+        at each end; ``-+DEFAULT_RANGE`` where a joint has none.
+    velocity : float or (n,) array_like, optional
+        Default: each joint's ``velocity_limit`` times ``1 - margin``, ``DEFAULT_VELOCITY`` where
+        none is given.
+    acceleration : float or (n,) array_like, optional
+        Default ``DEFAULT_ACCELERATION`` (descriptions carry no acceleration limits).
+    margin : float
+        Fraction in [0, 0.5) kept free at each end of a description's limits.
+
+    Returns
+    -------
+    ExcitationLimits
+    """
+    n = robot.dof
+    if not 0.0 <= margin < 0.5:
+        raise ValueError(f"excitation_limits: margin must be in [0, 0.5), got {margin!r}")
+    lo = np.array([-DEFAULT_RANGE if j.lower is None else float(j.lower) for j in robot.joints])
+    hi = np.array([DEFAULT_RANGE if j.upper is None else float(j.upper) for j in robot.joints])
+    span = hi - lo
+    lo, hi = lo + margin * span, hi - margin * span
+    if lower is not None:
+        lo = _finite_vector(lower, n, "lower")
+    if upper is not None:
+        hi = _finite_vector(upper, n, "upper")
+    if np.any(hi <= lo):
+        bad = int(np.argmax(hi <= lo))
+        raise ValueError(f"excitation_limits: joint {robot.joint_names[bad]!r}: upper limit "
+                         f"{hi[bad]:g} is not above lower limit {lo[bad]:g}")
+    vel = np.array([DEFAULT_VELOCITY if j.velocity_limit is None
+                    else (1.0 - margin) * float(j.velocity_limit) for j in robot.joints])
+    if velocity is not None:
+        vel = _positive_vector(velocity, n, "velocity")
+    acc = np.full(n, DEFAULT_ACCELERATION)
+    if acceleration is not None:
+        acc = _positive_vector(acceleration, n, "acceleration")
+    return ExcitationLimits(*(_frozen(v) for v in (lo, hi, vel, acc)))
+
+
+# ----------------------------------------------------------------------------------------------
+# base columns and criteria
+# ----------------------------------------------------------------------------------------------
+def base_columns(model: Model, rng: np.random.Generator | int | None = 0, *, samples: int | None = None,
+                 rtol: float = 1e-8) -> tuple[int, ...]:
+    """Indices of a maximal set of linearly independent regressor columns (the base columns).
+
+    The regressor is evaluated at ``samples`` random states (positions uniform within the joint
+    limits or ``+-pi``, velocities and accelerations standard normal) and stacked; QR with column
+    pivoting picks the columns, and the rank is the number of ``|R_kk| > rtol |R_00|`` after the
+    columns are scaled to unit norm (so the units of the parameters do not decide the rank): the
+    rule of :func:`robodyn.identify.base.base_relations`, which also gives the combinations the
+    dependent columns make (not needed here, and importing it would tie ``measure`` to ``identify``).
+
+    Parameters
+    ----------
+    model : Model
+    rng : numpy Generator or int seed or None
+    samples : int, optional
+        Random states, each adding n rows (default ``max(60, 30 n)``).
+    rtol : float
+        Rank tolerance relative to the largest pivot.
+
+    Returns
+    -------
+    tuple of int
+        Sorted column indices into the ``15 n`` columns of :meth:`Model.regressor`
+        (names in :func:`robodyn.symbolic.regressor.parameter_names`).
+    """
+    gen = np.random.default_rng(rng)
+    n = model.dof
+    samples = max(60, 30 * n) if samples is None else int(samples)
+    lo = np.array([-np.pi if j.lower is None else float(j.lower) for j in model.robot.joints])
+    hi = np.array([np.pi if j.upper is None else float(j.upper) for j in model.robot.joints])
+    q = gen.uniform(lo, hi, (samples, n))
+    y = model.regressor(q, gen.standard_normal((samples, n)), gen.standard_normal((samples, n)))
+    w = y.reshape(samples * n, -1)
+    norms = np.linalg.norm(w, axis=0)
+    used = np.flatnonzero(norms > 0)
+    _, r, piv = scipy.linalg.qr(w[:, used] / norms[used], mode="economic", pivoting=True)
+    d = np.abs(np.diag(r))
+    rank = int(np.sum(d > rtol * d[0])) if d.size else 0
+    return tuple(sorted(int(c) for c in used[piv[:rank]]))
+
+
+def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
+                          columns: Sequence[int]) -> np.ndarray:
+    """Stacked regressor ``W`` restricted to ``columns``: (N n, p) for samples (N, n)."""
+    y = model.regressor(q, qd, qdd)
+    return y.reshape(-1, y.shape[-1])[:, list(columns)]
+
+
+def condition_number(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
+                     columns: Sequence[int]) -> float:
+    """``sigma_max / sigma_min`` of :func:`identification_matrix` (inf when rank-deficient)."""
+    s = _singular_values(identification_matrix(model, q, qd, qdd, columns))
+    return float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+
+
+def _singular_values(w: np.ndarray) -> np.ndarray:
+    """Singular values of a tall ``w``, largest first, from the eigenvalues of ``w^T w``.
+
+    Relative accuracy of ``sigma_min`` about ``eps cond(w)^2``: ample below cond ~ 1e6. SciPy's
+    LAPACK on the small Gram matrix stays fast where a threaded SVD of the tall matrix competes
+    for busy cores (measured 100x slower on a loaded 2-core machine).
+    """
+    lam = scipy.linalg.eigh(w.T @ w, eigvals_only=True, driver="evr")
+    return np.sqrt(np.clip(lam[::-1], 0.0, None))
+
+
+# ----------------------------------------------------------------------------------------------
+# Fourier series
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class FourierTrajectory:
+    """Finite Fourier series joint motion (module docstring), periodic with period ``1 / f``.
+
+    Attributes
+    ----------
+    a, b : (n, L) ndarray
+        Sine-side and cosine-side coefficients of the velocity, rad/s (m/s).
+    offset : (n,) ndarray
+        ``q0``, rad (m).
+    base_frequency : float
+        ``f``, Hz.
+    """
+
+    a: np.ndarray
+    b: np.ndarray
+    offset: np.ndarray
+    base_frequency: float
+
+    @property
+    def harmonics(self) -> int:
+        """Number of harmonics L."""
+        return self.a.shape[1]
+
+    @property
+    def period(self) -> float:
+        """``1 / f``, s."""
+        return 1.0 / self.base_frequency
+
+    def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(q, qd, qdd)`` at times ``t`` (N,), each (N, n)."""
+        sq, sqd, sqdd = _basis(np.asarray(t, dtype=float), self.harmonics, self.base_frequency)
+        coef = np.concatenate([self.a, self.b], axis=1)  # (n, 2 L)
+        return self.offset + sq @ coef.T, sqd @ coef.T, sqdd @ coef.T
+
+    def scaled(self, s: float) -> FourierTrajectory:
+        """The same motion with its oscillation about the offset scaled by ``s``."""
+        return FourierTrajectory(_frozen(s * self.a), _frozen(s * self.b), self.offset, self.base_frequency)
+
+
+def _basis(t: np.ndarray, harmonics: int, f: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Matrices (N, 2 L) mapping ``[a; b]`` of one joint to q - q0, qd and qdd at ``t``."""
+    w = 2.0 * np.pi * f
+    wl = w * np.arange(1, harmonics + 1)
+    s, c = np.sin(np.outer(t, wl)), np.cos(np.outer(t, wl))
+    # q - q0 = a/(w l) sin - b/(w l) cos;  qd = a cos + b sin;  qdd = -a w l sin + b w l cos
+    return (np.hstack([s / wl, -c / wl]), np.hstack([c, s]), np.hstack([-s * wl, c * wl]))
+
+
+def _null_bases(harmonics: int, f: float) -> tuple[np.ndarray, np.ndarray]:
+    """Orthonormal bases (L, L-1) of ``sum a = 0`` and (L, L-2) of the two ``b`` constraints."""
+    wl = 2.0 * np.pi * f * np.arange(1, harmonics + 1)
+    na = scipy.linalg.null_space(np.ones((1, harmonics)))
+    # sum b/(w l) = 0 (q(0) = q0) and sum b w l = 0 (qdd(0) = 0)
+    nb = scipy.linalg.null_space(np.vstack([1.0 / wl, wl]))
+    return na, nb
+
+
+@dataclass(frozen=True)
+class _Layout:
+    """Map from the optimisation vector x to Fourier coefficients: x_i = [q0_i, z_a (L-1), z_b (L-2)]."""
+
+    n: int
+    harmonics: int
+    na: np.ndarray
+    nb: np.ndarray
+
+    @property
+    def per_joint(self) -> int:
+        return 1 + self.na.shape[1] + self.nb.shape[1]
+
+    def joint_map(self) -> np.ndarray:
+        """(2 L, per_joint - 1) matrix taking [z_a; z_b] to [a; b]."""
+        return scipy.linalg.block_diag(self.na, self.nb)
+
+    def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(offset (n,), coef (n, 2 L))`` of the vector x."""
+        xs = x.reshape(self.n, self.per_joint)
+        return xs[:, 0], xs[:, 1:] @ self.joint_map().T
+
+    def series(self, x: np.ndarray, f: float) -> FourierTrajectory:
+        off, coef = self.split(x)
+        L = self.harmonics
+        return FourierTrajectory(_frozen(coef[:, :L]), _frozen(coef[:, L:]), _frozen(off), f)
+
+    def pack(self, traj: FourierTrajectory) -> np.ndarray:
+        """Inverse of :meth:`series` for coefficients that satisfy the rest constraints."""
+        za = traj.a @ self.na
+        zb = traj.b @ self.nb
+        return np.hstack([traj.offset[:, None], za, zb]).ravel()
+
+
+def random_fourier(limits: ExcitationLimits, harmonics: int, base_frequency: float,
+                   rng: np.random.Generator, *, samples: int | None = None) -> FourierTrajectory:
+    """A random rest-to-rest Fourier trajectory scaled to touch its tightest limit.
+
+    Offsets are uniform in the middle half of each joint's range; coefficients standard normal in
+    the constraint null space, then the oscillation is scaled so that the largest ratio of
+    ``|q - q0|`` to the room left about the offset, ``|qd|`` to the speed limit and ``|qdd|`` to
+    the acceleration limit, over ``samples`` points of a period, is exactly 1.
+    """
+    na, nb = _null_bases(harmonics, base_frequency)
+    n = limits.dof
+    mid, half = 0.5 * (limits.lower + limits.upper), 0.5 * (limits.upper - limits.lower)
+    off = mid + 0.5 * half * rng.uniform(-1.0, 1.0, n)
+    a = rng.standard_normal((n, na.shape[1])) @ na.T
+    b = rng.standard_normal((n, nb.shape[1])) @ nb.T
+    traj = FourierTrajectory(_frozen(a), _frozen(b), _frozen(off), base_frequency)
+    return _fit_to_limits(traj, limits, samples or 40 * harmonics)
+
+
+def _fit_to_limits(traj: FourierTrajectory, limits: ExcitationLimits, samples: int,
+                   shrink_only: bool = False) -> FourierTrajectory:
+    """Scale the oscillation so the samples just meet the tightest limit (only shrink if asked)."""
+    t = np.arange(samples) * traj.period / samples
+    q, qd, qdd = traj.evaluate(t)
+    dq = q - traj.offset
+    room_up, room_down = limits.upper - traj.offset, traj.offset - limits.lower
+    ratio = max(np.max(np.where(dq > 0, dq / room_up, -dq / room_down)),
+                np.max(np.abs(qd) / limits.velocity), np.max(np.abs(qdd) / limits.acceleration))
+    if ratio <= 0 or (shrink_only and ratio <= 1.0):
+        return traj
+    return traj.scaled(1.0 / ratio)
+
+
+# ----------------------------------------------------------------------------------------------
+# result
+# ----------------------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class Excitation:
+    """An optimised excitation trajectory.
+
+    Attributes
+    ----------
+    series : FourierTrajectory
+        The Fourier coefficients ``a``, ``b`` (n, L), offsets and base frequency.
+    t : (N,) ndarray
+        Sample times from 0 to ``duration``, s (step ``dt``).
+    q, qd, qdd : (N, n) ndarray
+        The trajectory at ``t``: rad, rad/s, rad/s^2 (m, m/s, m/s^2 for prismatic joints).
+    duration : float
+        s; a whole number of periods.
+    condition_number : float
+        ``cond(W)`` on the base columns over ``design_samples`` samples of one period.
+    criterion : {"cond", "logdet"}
+        What was optimised.
+    logdet : float
+        ``log det(W^T W / K)`` of the same matrix (``K`` samples).
+    limits : ExcitationLimits
+        The limits used; every sample respects them.
+    columns : tuple of int
+        Base columns of the regressor used in ``W``.
+    column_names : tuple of str
+        Their parameter names.
+    joint_names : tuple of str
+    starts : int
+        Optimiser starts.
+    history : tuple of float
+        Final condition number of each start.
+    elapsed : float
+        Wall time of the design, s.
+    """
+
+    series: FourierTrajectory
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    duration: float
+    condition_number: float
+    criterion: str
+    logdet: float
+    limits: ExcitationLimits
+    columns: tuple[int, ...]
+    column_names: tuple[str, ...]
+    joint_names: tuple[str, ...]
+    starts: int
+    history: tuple[float, ...]
+    elapsed: float
+    design_samples: int = 0
+    _dt: float = field(default=1e-3, repr=False)
+
+    @property
+    def coefficients(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(a, b, offset)``: (n, L), (n, L), (n,)."""
+        return self.series.a, self.series.b, self.series.offset
+
+    @property
+    def dof(self) -> int:
+        """Number of joints n."""
+        return self.q.shape[1]
+
+    def at(self, t: float | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(q, qd, qdd)`` at any time(s), exact (the series); (n,) each for a scalar t."""
+        tt = np.atleast_1d(np.asarray(t, dtype=float))
+        q, qd, qdd = self.series.evaluate(tt)
+        if np.ndim(t) == 0:
+            return q[0], qd[0], qdd[0]
+        return q, qd, qdd
+
+    def trajectory(self, knot_step: float = 0.01) -> JointTrajectory:
+        """The motion as a :class:`~robodyn.simulate.trajectory.JointTrajectory` (a reference
+        for :func:`robodyn.simulate` controllers): quintic Hermite pieces matching q, qd, qdd of
+        the series exactly at knots every ``knot_step`` s."""
+        steps = max(1, int(np.ceil(self.duration / knot_step - 1e-9)))
+        tk = np.linspace(0.0, self.duration, steps + 1)
+        q, qd, qdd = self.series.evaluate(tk)
+        y = np.stack([q, qd, qdd], axis=1)  # (K, 3, n)
+        pp = PPoly.from_bernstein_basis(BPoly.from_derivatives(tk, y))
+        return JointTrajectory(self.t, self.q, self.qd, self.qdd, duration=self.duration,
+                               kind="fourier excitation", _pp=pp)
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write ``t, q_<joint>..., qd_<joint>..., qdd_<joint>...`` (s, rad, rad/s, rad/s^2), one
+        row per sample, for a controller to play. Returns the path."""
+        return write_trajectory_csv(path, self.t, self.q, self.qd, self.qdd, self.joint_names)
+
+
+def write_trajectory_csv(path: str | Path, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
+                         qdd: np.ndarray, joint_names: Sequence[str]) -> Path:
+    """Write a sampled joint trajectory as CSV: header ``t, q_<name>..., qd_<name>...,
+    qdd_<name>...``; SI units (s, rad, rad/s, rad/s^2), 17 significant digits."""
+    out = Path(path)
+    header = (["t"] + [f"q_{j}" for j in joint_names] + [f"qd_{j}" for j in joint_names]
+              + [f"qdd_{j}" for j in joint_names])
+    data = np.column_stack([t, q, qd, qdd])
+    with out.open("w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        w.writerows([[f"{v:.17g}" for v in row] for row in data])
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+# design
+# ----------------------------------------------------------------------------------------------
+def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float = 0.1,
+               duration: float | None = None, limits: ExcitationLimits | None = None, *,
+               criterion: Criterion = "cond", starts: int = 6, seed: int = 0, dt: float = 1e-3,
+               design_samples: int | None = None, max_iterations: int = 40,
+               columns: Sequence[int] | None = None) -> Excitation:
+    """Design an optimal periodic excitation trajectory (finite Fourier series, Swevers 1997).
+
+    Parameters
+    ----------
+    robot : Robot or Model
+        A description (compiled with :func:`robodyn.compile_model`) or a compiled model.
+    harmonics : int
+        Harmonics L per joint (>= 3: the rest-to-rest constraints use three of the 2 L + 1
+        numbers per joint).
+    base_frequency : float
+        ``f``, Hz; the period is ``1 / f`` and the highest frequency ``L f``.
+    duration : float, optional
+        Length of the returned trajectory, s: a whole number of periods (default one period).
+    limits : ExcitationLimits, optional
+        Default :func:`excitation_limits` of the robot.
+    criterion : {"cond", "logdet"}
+        Minimise ``log cond(W)`` or ``-log det(W^T W)``.
+    starts : int
+        Random feasible starts of the optimiser (multi-start); the best result is kept.
+    seed : int
+        Seed of the starts and of the base-column search.
+    dt : float
+        Sampling step of the returned arrays, s.
+    design_samples : int, optional
+        Samples of one period in ``W`` and in the limit constraints (default ``20 L``).
+    max_iterations : int
+        SLSQP iterations per start.
+    columns : sequence of int, optional
+        Regressor columns to use (default :func:`base_columns`).
+
+    Returns
+    -------
+    Excitation
+
+    Raises
+    ------
+    ValueError
+        On a bad argument (non-positive frequency, duration not a whole number of periods,
+        limits for another number of joints, unknown criterion).
+    """
+    t_start = time.perf_counter()
+    model = robot if isinstance(robot, Model) else compile_model(robot)
+    n = model.dof
+    if not isinstance(harmonics, int | np.integer) or harmonics < 3:
+        raise ValueError(f"excitation: harmonics must be an integer >= 3, got {harmonics!r}")
+    f = float(base_frequency)
+    if not np.isfinite(f) or f <= 0:
+        raise ValueError(f"excitation: base_frequency must be a positive number of Hz, "
+                         f"got {base_frequency!r}")
+    period = 1.0 / f
+    total = period if duration is None else float(duration)
+    periods = total / period
+    if not np.isfinite(periods) or periods < 1 - 1e-9 or abs(periods - round(periods)) > 1e-6:
+        raise ValueError(f"excitation: duration {duration!r} s must be a whole number of periods "
+                         f"(1 / base_frequency = {period:g} s)")
+    if criterion not in ("cond", "logdet"):
+        raise ValueError(f"excitation: unknown criterion {criterion!r}; choose 'cond' or 'logdet'")
+    if starts < 1:
+        raise ValueError(f"excitation: starts must be >= 1, got {starts!r}")
+    lim = excitation_limits(model.robot) if limits is None else limits
+    if lim.dof != n:
+        raise ValueError(f"excitation: limits are for {lim.dof} joints, the robot has {n}")
+    rng = np.random.default_rng(seed)
+    cols = base_columns(model, rng) if columns is None else tuple(int(c) for c in columns)
+    k = int(design_samples or 20 * harmonics)
+    na, nb = _null_bases(harmonics, f)
+    layout = _Layout(n, harmonics, na, nb)
+    problem = _Problem(model, layout, f, k, cols, lim, criterion)
+    best: tuple[float, FourierTrajectory] | None = None
+    history = []
+    for _ in range(starts):
+        x0 = layout.pack(random_fourier(lim, harmonics, f, rng, samples=k))
+        problem.best = (np.inf, x0)
+        minimize(problem.objective, x0, jac=True, method="SLSQP",
+                 constraints=[{"type": "ineq", "fun": problem.slack, "jac": problem.slack_jacobian}],
+                 options={"maxiter": max_iterations, "ftol": 1e-9})
+        # the best feasible point visited: the criterion is not smooth where the extreme singular
+        # values cross, and SLSQP's last iterate is not always its best
+        res_x = problem.best[1]
+        # keep the result inside the limits on a fine grid (SLSQP may end slightly outside)
+        traj = _fit_to_limits(layout.series(res_x, f), lim, 20 * k, shrink_only=True)
+        t_d = np.arange(k) * period / k
+        c = condition_number(model, *traj.evaluate(t_d), cols)
+        score = c if criterion == "cond" else -_logdet(model, traj, t_d, cols)
+        history.append(c)
+        if best is None or score < best[0]:
+            best = (score, traj)
+    assert best is not None
+    traj = best[1]
+    steps = int(round(total / dt))
+    t = np.linspace(0.0, steps * dt, steps + 1)
+    q, qd, qdd = traj.evaluate(t)
+    if lim.violation(q, qd, qdd) > 0:
+        # the output grid is finer than the design grid: shrink about the offset to fit it too
+        traj = traj.scaled(_shrink_factor(q, qd, qdd, traj.offset, lim))
+        q, qd, qdd = traj.evaluate(t)
+    # rest at both ends (exact in the series; remove rounding of the sines)
+    for arr, ref in ((q, traj.offset), (qd, 0.0), (qdd, 0.0)):
+        arr[0] = arr[-1] = ref
+    t_d = np.arange(k) * period / k
+    cond = condition_number(model, *traj.evaluate(t_d), cols)
+    names = parameter_names(n)
+    return Excitation(series=traj, t=_frozen(t), q=_frozen(q), qd=_frozen(qd), qdd=_frozen(qdd),
+                      duration=float(steps * dt), condition_number=cond, criterion=criterion,
+                      logdet=_logdet(model, traj, t_d, cols), limits=lim, columns=cols,
+                      column_names=tuple(names[c] for c in cols), joint_names=model.robot.joint_names,
+                      starts=starts, history=tuple(history), elapsed=time.perf_counter() - t_start,
+                      design_samples=k, _dt=dt)
+
+
+def _shrink_factor(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, off: np.ndarray,
+                   lim: ExcitationLimits) -> float:
+    dq = q - off
+    ratio = max(np.max(np.where(dq > 0, dq / (lim.upper - off), -dq / (off - lim.lower))),
+                np.max(np.abs(qd) / lim.velocity), np.max(np.abs(qdd) / lim.acceleration))
+    return min(1.0, (1.0 - 1e-12) / ratio)
+
+
+def _logdet(model: Model, traj: FourierTrajectory, t: np.ndarray, cols: Sequence[int]) -> float:
+    s = _singular_values(identification_matrix(model, *traj.evaluate(t), cols))
+    # log det(W^T W / K) = 2 sum log sigma - p log K
+    return float(2.0 * np.sum(np.log(s)) - s.size * np.log(t.size))
+
+
+class _Problem:
+    """Objective, gradient and linear limit constraints of one design (x as in :class:`_Layout`)."""
+
+    def __init__(self, model: Model, layout: _Layout, f: float, k: int, cols: Sequence[int],
+                 lim: ExcitationLimits, criterion: str) -> None:
+        self.model, self.layout, self.cols, self.criterion = model, layout, list(cols), criterion
+        n, m = layout.n, layout.per_joint
+        t = np.arange(k) / (k * f)
+        sq, sqd, sqdd = _basis(t, layout.harmonics, f)
+        jm = layout.joint_map()
+        # d(q_i, qd_i, qdd_i)(t_k) / d x_i: (K, per_joint) each; the offset enters q only
+        self.dq = np.hstack([np.ones((k, 1)), sq @ jm])
+        self.dqd = np.hstack([np.zeros((k, 1)), sqd @ jm])
+        self.dqdd = np.hstack([np.zeros((k, 1)), sqdd @ jm])
+        self.n, self.m, self.k = n, m, k
+        self.step_cols = np.array([c for c in range(PER_JOINT * n) if c % PER_JOINT in _STEP_COLUMNS])
+        # constraints g(x) >= 0, linear: rows for upper/lower q, +-qd, +-qdd per joint and sample
+        blocks = []
+        consts = []
+        for i in range(n):
+            for d, bound in ((self.dq, None), (self.dqd, lim.velocity[i]), (self.dqdd, lim.acceleration[i])):
+                jac = np.zeros((2 * k, n * m))
+                jac[:k, i * m:(i + 1) * m] = -d
+                jac[k:, i * m:(i + 1) * m] = d
+                blocks.append(jac)
+                if bound is None:
+                    consts.append(np.concatenate([np.full(k, lim.upper[i]), np.full(k, -lim.lower[i])]))
+                else:
+                    consts.append(np.full(2 * k, bound))
+        self.g_jac = np.vstack(blocks)
+        self.g_const = np.concatenate(consts)
+        self.g_scale = float(np.max(np.abs(self.g_const)))
+        self.best: tuple[float, np.ndarray] = (np.inf, np.zeros(n * m))
+
+    def states(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        xs = x.reshape(self.n, self.m)
+        return self.dq @ xs.T, self.dqd @ xs.T, self.dqdd @ xs.T
+
+    def slack(self, x: np.ndarray) -> np.ndarray:
+        return self.g_const + self.g_jac @ x
+
+    def slack_jacobian(self, x: np.ndarray) -> np.ndarray:
+        return self.g_jac
+
+    def objective(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """Criterion value and its gradient with respect to x."""
+        states = self.states(x)
+        y = self.model.regressor(*states)  # (K, n, P)
+        feasible = np.min(self.slack(x)) >= -1e-9 * self.g_scale
+        w = y.reshape(-1, y.shape[-1])[:, self.cols]
+        # eigen-decomposition of the Gram matrix W^T W (p x p): much cheaper than an SVD of the
+        # tall W and accurate enough for the condition numbers met here (lambda = sigma^2);
+        # SciPy's LAPACK, which stays fast when NumPy's threaded BLAS competes for busy cores
+        lam, v = scipy.linalg.eigh(w.T @ w, driver="evr")
+        if lam[0] <= lam[-1] * 1e-24:
+            return 1e3, np.zeros_like(x)
+        if self.criterion == "cond":
+            # log cond = (log l_max - log l_min) / 2;  d l_i = 2 v_i^T W^T dW v_i
+            value = float(0.5 * np.log(lam[-1] / lam[0]))
+            g = w @ (np.outer(v[:, -1], v[:, -1]) / lam[-1] - np.outer(v[:, 0], v[:, 0]) / lam[0])
+        else:
+            # -log det(W^T W);  d = -2 tr((W^T W)^-1 W^T dW)
+            value = float(-np.sum(np.log(lam)))
+            g = -2.0 * w @ ((v / lam) @ v.T)
+        if feasible and value < self.best[0]:
+            self.best = (value, x.copy())
+        gk = np.zeros((w.shape[0], y.shape[-1]))
+        gk[:, self.cols] = g
+        gk = gk.reshape(y.shape)  # (K, n, P)
+        # central differences in q and qd, a one-sided one in qdd (Y is linear in qdd: exact),
+        # all 5 n perturbed copies of the K states in one batched regressor call
+        n, h = self.n, 1e-6
+        shifts = [(which, i, sign) for which in (0, 1) for i in range(n) for sign in (1.0, -1.0)]
+        shifts += [(2, i, 1.0) for i in range(n)]
+        batch = [np.repeat(st[None], len(shifts), axis=0) for st in states]  # (S, K, n) each
+        for s_idx, (which, i, sign) in enumerate(shifts):
+            batch[which][s_idx, :, i] += sign * h
+        yb = self.model.regressor(*(b.reshape(-1, n) for b in batch)).reshape((len(shifts),) + y.shape)
+        yb[..., self.step_cols] = 0.0
+        # d value / d state(t_k) = sum over the rows of sample k of G . dY
+        dots = np.einsum("skjp,kjp->sk", yb, gk)
+        y0 = y.copy()
+        y0[..., self.step_cols] = 0.0
+        dots0 = np.einsum("kjp,kjp->k", y0, gk)
+        grad = np.zeros((n, self.m))
+        d_states = (self.dq, self.dqd, self.dqdd)
+        for i in range(n):
+            for which in (0, 1):
+                plus = 2 * (which * n + i)
+                grad[i] += (dots[plus] - dots[plus + 1]) / (2 * h) @ d_states[which]
+            grad[i] += (dots[4 * n + i] - dots0) / h @ self.dqdd
+        return value, grad.ravel()
+
+
+# --- helpers -----------------------------------------------------------------------------------
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a = np.array(a, dtype=float)
+    a.flags.writeable = False
+    return a
+
+
+def _finite_vector(v: Sequence[float], n: int, name: str) -> np.ndarray:
+    arr = np.asarray(v, dtype=float)
+    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+        raise ValueError(f"excitation_limits: {name} must be a finite ({n},) array, got {v!r}")
+    return arr
+
+
+def _positive_vector(v: float | Sequence[float], n: int, name: str) -> np.ndarray:
+    arr = np.asarray(v, dtype=float)
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,) or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise ValueError(f"excitation_limits: {name} must be positive: a scalar or a ({n},) array, got {v!r}")
+    return arr
+
+
+__all__ = [
+    "DEFAULT_ACCELERATION",
+    "DEFAULT_VELOCITY",
+    "Excitation",
+    "ExcitationLimits",
+    "FourierTrajectory",
+    "base_columns",
+    "condition_number",
+    "excitation",
+    "excitation_limits",
+    "identification_matrix",
+    "random_fourier",
+    "write_trajectory_csv",
+]
