@@ -43,7 +43,7 @@ joints:
       mass: m2
       com: [-l2/2, 0, 0]
       inertia: [[0.001, 0, 0], [0, m2*l2**2/12, 0], [0, 0, m2*l2**2/12]]
-      hydro: {shape: cylinder, radius: 0.05, extra: [1, 2]}
+      hydro: {cylinders: [{radius: 0.05, length: l2, axis: [1, 0, 0], start: [-l2, 0, 0]}]}
 """
 
 Q1, Q2 = sp.symbols("q1 q2", real=True)
@@ -94,7 +94,8 @@ def test_two_link_arm_loads(tmp_path: Path) -> None:
     assert up.com == sp.ImmutableMatrix([-l1 / 2, 0, 0])
     assert up.inertia == sp.ImmutableMatrix(sp.diag(0, m1 * l1**2 / 12, m1 * l1**2 / 12))
     assert fore.inertia[1, 1] == m2 * l2**2 / 12
-    assert dict(fore.hydro) == {"shape": "cylinder", "radius": 0.05, "extra": [1, 2]}
+    assert dict(fore.hydro) == {
+        "cylinders": [{"radius": 0.05, "length": "l2", "axis": [1, 0, 0], "start": ["-l2", 0, 0]}]}
     j1 = robot.joints[0]
     assert j1.lower == -sp.pi and j1.upper == sp.pi
     assert j1.velocity_limit == 2 and j1.effort_limit == 50
@@ -137,7 +138,7 @@ def test_user_data_is_not_mutated(tmp_path: Path) -> None:
     robot = load_yaml_text(yaml.safe_dump(data), source="mem")
     assert data == before
     with pytest.raises(TypeError):
-        robot.links[1].hydro["shape"] = "box"  # type: ignore[index]
+        robot.links[1].hydro["drag"] = 2.0  # type: ignore[index]
 
 
 def test_exact_pi_over_2_folding() -> None:
@@ -576,9 +577,9 @@ def test_description_hash_is_canonical() -> None:
     def robot(hydro: str) -> Robot:
         return load_yaml_text(jt("{mass: 1, hydro: " + hydro + "}"), source="t.yaml")
 
-    a = robot("{drag: 1.2, cylinders: [{radius: 0.05, length: 1}]}")
-    b = robot("{cylinders: [{length: 1, radius: 0.05}], drag: 1.2}")
-    c = robot("{cylinders: [{length: 1, radius: 0.06}], drag: 1.2}")
+    a = robot("{drag: 1.2, cylinders: [{radius: 0.05, length: 1, axis: [1, 0, 0]}]}")
+    b = robot("{cylinders: [{axis: [1, 0, 0], length: 1, radius: 0.05}], drag: 1.2}")
+    c = robot("{cylinders: [{axis: [1, 0, 0], length: 1, radius: 0.06}], drag: 1.2}")
     assert a.description_hash == b.description_hash
     assert a.description_hash != c.description_hash
     assert re.fullmatch(r"[0-9a-f]{64}", a.description_hash)

@@ -238,7 +238,7 @@ def test_header_description_and_yaml_floats() -> None:
 
 
 def test_hydro_is_written_verbatim_or_refused() -> None:
-    hydro = {"shape": "cylinder", "radius": 0.05, "length": 0.4, "cd": [1.0, 1.2]}
+    hydro = {"cylinders": [{"radius": 0.05, "length": 0.4, "axis": [0, 0, 1]}], "drag": 1.2}
     pre, axis, post = placement.from_origin([0, 0, sp.Float(0.1)], [0, 0, 0], [0, 0, 1])
     link = Link("l0", sp.Integer(1), sp.ImmutableMatrix([0, 0, 0]), sp.ImmutableMatrix(sp.eye(3)),
                 hydro=hydro)

@@ -187,6 +187,9 @@ class Robot:
         Default values of the named symbolic parameters the description declares.
     source : str
         Where the description came from (file path or ``builtin:NAME``).
+    fluid : Mapping or None
+        The description's ``fluid`` block (density, current), kept verbatim like ``Link.hydro``;
+        read by :func:`robodyn.hydro.schema.fluid_of`.
     """
 
     name: str
@@ -198,6 +201,7 @@ class Robot:
     parameters: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
     source: str = "<memory>"
     description_hash: str = ""
+    fluid: Mapping[str, Any] | None = None
 
     def __post_init__(self) -> None:
         if len(self.joints) != len(self.links):
@@ -254,6 +258,8 @@ def _canonical_text(robot: Robot) -> str:
         "parameters": {k: repr(v) for k, v in robot.parameters.items()},
         "joints": joints, "links": links,
     }
+    if robot.fluid is not None:  # only then: hashes of robots without one stay as they were
+        data["fluid"] = _plain(robot.fluid)
     return json.dumps(data, sort_keys=True, default=_json_default)
 
 

@@ -10,6 +10,7 @@ physically impossible values are rejected with a :class:`DescriptionError` whose
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -20,6 +21,7 @@ import sympy as sp
 import yaml
 
 from robodyn import spatial as S
+from robodyn.hydro.schema import parse_fluid, parse_hydro
 from robodyn.robot import placement, validation
 from robodyn.robot.chain import ChainElement, assemble
 from robodyn.robot.errors import DescriptionError
@@ -33,7 +35,7 @@ JOINT_TYPES: Mapping[str, str] = MappingProxyType(
     {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic", "fixed": "fixed"}
 )
 
-_TOP_KEYS = ("name", "description", "parameters", "gravity", "base", "tool", "joints")
+_TOP_KEYS = ("name", "description", "parameters", "gravity", "base", "tool", "fluid", "joints")
 _JOINT_KEYS = ("name", "type", "dh", "mdh", "origin", "axis", "limits", "drive", "friction", "link")
 _PLACEMENTS = ("dh", "mdh", "origin")
 _DH_KEYS = ("a", "alpha", "d", "theta")
@@ -290,6 +292,11 @@ class _Reader:
         if "gravity" in top:
             gravity = sp.ImmutableMatrix(self.vector(top["gravity"], "gravity"))
         base = self.pose(top["base"], "base") if "base" in top else None
+        fluid = None
+        if "fluid" in top:
+            self.plain(top["fluid"], "fluid")
+            parse_fluid(top["fluid"], self.symbols, self.defaults, where=f"{self.source}: fluid")
+            fluid = MappingProxyType(copy.deepcopy(dict(top["fluid"])))
         tool = self.pose(top["tool"], "tool") if "tool" in top else None
 
         joints = top["joints"]
@@ -311,10 +318,20 @@ class _Reader:
             kwargs["base"] = base
         if tool is not None:
             kwargs["tool"] = tool
-        return assemble(
+        self.check_immersion(fluid, elements)
+        robot = assemble(
             name, elements, gravity=gravity, parameters=dict(self.defaults),
             source=self.source, **kwargs,
         )
+        return robot if fluid is None else dataclasses.replace(
+            robot, fluid=fluid, description_hash="")
+
+    def check_immersion(self, fluid: Any, elements: Sequence[ChainElement]) -> None:
+        """A fluid block needs a link with hydro data (hydro alone means still fresh water)."""
+        wet = [i for i, e in enumerate(elements) if e.link.hydro is not None]
+        if fluid is not None and not wet:
+            raise self.error("fluid", "no link has a hydro block, so nothing is immersed; "
+                             "add hydro blocks to the links or remove the fluid block")
 
     def parameters(self, value: Any) -> None:
         """``parameters``: name -> default value (a number or a constant expression)."""
@@ -354,6 +371,11 @@ class _Reader:
             for key in ("limits", "drive", "friction"):
                 if key in j:
                     raise self.error(f"{path}.{key}", "not allowed on a fixed joint")
+            if link.hydro is not None:
+                raise self.error(
+                    f"{path}.link.hydro", "not supported on a link attached by a fixed joint "
+                    "(it is merged into its parent): give its cylinders in the parent's hydro block",
+                )
         else:
             fields.update(self.limits(j.get("limits"), f"{path}.limits"))
             drive = self.drive(j.get("drive"), f"{path}.drive")
@@ -507,6 +529,7 @@ class _Reader:
             if not isinstance(m["hydro"], Mapping):
                 raise self.error(f"{path}.hydro", f"expected a mapping, got {_kind(m['hydro'])}")
             self.plain(m["hydro"], f"{path}.hydro")
+            parse_hydro(m["hydro"], self.symbols, self.defaults, where=f"{self.source}: {path}.hydro")
             hydro = MappingProxyType(copy.deepcopy(dict(m["hydro"])))
         link = Link(
             name=name, mass=mass, com=sp.ImmutableMatrix(com),

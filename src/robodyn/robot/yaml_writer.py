@@ -325,6 +325,9 @@ def dump_yaml(robot: Robot) -> str:
     lines.append(f"gravity: {value.seq(list(robot.gravity), 'gravity')}")
     lines.append(f"base: {value.pose(*_xyz_rpy(robot.base), 'base')}")
     lines.append(f"tool: {value.pose(*_xyz_rpy(tool), 'tool')}")
+    if robot.fluid is not None:
+        text = yaml.safe_dump(_plain_data(robot.fluid), default_flow_style=True, width=10**6)
+        lines.append(f"fluid: {text.strip()}")
     lines.append("joints:")
     for k, (joint, xyz, rpy, link) in enumerate(joints):
         lines += _joint_lines(joint, xyz, rpy, link, value, f"joints[{k}]")
