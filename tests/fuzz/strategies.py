@@ -20,13 +20,14 @@ MAX_BYTES = 64 * 1024
 FUZZ_EXAMPLES = int(os.environ.get("ROBODYN_FUZZ_EXAMPLES", "40"))
 
 
-def fuzz_settings(deadline_s: float) -> settings:
+def fuzz_settings(deadline_s: float, *, report_multiple_bugs: bool = True) -> settings:
     """Bounded example count and time per example; no example database in the repository."""
     return settings(
         max_examples=FUZZ_EXAMPLES,
         deadline=timedelta(seconds=deadline_s),
         database=None,
         suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+        report_multiple_bugs=report_multiple_bugs,
     )
 
 
