@@ -56,23 +56,14 @@ class Agreement:
 def _evaluator(eom: rd.EquationsOfMotion) -> Callable[..., dict[str, np.ndarray]]:
     """``f(q, qd, qdd) -> {"M": (n, n), "g": (n,), "tau": (n,)}`` at the default parameters.
 
-    One ``sympy.cse`` (which walks shared subtrees once) runs before ``lambdify``, which is
-    handed only the reduced expressions: its own passes walk every expression as a tree, which
-    takes minutes on the (heavily shared) Lagrange expressions of a 6-joint arm.
+    Each formulation is evaluated on its own straight-line form
+    (:meth:`~robodyn.symbolic.eom.EquationsOfMotion.numeric_function`): seconds to build on a
+    6- or 7-joint arm, where ``lambdify`` of the expanded expressions takes minutes.
     """
-    n = eom.dof
-    values = eom.numeric()
-    params = list(values)
-    exprs = list(eom.M) + list(eom.g) + list(eom.tau)
-    replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_x"), order="none")
-    fn = sp.lambdify([eom.q, eom.qd, eom.qdd, params], reduced, modules="numpy",
-                     cse=lambda _: (replacements, reduced))
-    args = [values[p] for p in params]
+    mass, grav, tau = (eom.numeric_function(k) for k in _QUANTITIES)
 
     def call(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> dict[str, np.ndarray]:
-        out = np.asarray(fn(q, qd, qdd, args), dtype=float)
-        return {"M": out[: n * n].reshape(n, n), "g": out[n * n: n * n + n],
-                "tau": out[n * n + n:]}
+        return {"M": mass(q), "g": grav(q), "tau": tau(q, qd, qdd)}
 
     return call
 
