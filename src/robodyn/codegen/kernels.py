@@ -7,6 +7,10 @@ printers of :mod:`robodyn.codegen` only translate kernels; what is computed is d
 Kernels (``n`` joints, all arrays row-major)::
 
     inverse_dynamics(q, qd, qdd) -> tau (n)       M qdd + C qd + g + friction (rotor included)
+
+Under water (a robot with hydro blocks) ``M`` includes the added mass, ``C qd`` its Christoffel
+terms, ``g`` the buoyancy, and the inverse and forward dynamics also drag, skin friction and lift
+(see :mod:`robodyn.hydro`); ``|u|`` is printed as ``sqrt(u . u)``, without branches.
     mass_matrix(q)               -> M (n, n)      composite-rigid-body algorithm + G^2 J_m
     gravity(q)                   -> g (n)
     coriolis(q, qd)              -> c (n)         C(q, qd) qd
@@ -19,12 +23,14 @@ Kernels (``n`` joints, all arrays row-major)::
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import sympy as sp
 
 from robodyn.codegen import optimize as opt
+from robodyn.hydro.terms import HydroTerms, hydro_terms
 from robodyn.robot.model import Robot
 from robodyn.symbolic import crba
 from robodyn.symbolic import newton_euler as ne
@@ -172,27 +178,30 @@ def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
     reserved = {s.name for s in (*q, *qd, *qdd, *u)} | set(merged) | set(KERNEL_NAMES)
     reserved |= {"q", "qd", "qdd", "tau", "M", "g", "c", "T", "J", "Y", "xd", "u", "qdd_out"}
 
+    hyd = _pi_as_number(hydro_terms(robot, q, qd, qdd))
+
     def fd_outputs(rec: Recorder) -> list[sp.Expr]:
-        return _forward_dynamics(robot, q, qd, u, rec)
+        return _forward_dynamics(robot, q, qd, u, rec, hyd)
 
     builders: dict[str, tuple[str, tuple[Argument, ...], str, tuple[int, ...],
                               Callable[[Recorder], Sequence[sp.Expr]]]] = {
         "inverse_dynamics": (
             "Inverse dynamics tau = M(q) qdd + C(q, qd) qd + g(q) + friction(qd), N m or N",
             (inputs["q"], inputs["qd"], inputs["qdd"]), "tau", (n,),
-            lambda rec: list(_tau_full(robot, q, qd, qdd, rec))),
+            lambda rec: list(_tau_full(robot, q, qd, qdd, rec, hyd))),
         "mass_matrix": (
             "Joint-space inertia matrix M(q) including reflected rotor inertia",
             (inputs["q"],), "M", (n, n),
-            lambda rec: list(_mass_matrix(robot, q, rec))),
+            lambda rec: list(_mass_matrix(robot, q, rec, hyd))),
         "gravity": (
             "Gravity load g(q): the joint torques that hold the arm still",
             (inputs["q"],), "g", (n,),
-            lambda rec: list(ne.gravity_torque(robot, q, rec))),
+            lambda rec: list(_plus(ne.gravity_torque(robot, q, rec), hyd and hyd.buoyancy))),
         "coriolis": (
             "Coriolis and centrifugal torques C(q, qd) qd",
             (inputs["q"], inputs["qd"]), "c", (n,),
-            lambda rec: list(ne.inverse_dynamics(robot, q, qd, [0] * n, rec, with_gravity=False))),
+            lambda rec: list(_plus(ne.inverse_dynamics(robot, q, qd, [0] * n, rec, with_gravity=False),
+                                   hyd and hyd.coriolis * sp.Matrix(qd)))),
         "forward_dynamics": (
             "Forward dynamics qdd = M^-1 (tau - C qd - g - friction) by Cholesky of M",
             (inputs["q"], inputs["qd"], inputs["tau"]), "qdd", (n,), fd_outputs),
@@ -247,30 +256,53 @@ def _friction(robot: Robot, qd: Sequence[sp.Expr]) -> list[sp.Expr]:
     return out
 
 
+def _pi_as_number(hyd: HydroTerms | None) -> HydroTerms | None:
+    """The terms with ``pi`` as a double (generated C has no portable ``M_PI``)."""
+    if hyd is None:
+        return None
+    pi = {sp.pi: sp.Float(math.pi, 17)}
+    return HydroTerms(*(getattr(hyd, f.name).xreplace(pi) for f in fields(hyd)))
+
+
+def _plus(a: Sequence[sp.Expr], b: sp.MatrixBase | None) -> list[sp.Expr]:
+    """``a + b`` entrywise (``a`` alone when ``b`` is None)."""
+    return list(a) if b is None else [x + y for x, y in zip(a, b, strict=True)]
+
+
+def _hydro_tau(hyd: HydroTerms, qd: Sequence[sp.Expr], qdd: Sequence[sp.Expr]) -> sp.Matrix:
+    # tau_h = M_a qdd + C_a qd + g_B + tau_d + tau_f + tau_L
+    return (hyd.mass_matrix * sp.Matrix(qdd) + hyd.coriolis * sp.Matrix(qd) + hyd.buoyancy
+            + hyd.velocity_forces)
+
+
 def _tau_full(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Expr], qdd: Sequence[sp.Expr],
-              rec: Recorder) -> list[sp.Expr]:
+              rec: Recorder, hyd: HydroTerms | None = None) -> list[sp.Expr]:
     rigid = ne.inverse_dynamics(robot, q, qd, qdd, rec)
     fric = _friction(robot, qd)
     # tau = tau_rigid + G^2 J_m qdd + tau_f
-    return [rigid[j] + reflected_rotor_inertia(robot, j) * qdd[j] + fric[j] for j in range(robot.dof)]
+    tau = [rigid[j] + reflected_rotor_inertia(robot, j) * qdd[j] + fric[j] for j in range(robot.dof)]
+    return _plus(tau, None if hyd is None else _hydro_tau(hyd, qd, qdd))
 
 
-def _mass_matrix(robot: Robot, q: Sequence[sp.Symbol], rec: Recorder) -> sp.Matrix:
+def _mass_matrix(robot: Robot, q: Sequence[sp.Symbol], rec: Recorder,
+                 hyd: HydroTerms | None = None) -> sp.Matrix:
     m = sp.Matrix(crba.mass_matrix(robot, q, rec))
     for j in range(robot.dof):
         # M_jj += G_j^2 J_m,j
         m[j, j] += reflected_rotor_inertia(robot, j)
-    return m
+    # M += M_a (added mass, under water)
+    return m if hyd is None else m + hyd.mass_matrix
 
 
 def _forward_dynamics(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
-                      tau: Sequence[sp.Symbol], rec: Recorder) -> list[sp.Expr]:
+                      tau: Sequence[sp.Symbol], rec: Recorder,
+                      hyd: HydroTerms | None = None) -> list[sp.Expr]:
     """qdd by an unrolled Cholesky factorisation ``M = L L^T`` and two triangular solves."""
     n = robot.dof
-    m = _mass_matrix(robot, q, rec)
+    m = _mass_matrix(robot, q, rec, hyd)
     # b = tau - (C qd + g + friction): inverse dynamics at qdd = 0
     rec.prefix = "h_"
-    bias = _tau_full(robot, q, qd, [0] * n, rec)
+    bias = _tau_full(robot, q, qd, [0] * n, rec, hyd)
     rec.prefix = ""
     b = [rec.scalar(tau[j] - bias[j], f"b{j + 1}") for j in range(n)]
     lower: dict[tuple[int, int], sp.Expr] = {}
