@@ -171,7 +171,8 @@ def test_demo_writes_report(tmp_path, capsys):
     assert "the three formulations agree" in page
     # self-contained: every figure is embedded, none is a file beside the page
     assert page.count("<img ") >= 3 and page.count("<img ") == page.count('<img src="data:image/')
-    assert "seed" not in page.lower()  # no internal jargon: "the thesis"
+    text = re.sub(r'src="data:[^"]*"', "", page)  # base64 may spell anything
+    assert "seed" not in text.lower()  # no internal jargon: "the thesis"
 
 
 # ----------------------------------------------------------------------------------------------
