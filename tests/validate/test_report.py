@@ -43,3 +43,16 @@ def test_manufacturer_model_on_the_joint_2_run():
     np.testing.assert_allclose(val_tau.prediction.relative, val.prediction.relative, rtol=1e-9)
     np.testing.assert_allclose(val_tau.prediction.rms, val.prediction.rms * KINOVA_CONTROLLER_GAINS,
                                rtol=1e-9)
+
+
+def test_gravity_scale_is_one_for_the_same_model_and_nan_without_gravity_load():
+    from robodyn.report.identification_report import _gravity_scale
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = rd.compile_model(rd.load("puma560"))
+    q = np.random.default_rng(5).uniform(-2, 2, (50, 6))
+    scale = _gravity_scale(model, model, q)
+    # joint 1 turns about the vertical: no gravity load to scale
+    assert np.isnan(scale[0])
+    np.testing.assert_allclose(scale[1:3], 1.0, rtol=1e-12)
