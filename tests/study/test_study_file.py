@@ -1,0 +1,94 @@
+"""Study files and ``robodyn sweep``: bad files refused with file, field and reason (exit 2)."""
+
+from __future__ import annotations
+
+import pandas as pd
+import pytest
+
+from robodyn.cli import main
+from robodyn.robot.errors import StudyError
+from robodyn.study import expand_cases
+from robodyn.study.study_file import read_study
+
+GOOD = """
+task: actuator_sizing
+robot: aa300
+settings: {dt: 0.005}
+parameters:
+  payload: [0, 50]
+  bandwidth_hz: {min: 2, max: 8}
+  zeta: {min: 0.5, max: 1.0, steps: 3}
+sampler: {kind: random, n: 2}
+seed: 4
+"""
+
+
+def _write(tmp_path, text, name="study.yaml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_study_file_expands_grid_times_samples(tmp_path):
+    study = read_study(_write(tmp_path, GOOD))
+    cases = expand_cases(study.cases, study.seed)
+    assert len(cases) == 2 * 3 * 2
+    assert sorted({c["zeta"] for c in cases}) == [0.5, 0.75, 1.0]
+    assert all(2 <= c["bandwidth_hz"] <= 8 for c in cases) and study.varying == (
+        "payload", "bandwidth_hz", "zeta")
+    assert expand_cases(read_study(_write(tmp_path, GOOD)).cases, 4) == cases  # deterministic
+
+
+@pytest.mark.parametrize("change, message", [
+    (("  payload: [0, 50]", "  payload_kg: [0, 50]"),
+     r"study.yaml: parameters.payload_kg: unknown parameter 'payload_kg' for actuator sizing of aa300"),
+    (("{min: 2, max: 8}", "{min: 8, max: 2}"), r"study.yaml: parameters.bandwidth_hz: min 8 > max 2"),
+    (("sampler: {kind: random, n: 2}", "sampler: {kind: sobol, n: 2}"), r"sampler.kind: expected"),
+    (("sampler: {kind: random, n: 2}", ""), r"sampler: ranges \['bandwidth_hz'\] need a sampler"),
+    (("seed: 4", "seeds: 4"), r"study.yaml: unknown key 'seeds'"),
+    (("task: actuator_sizing", "task: sizing"), r"study.yaml: task: expected one of"),
+    (("settings: {dt: 0.005}", "settings: {step: 0.005}"), r"study.yaml: settings: .*'step'"),
+])
+def test_bad_study_file_is_named(tmp_path, change, message):
+    path = _write(tmp_path, GOOD.replace(*change))
+    with pytest.raises(StudyError, match=message):
+        read_study(path)
+
+
+def test_cli_bad_study_is_exit_2_in_one_line(tmp_path, capsys):
+    path = _write(tmp_path, GOOD.replace("{min: 2, max: 8}", "{min: 8, max: 2}"))
+    assert main(["sweep", str(path), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "parameters.bandwidth_hz: min 8 > max 2" in err[0]
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_unreachable_scheduler_is_exit_2(tmp_path, capsys):
+    path = _write(tmp_path, GOOD)
+    code = main(["sweep", str(path), "--scheduler", "tcp://127.0.0.1:9", "--timeout", "1",
+                 "-o", str(tmp_path / "out")])
+    assert code == 2
+    assert "cannot reach the Dask scheduler at 'tcp://127.0.0.1:9'" in capsys.readouterr().err
+
+
+def test_cli_sweep_writes_table_figures_and_report(tmp_path, capsys):
+    text = """
+task: actuator_sizing
+robot: aa300
+settings: {trajectory: trapezoid, q_start: [0, 0.6, 1], q_goal: [0.5, 0.9, 1],
+           vmax: [1, 0.5, 1.5], amax: [2, 2, 4], dt: 0.005, settle: 0.1}
+parameters:
+  payload: [0, 50]
+  bandwidth_hz: [3, 5]
+"""
+    path = _write(tmp_path, text)
+    assert main(["sweep", str(path), "--workers", "1", "-o", str(tmp_path / "out")]) == 0
+    out = tmp_path / "out"
+    table = pd.read_parquet(out / "results.parquet")
+    assert list(table.index) == [0, 1, 2, 3] and table["error"].isna().all()
+    assert list(table["payload"]) == [0, 0, 50, 50]
+    csv = pd.read_csv(out / "results.csv", index_col="case")
+    assert (csv["peak_torque.upper_arm"] == table["peak_torque.upper_arm"]).all()
+    html = (out / "study.html").read_text()
+    assert "4 cases" in html and "0 failed" in html and "data:image/png" in html
+    assert (out / "study_map.png").is_file() and (out / "study_histogram.png").is_file()
