@@ -8,7 +8,8 @@ for an integrand with a continuous ``2 N``-th derivative is::
 The drag integrand ``xi^j |u_n(xi)| u_n(xi)`` is a polynomial (exact with ``N >= 2`` for the
 single-cylinder closed form) or smooth when the normal relative velocity does not vanish on the
 segment; where it does vanish inside the segment the integrand has a kink (continuous first
-derivative only) and the error falls algebraically, about as ``N^-3`` (measured in
+derivative only) and the error falls algebraically, about as ``N^-2.5`` (fitted over N = 4..64
+: 6 points 1e-4, 16 points 4e-6, 64 points 5e-8 of an integral of 0.094; measured in
 ``tests/hydro``).
 """
 
