@@ -276,8 +276,9 @@ the controller's current-to-torque constants (9.13 N m/A joints 1&ndash;4, 5.852
 <p>Relative current error of each joint on the held-out data and on the jointwise run in which
 only that joint moves (for its own current), for the identified and the manufacturer's model;
 beside them the identified drive gain against the controller's constant, the identified friction
-and reflected rotor inertia (the URDF has neither), and the identified gravity load as a multiple
-of the URDF's (least-squares scale over the held-out states; the data README estimates about
+and reflected rotor inertia (the URDF has neither), and the current the identified model needs
+to hold the arm against gravity as a multiple of what the URDF with the controller's constant
+needs (least-squares scale of g(q)/k over the held-out states; the data README estimates about
 1.3 on joints 2 and 4 and 2 on joint 6 from a mounted tool).</p>
 {html_table(_JOINT_HEADERS, joint_rows)}
 <details><summary>Identified base parameters</summary>{parameter_table(ident)}</details>
@@ -288,7 +289,7 @@ of the URDF's (least-squares scale over the held-out states; the data README est
 _JOINT_HEADERS = ("joint", "held-out: identified", "held-out: URDF", "jointwise: identified",
                   "jointwise: URDF", "jointwise noise floor", "gain / (N m/A)",
                   "controller gain", "viscous / (N m s)", "Coulomb +/- / N m",
-                  "rotor inertia / (kg m²)", "gravity load / URDF's")
+                  "rotor inertia / (kg m²)", "gravity current / URDF's")
 
 
 def _gravity_scale(identified: Any, urdf: Any, q: np.ndarray) -> np.ndarray:
@@ -324,7 +325,9 @@ def _joint_row(j: int, robot: Any, ident: Any, held_id: Sequence[Validation],
             f"{num(fr.viscous):.4g}",
             f"{num(fr.coulomb_positive):.3g} / {num(fr.coulomb_negative):.3g}",
             f"{num(drive.gear_ratio) ** 2 * num(drive.rotor_inertia):.4g}",
-            "-" if np.isnan(gravity_scale) else f"{gravity_scale:.3f}"]
+            # in current: (g_id / k_id) / (g_urdf / k_controller)
+            "-" if np.isnan(gravity_scale) else
+            f"{gravity_scale * KINOVA_CONTROLLER_GAINS[j] / ident.gains[j]:.3f}"]
 
 
 def _default_data_dir() -> Path:
