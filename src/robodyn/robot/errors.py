@@ -94,16 +94,3 @@ class DataFileError(ValueError):
     repeated column, a value that is not a finite number).
     """
 
-
-class SimulationError(FloatingPointError, ValueError):
-    """A simulation (or a forward-dynamics call) stopped being finite.
-
-    A ``FloatingPointError`` (what the integrators always raised) and a ``ValueError`` (what the
-    command line reports as bad input, exit 2). The message says when it happened and what to
-    change.
-    """
-
-
-class SingularMassMatrixError(SimulationError):
-    """The joint-space mass matrix is singular (a joint moves no mass, inertia or rotor), so the
-    forward dynamics has no solution. The message names the robot and the joint."""
