@@ -555,11 +555,14 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
     traj = best[1]
     steps = int(round(total / dt))
     t = np.linspace(0.0, steps * dt, steps + 1)
+    # the continuous motion, checked on a grid 10x finer than the output, must stay within the
+    # limits: shrink the oscillation about the offset where needed, with a 1e-6 relative margin
+    # (far above the excess possible between those check points)
+    t_check = np.linspace(0.0, period, 10 * max(1, int(round(period / dt))) + 1)
+    s_fit = _shrink_factor(*traj.evaluate(t_check), traj.offset, lim)
+    if s_fit < 1.0:
+        traj = traj.scaled(s_fit * (1.0 - 1e-6))
     q, qd, qdd = traj.evaluate(t)
-    if lim.violation(q, qd, qdd) > 0:
-        # the output grid is finer than the design grid: shrink about the offset to fit it too
-        traj = traj.scaled(_shrink_factor(q, qd, qdd, traj.offset, lim))
-        q, qd, qdd = traj.evaluate(t)
     # rest at both ends (exact in the series; remove rounding of the sines)
     for arr, ref in ((q, traj.offset), (qd, 0.0), (qdd, 0.0)):
         arr[0] = arr[-1] = ref
@@ -579,7 +582,7 @@ def _shrink_factor(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, off: np.ndarr
     dq = q - off
     ratio = max(np.max(np.where(dq > 0, dq / (lim.upper - off), -dq / (off - lim.lower))),
                 np.max(np.abs(qd) / lim.velocity), np.max(np.abs(qdd) / lim.acceleration))
-    return min(1.0, (1.0 - 1e-12) / ratio)
+    return min(1.0, 1.0 / ratio)
 
 
 def _logdet(model: Model, traj: FourierTrajectory, t: np.ndarray, cols: Sequence[int]) -> float:
