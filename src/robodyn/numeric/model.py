@@ -265,8 +265,11 @@ class Model:
         if status:
             # the last finite state: a singular mass matrix there is the explanation
             self.check_mass_matrix(x_out[status - 1, :n])
-            raise SimulationError(f"the simulated state stopped being finite at step {status - 1} "
+            exc = SimulationError(f"the simulated state stopped being finite at step {status - 1} "
                                   f"(t = {(status - 1) * dt:g} s); reduce dt or check the inputs")
+            # the last finite state, for a caller's diagnosis
+            exc.state = x_out[status - 1].copy()
+            raise exc
         return x_out, tau_out
 
     # --- plumbing ------------------------------------------------------------------------------

@@ -103,7 +103,7 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
              method: str = "rk4", controller: ControllerLike = None, *,
              tau_limit: float | np.ndarray | None = None, rtol: float = 1e-9,
              atol: float = 1e-12, control: str = "sampled", decimate: int = 1,
-             max_samples: int | None = MAX_SAMPLES) -> Trajectory:
+             max_samples: int | None = MAX_SAMPLES, substeps: int = 1) -> Trajectory:
     """Simulate ``model`` from ``(q0, qd0)`` for ``duration`` seconds.
 
     Parameters
@@ -141,6 +141,12 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
     max_samples : int or None
         Refuse a run that would keep more samples than this (default :data:`MAX_SAMPLES`,
         checked before anything is allocated); None: no limit.
+    substeps : int
+        Fixed-step methods with ``control="sampled"``: the law is still evaluated every ``dt``
+        and held, but the plant is integrated with ``substeps`` steps of ``dt / substeps`` (the
+        loop over the control steps then runs in Python). For a plant stiffer than the control
+        rate: RK4 is stable only while ``|lambda| dt < 2.79`` for every mode ``lambda`` of the
+        held-torque dynamics (e.g. viscous friction over a small wrist inertia, ``-b / m``).
 
     Returns
     -------
@@ -179,6 +185,12 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
             f"{max_samples:,}; keep every k-th step with decimate=k (k >= "
             f"{-(-steps // (max_samples - 1)) if max_samples > 1 else steps}), shorten the run, "
             "or raise max_samples")
+    if isinstance(substeps, bool) or not isinstance(substeps, int | np.integer) or substeps < 1:
+        raise ValueError(f"simulate: substeps must be a positive integer, got {substeps!r}")
+    if substeps > 1 and (control != "sampled" or method not in FIXED_STEP):
+        raise ValueError("simulate: substeps needs a fixed-step method and control='sampled' (a "
+                         "continuous law or a SciPy method already evaluates the law wherever it "
+                         "evaluates the dynamics)")
     if method not in FIXED_STEP + ADAPTIVE:
         raise ValueError(f"unknown method {method!r}; choose one of {', '.join(FIXED_STEP + ADAPTIVE)}")
     if control not in ("sampled", "continuous"):
@@ -205,13 +217,17 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
     t = dt * np.arange(0, steps + 1, decimate)
     x0 = np.concatenate([q0, qd0])
     continuous = control == "continuous"
-    if method in FIXED_STEP and (controller is None or isinstance(controller, Controller)):
-        x, tau, evals = _fixed_step_c(model, x0, steps, dt, decimate, method, controller, limit,
-                                      continuous, max_samples)
-    elif method in FIXED_STEP:
-        x, tau, evals = _fixed_step_python(model, x0, steps, dt, decimate, method, controller,
-                                           limit, continuous)
-    else:
+    try:
+        if method in FIXED_STEP and substeps == 1 and (controller is None
+                                                       or isinstance(controller, Controller)):
+            x, tau, evals = _fixed_step_c(model, x0, steps, dt, decimate, method, controller, limit,
+                                          continuous, max_samples)
+        elif method in FIXED_STEP:
+            x, tau, evals = _fixed_step_python(model, x0, steps, dt, decimate, method, controller,
+                                               limit, continuous, substeps)
+    except SimulationError as exc:
+        raise _diagnosed(exc, model, x0, dt / substeps, method, control) from None
+    if method in ADAPTIVE:
         x, tau, evals = _adaptive(model, x0, t, method, controller, limit, rtol, atol)
     return _result(model, t, x, tau, method, dt, controller, evals, decimate)
 
@@ -293,16 +309,26 @@ def _fixed_step_c(model: Model, x0: np.ndarray, steps: int, dt: float, decimate:
 
 
 def _fixed_step_python(model: Model, x0: np.ndarray, steps: int, dt: float, decimate: int,
-                       method: str, controller: Callable, limit: np.ndarray | None,
-                       continuous: bool) -> tuple[np.ndarray, np.ndarray, int]:
-    """A Python callable, sampled or at every RK4 stage: the loop over the steps in Python."""
+                       method: str, controller: ControllerLike, limit: np.ndarray | None,
+                       continuous: bool, substeps: int = 1) -> tuple[np.ndarray, np.ndarray, int]:
+    """The loop over the control steps in Python: a callable (sampled or at every RK4 stage), or
+    any sampled law held over ``substeps`` integration steps."""
     n = model.dof
     keep = steps // decimate + 1
     x_out, tau_out = np.empty((keep, 2 * n)), np.empty((keep, n))
     f = model.state_derivative
+    z = np.zeros(n)
 
     def law(tk: float, xk: np.ndarray) -> np.ndarray:
-        return _clip(_call(controller, tk, xk, n), limit)
+        nonlocal z
+        if controller is None:
+            return np.zeros(n)
+        if not isinstance(controller, Controller):
+            return _clip(_call(controller, tk, xk, n), limit)
+        if controller.has_integral:
+            # z += dt (q_ref(t_k) - q_k) before the torque, as the generated loop does
+            z = z + dt * controller.position_error(tk, xk[:n])
+        return _clip(controller.law(model, tk, xk, z), limit)
 
     x = x0
     for k in range(steps):
@@ -325,10 +351,62 @@ def _fixed_step_python(model: Model, x0: np.ndarray, steps: int, dt: float, deci
                 raise SimulationError(f"the simulated state stopped being finite at step {k} "
                                       f"(t = {tk:g} s); reduce dt or check the inputs")
         else:
-            # one step with the torque held (zero-order hold)
-            x = model.integrate(x, 1, dt, method, feedforward=tau[None])[0][1]
+            # the torque held over the step (zero-order hold), the plant in substeps
+            held = np.broadcast_to(tau, (substeps, n))
+            try:
+                x = model.integrate(x, substeps, dt / substeps, method, feedforward=held)[0][-1]
+            except SimulationError:
+                exc = SimulationError(f"the simulated state stopped being finite at step {k} "
+                                      f"(t = {tk:g} s); reduce dt or check the inputs")
+                exc.state = x
+                raise exc from None
     x_out[-1], tau_out[-1] = x, law(steps * dt, x)
-    return x_out, tau_out, steps * (4 if method == "rk4" else 1)
+    return x_out, tau_out, steps * substeps * (4 if method == "rk4" else 1)
+
+
+#: Largest ``|lambda| h`` on the negative real axis for which one step is stable.
+_STABLE = {"rk4": 2.785, "semi_implicit": 2.0}
+
+
+def _diagnosed(exc: SimulationError, model: Model, x: np.ndarray, h: float, method: str,
+               control: str) -> SimulationError:
+    """The blow-up explained when the plant is too stiff for the integration step ``h``.
+
+    Linearises the held-torque dynamics ``xd = f(x, tau)`` at the initial state ``x`` (central
+    differences; the last finite state is already far off) and compares its fastest mode with
+    the method's stability limit.
+    """
+    if method not in _STABLE:
+        return exc
+    n = model.dof
+    # a typical held torque: the one that keeps the current velocities unaccelerated
+    tau = model.inverse_dynamics(x[:n], x[n:], np.zeros(n))
+    jac = np.empty((2 * n, 2 * n))
+    for i in range(2 * n):
+        eps = 1e-6 * max(1.0, abs(x[i]))
+        e = np.zeros(2 * n)
+        e[i] = eps
+        # A[:, i] = (f(x + e) - f(x - e)) / 2 eps
+        jac[:, i] = (model.state_derivative(x + e, tau) - model.state_derivative(x - e, tau)) / (2 * eps)
+    if not np.all(np.isfinite(jac)):
+        return exc
+    lam, vec = np.linalg.eig(jac)
+    k = int(np.argmax(np.abs(lam)))
+    rate = float(np.abs(lam[k]))
+    if rate * h <= _STABLE[method]:
+        return SimulationError(f"{exc}; the plant's fastest mode ({rate:.3g} 1/s) is within "
+                               f"{method}'s stability at dt = {h:g} s, so the control loop itself "
+                               "diverged: lower the gains or sample faster")
+    joint = model.robot.joints[int(np.argmax(np.abs(vec[n:, k])))].name
+    # |lambda| h <= 1 resolves the mode; the stability limit alone leaves it barely damped
+    fixes = (f"substeps >= {int(np.ceil(rate * h))} (the plant integrated at |lambda| h <= 1, "
+             "the law still sampled every dt)" if control == "sampled"
+             else f"a step below {1 / rate:.2g} s")
+    return SimulationError(
+        f"{exc}: the held-torque dynamics has a mode of {rate:.4g} 1/s (mostly joint {joint!r}: "
+        f"e.g. viscous friction over a small inertia) and {method} is stable only while |lambda| "
+        f"dt < {_STABLE[method]:g}, not {rate * h:.3g} at dt = {h:g} s: a numerical, not a "
+        f"physical, instability. Use {fixes}, control='continuous', or method='Radau' or 'BDF'")
 
 
 def _adaptive(model: Model, x0: np.ndarray, t: np.ndarray, method: str, controller: ControllerLike,
