@@ -118,7 +118,8 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         try:
             sim = rd.simulate(model, q0, qd0, args.duration, args.dt, method=args.method,
                               controller=controller, tau_limit=limit, control=args.control,
-                              decimate=args.decimate, max_samples=args.max_samples or None)
+                              decimate=args.decimate, max_samples=args.max_samples or None,
+                              substeps=args.substeps)
         except FloatingPointError as exc:
             # the controller's or the integrator's message, as one line and exit 2
             raise ValueError(str(exc)) from None
@@ -285,6 +286,9 @@ def _simulate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
     p.add_argument("--backend", choices=("c", "numpy"), default="c",
                    help="compiled C (needs a C compiler) or pure NumPy (no compiler; slower) "
                         "(default: %(default)s)")
+    p.add_argument("--substeps", type=int, default=1, metavar="K",
+                   help="sampled control: hold the law over K integration steps of dt/K (for a "
+                        "plant stiffer than the control rate) (default: %(default)s)")
     p.add_argument("--decimate", type=int, default=1, metavar="K",
                    help="keep every K-th step in the CSV and plots (the integration still uses "
                         "--dt) (default: %(default)s)")
