@@ -21,7 +21,8 @@ from tests.fuzz.strategies import MAX_BYTES, TOKENS, fuzz_settings, mutated
 from tests.urdf_chains import random_urdf
 
 # the small built-ins (the 3 s aa300 and the 7-joint Gen3 would dominate the time budget)
-_SMALL = ("planar_2r", "puma560", "trolley_pendulum", "trolley_double_pendulum", "puma560_akb")
+_SMALL = ("planar_2r", "puma560", "trolley_pendulum", "trolley_double_pendulum", "puma560_akb",
+          "underwater_2r")
 LIBRARY = [(resources.files("robodyn.robot.library") / f"{n}.yaml").read_text() for n in _SMALL]
 
 
