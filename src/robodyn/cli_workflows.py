@@ -203,8 +203,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
 
 
 def _cmd_iso9283(args: argparse.Namespace) -> int:
-    from robodyn.calibrate.io import read_table
-    from robodyn.calibrate.iso9283 import overshoot_stabilisation, pose_characteristics_from_csv
+    from robodyn.calibrate.iso9283 import overshoot_from_csv, pose_characteristics_from_csv
 
     if args.data is None and args.approach is None:
         raise ValueError("give a CSV of repeated poses (DATA) and/or --approach FILE.csv")
@@ -213,10 +212,8 @@ def _cmd_iso9283(args: argparse.Namespace) -> int:
         print(f"ISO 9283 pose accuracy and repeatability, {args.data} ({pc.cycles} cycles)")
         print(pc.text())
     if args.approach is not None:
-        t = read_table(args.approach, ["t", "x", "y", "z"])
-        x = np.column_stack([t[c] for c in ("x", "y", "z")])
         attained = _vector(args.attained, 3, "--attained") if args.attained is not None else None
-        ov = overshoot_stabilisation(np.asarray(t["t"]), x, band=args.band * 1e-3, attained=attained)
+        ov = overshoot_from_csv(args.approach, band=args.band * 1e-3, attained=attained)
         stab = (f"{ov.stabilisation_time:.4g} s" if not math.isnan(ov.stabilisation_time)
                 else "not stabilised within the record")
         over = (f"{ov.overshoot * 1e3:.4f} mm" if not math.isnan(ov.overshoot)

@@ -14,7 +14,12 @@ import numpy as np
 import pytest
 
 from robodyn.calibrate.io import read_calibration_csv, read_table
-from robodyn.calibrate.iso9283 import pose_characteristics, pose_characteristics_from_csv
+from robodyn.calibrate.iso9283 import (
+    overshoot_from_csv,
+    overshoot_stabilisation,
+    pose_characteristics,
+    pose_characteristics_from_csv,
+)
 from robodyn.robot.errors import DataFileError
 from tests.calibrate.helpers import robot
 
@@ -126,3 +131,23 @@ def test_iso9283_single_cycle_and_huge_values_are_data_errors(tmp_path):
 def test_calibration_values_beyond_1000_km_are_refused(tmp_path):
     raises(write(tmp_path, HEADER + ROW.replace("1.0,", "2e6,")),
            r"line 2, column 'x': 2e6 is out of range \(at most 1e\+06 in magnitude\)$")
+
+
+def test_approach_csv_errors_name_the_file(tmp_path):
+    # before: the CLI printed "t must be (T,) ..." / "trajectory times must increase" without
+    # naming the file or the line
+    read = lambda p: overshoot_from_csv(p, band=1e-3)  # noqa: E731
+    raises(write(tmp_path, "t,x,y,z\n0,0,0,0\n0.1,0,0,0\n"),
+           r"2 data row\(s\); an approach needs at least 3$", read)
+    raises(write(tmp_path, "t,x,y,z\n0,0,0,0\n# pause\n0.2,0,0,0\n0.1,0,0,0\n"),
+           r"line 5, column 't': times must increase \(0\.1 after 0\.2\)$", read)
+
+
+def test_approach_csv_matches_the_array_function(tmp_path):
+    t = np.linspace(0, 1, 11)
+    x = np.column_stack([0.5 + 0.01 * np.exp(-5 * t) * np.cos(20 * t), 0 * t, 0 * t])
+    rows = np.column_stack([t, x])
+    text = "t,x,y,z\n" + "".join(",".join(repr(float(v)) for v in r) + "\n" for r in rows)
+    ov = overshoot_from_csv(write(tmp_path, text), band=1e-3)
+    ref = overshoot_stabilisation(t, x, band=1e-3)
+    assert ov == ref

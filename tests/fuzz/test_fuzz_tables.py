@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 import robodyn as rd
 from robodyn.calibrate.io import read_calibration_csv
-from robodyn.calibrate.iso9283 import pose_characteristics_from_csv
+from robodyn.calibrate.iso9283 import overshoot_from_csv, pose_characteristics_from_csv
 from robodyn.robot.errors import DataFileError, DescriptionWarning
 from tests.fuzz.strategies import TOKENS, fuzz_settings, mutated
 
@@ -30,6 +30,8 @@ CAL = ["q1,q2,q3,q4,q5,q6,x,y,z,qw,qx,qy,qz,sigma\n" + "".join(
 ISO = ["pose,x_cmd,y_cmd,z_cmd,x,y,z\n" + "".join(
     f"P{p},0.{p},0,0.5,0.{p}001,0.0002,0.4999\nP{p},0.{p},0,0.5,0.{p}003,-0.0001,0.5002\n"
     for p in range(1, 4))]
+APPROACH = ["t,x,y,z\n" + "".join(f"{0.01 * k:.2f},{0.5 + 0.01 * 0.7 ** k:.6f},0,0\n"
+                                  for k in range(12))]
 
 
 def outcome(read, data: str | bytes) -> None:
@@ -97,3 +99,14 @@ def test_calibration_csv(data: str | bytes) -> None:
 @given(st.one_of(mutated(ISO), _table, _iso_table, st.binary(max_size=512)))
 def test_iso9283_csv(data: str | bytes) -> None:
     outcome(read_iso, data)
+
+
+def read_approach(path: Path) -> None:
+    ov = overshoot_from_csv(path, band=1e-3)
+    assert np.all(np.isfinite(ov.attained))
+
+
+@fuzz_settings(deadline_s=10)
+@given(st.one_of(mutated(APPROACH), _table, st.binary(max_size=512)))
+def test_approach_csv(data: str | bytes) -> None:
+    outcome(read_approach, data)

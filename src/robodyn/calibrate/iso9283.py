@@ -42,6 +42,7 @@ __all__ = [
     "PoseCharacteristics",
     "cube_corners",
     "cube_points",
+    "overshoot_from_csv",
     "overshoot_stabilisation",
     "pose_characteristics",
     "pose_characteristics_from_csv",
@@ -287,3 +288,31 @@ def pose_characteristics_from_csv(path: str | Path) -> PoseCharacteristics:
         raise DataFileError(f"{path}: one cycle per pose; repeatability needs at least 2")
     return pose_characteristics(np.array(cmd), np.array(att), labels=labels)
 
+
+def overshoot_from_csv(path: str | Path, *, band: float, attained=None) -> Overshoot:
+    """Overshoot and stabilisation time of a measured approach read from a CSV file.
+
+    Columns (header row, any order; ``#`` lines are comments): ``t`` (s, increasing) and ``x``,
+    ``y``, ``z`` (m), at least 3 rows; values at most
+    :data:`robodyn.calibrate.io.MAX_ABS_VALUE` in magnitude. ``band`` and ``attained`` as in
+    :func:`overshoot_stabilisation`.
+
+    Raises
+    ------
+    FileNotFoundError, DataFileError
+        See :func:`robodyn.calibrate.io.read_table`; also too few rows or times that do not
+        increase (the message names the file).
+    """
+    from robodyn.calibrate.io import MAX_ABS_VALUE, _read_table
+    from robodyn.robot.errors import DataFileError
+
+    table, lines = _read_table(path, ["t", "x", "y", "z"], (), (), MAX_ABS_VALUE)
+    t = np.asarray(table["t"])
+    x = np.column_stack([table[c] for c in ("x", "y", "z")])
+    if len(t) < 3:
+        raise DataFileError(f"{path}: {len(t)} data row(s); an approach needs at least 3")
+    if np.any(np.diff(t) <= 0):
+        k = int(np.flatnonzero(np.diff(t) <= 0)[0])
+        raise DataFileError(f"{path}: line {lines[k + 1]}, column 't': times must increase "
+                            f"({t[k + 1]:g} after {t[k]:g})")
+    return overshoot_stabilisation(t, x, band=band, attained=attained)
