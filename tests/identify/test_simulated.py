@@ -42,6 +42,16 @@ def test_noise_free_data_recover_the_base_parameters(compiled):
                                rtol=0, atol=1e-9 * np.abs(rec.tau).max())
 
 
+def test_identified_robot_reproduces_the_prediction(compiled):
+    """ident.robot (a Robot) compiled anew gives the identified model's torques."""
+    robot, model = compiled
+    rec, _ = simulated(model, seconds=10.0, dt=0.02, seed=9, noise=0.05)
+    ident = rd.identify(robot, rec, method="wls", cutoff=None, model=model)
+    again = rd.compile_model(ident.robot)
+    np.testing.assert_allclose(again.inverse_dynamics(rec.q, rec.qd, rec.qdd), ident.predict(rec),
+                               rtol=1e-9, atol=1e-9 * np.abs(rec.tau).max())
+
+
 def test_base_relations_hold_for_the_full_regressor(compiled):
     robot, model = compiled
     from robodyn.identify.base import base_relations, random_states

@@ -26,6 +26,10 @@ def _f(x: float) -> sp.Expr:
     return sp.Integer(0) if x == 0 else sp.Float(float(x), 17)
 
 
+def _num(value: sp.Expr | None, subs: dict) -> sp.Expr | None:
+    return None if value is None else sp.sympify(value).xreplace(subs)
+
+
 def robot_with_parameters(nominal: Robot, standard: np.ndarray, gains: np.ndarray | None = None, *,
                           name: str | None = None, source: str = "") -> Robot:
     """The nominal robot with its inertial, drive and friction data replaced.
@@ -66,6 +70,10 @@ def robot_with_parameters(nominal: Robot, standard: np.ndarray, gains: np.ndarra
             pre=sp.ImmutableMatrix(joint.pre.xreplace(subs)),
             post=sp.ImmutableMatrix(joint.post.xreplace(subs)),
             axis=sp.ImmutableMatrix(joint.axis.xreplace(subs)),
+            lower=_num(joint.lower, subs),
+            upper=_num(joint.upper, subs),
+            velocity_limit=_num(joint.velocity_limit, subs),
+            effort_limit=_num(joint.effort_limit, subs),
             drive=drive,
             friction=Friction(viscous=_f(fv), coulomb_positive=_f(fcp), coulomb_negative=_f(fcn),
                               offset=_f(fo)),

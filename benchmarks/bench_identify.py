@@ -1,0 +1,102 @@
+"""Identification speed: stacking the identification matrix, and whole identifications.
+
+Prints, in one run:
+
+  1. stacking the identification matrix (full regressor, 7 x 105 per sample) for 100,000
+     Kinova Gen3 samples: robodyn's batched compiled regressor, written in chunks into one
+     matrix (``robodyn.identify.stacking.identification_matrix``), against a
+     Python loop over Pinocchio's ``computeJointTorqueRegressor`` on the same arm (the
+     manufacturer's URDF, ../shared/data/kinova-gen3/gen3.urdf), the ratio (target >= 10x) and
+     the agreement of the rigid-body columns;
+  2. whole identifications of the Kinova whole-arm runs (all three, motor current) with
+     ``rd.identify`` for OLS, WLS and the physically consistent SDP, in seconds each.
+
+Run: ``.venv/bin/python benchmarks/bench_identify.py [--samples N] [--repeat N]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+import robodyn as rd
+from robodyn.identify.stacking import identification_matrix
+from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+from tests.identify.kinova import DATA, WHOLE_ARM_FILES, read  # noqa: E402
+from tests.urdf_chains import pin_q  # noqa: E402
+
+PIN_ORDER = [INERTIAL_NAMES.index(k) for k in ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")]
+
+
+def best_of(fn, repeat: int):
+    """Smallest wall time of ``repeat`` calls, and the last result."""
+    best, out = float("inf"), None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - start)
+    return best, out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--samples", type=int, default=100_000)
+    parser.add_argument("--repeat", type=int, default=3, help="timing repeats (best is kept)")
+    args = parser.parse_args()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = rd.load("kinova_gen3")
+    model = rd.compile_model(robot)
+    n, count = robot.dof, args.samples
+    rng = np.random.default_rng(0)
+    q, qd, qdd = rng.uniform(-2, 2, (3, count, n))
+
+    t_rd, y = best_of(lambda: identification_matrix(model, q, qd, qdd), args.repeat)
+    print(f"stacking {count} Gen3 samples ({count * n} x {y.shape[1]}):")
+    print(f"  robodyn identification_matrix (batched C)  {t_rd:8.3f} s  "
+          f"{1e9 * t_rd / count:8.0f} ns/sample")
+    try:
+        import pinocchio as pin
+    except ImportError:
+        print("  pinocchio not installed: no peer timing")
+    else:
+        pmodel = pin.buildModelFromUrdf(str(DATA / "gen3.urdf"))
+        pmodel.gravity.linear = np.array([0.0, 0.0, -9.81])
+        data = pmodel.createData()
+        out = np.empty((count * n, 10 * n))
+        qp = np.array([pin_q(pmodel, qi) for qi in q])  # continuous joints: (cos, sin)
+
+        def loop():
+            for i in range(count):
+                out[i * n:(i + 1) * n] = pin.computeJointTorqueRegressor(pmodel, data, qp[i], qd[i], qdd[i])
+            return out
+
+        t_pin, w = best_of(loop, 1)
+        print(f"  Pinocchio computeJointTorqueRegressor loop    {t_pin:8.3f} s  "
+              f"{1e9 * t_pin / count:8.0f} ns/sample")
+        print(f"  ratio Pinocchio / robodyn: {t_pin / t_rd:.1f}x (target >= 10x)")
+        cols = [PER_JOINT * j + k for j in range(n) for k in PIN_ORDER]
+        dev = np.abs(y[:, cols] - w).max() / np.abs(w).max()
+        print(f"  rigid-body columns agree to {dev:.1e} (relative to the largest entry)")
+
+    runs = [read(p) for p in WHOLE_ARM_FILES]
+    print(f"whole identification, Kinova whole-arm runs ({sum(r.n_samples for r in runs)} samples, "
+          f"target current, defaults):")
+    for method in ("ols", "wls", "consistent"):
+        t, ident = best_of(lambda m=method: rd.identify(robot, runs, target="current", method=m,
+                                                        model=model), 1)
+        print(f"  {method:>10}: {t:6.2f} s  (cut-off {ident.preprocess.cutoff:g} Hz, decimate "
+              f"{ident.preprocess.decimate}, {len(ident.base_parameters)} base parameters, "
+              f"lambda {ident.regularization:.3g})")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,49 @@
+"""The stacked identification matrix ``W`` (N n, p): the batched compiled regressor, chunked.
+
+``W[k n + i, :] = Y(q_k, qd_k, qdd_k)[i, columns]``: one row per joint ``i`` per sample ``k``
+(sample-major). The regressor is evaluated in chunks of ``CHUNK`` samples written into one
+preallocated matrix, so that stacking 100,000 samples of a 7-joint arm does not first build a
+second full-size temporary.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from robodyn.numeric.model import Model
+
+__all__ = ["CHUNK", "identification_matrix"]
+
+CHUNK = 4096
+
+
+def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
+                          columns: Sequence[int] | None = None) -> np.ndarray:
+    """Stacked regressor.
+
+    Parameters
+    ----------
+    model : Model
+        ``rd.compile_model(robot)``.
+    q, qd, qdd : numpy.ndarray, shape (N, n)
+        rad, rad/s, rad/s^2 (m, m/s, m/s^2 for prismatic joints).
+    columns : sequence of int, optional
+        Regressor columns to keep (default all ``15 n``).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N n, p)
+    """
+    q, qd, qdd = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (q, qd, qdd))
+    count, n = q.shape
+    cols = None if columns is None else np.asarray(columns, dtype=int)
+    width = 15 * n if cols is None else cols.size
+    out = np.empty((count * n, width))
+    for start in range(0, count, CHUNK):
+        stop = min(start + CHUNK, count)
+        y = model.regressor(q[start:stop], qd[start:stop], qdd[start:stop])
+        block = y.reshape((stop - start) * n, -1)
+        out[start * n:stop * n] = block if cols is None else block[:, cols]
+    return out
