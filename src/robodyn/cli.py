@@ -25,6 +25,7 @@ from robodyn.cli_cache import add_cache_parser
 from robodyn.cli_identify import add_parsers as add_identify_parsers
 from robodyn.cli_record import add_record_parser
 from robodyn.cli_sweep import add_sweep_parser
+from robodyn.cli_underwater import add_underwater_parser
 from robodyn.cli_workflows import add_parsers
 from robodyn.report.agreement import (
     AGREEMENT_HEADERS,
@@ -308,6 +309,7 @@ def _parser() -> argparse.ArgumentParser:
     add_record_parser(sub, fmt, _ROBOT_HELP)
     add_cache_parser(sub, fmt)
     add_sweep_parser(sub, fmt)
+    add_underwater_parser(sub, fmt)
 
     p = sub.add_parser("demo", help="PUMA 560 three ways: files, comparison and HTML report",
                        formatter_class=fmt,

@@ -1,0 +1,87 @@
+"""``robodyn underwater ROBOT -o DIR``: the effect series of an underwater arm (thesis ch. 7).
+
+Kept apart from :mod:`robodyn.cli` (which registers it); it parses, calls
+:func:`robodyn.hydro.study.effect_series` and :func:`robodyn.hydro.study_plots.write_study`, and
+prints the files written. A robot without hydro blocks is a
+:class:`~robodyn.robot.errors.StudyError` (exit 2, one line).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import robodyn as rd
+from robodyn.hydro.study import DEFAULT_CURRENT, EFFECTS, effect_series
+from robodyn.hydro.study_plots import write_study
+
+__all__ = ["add_underwater_parser"]
+
+
+def _seconds(text: str) -> float:
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text}")
+    return value
+
+
+def _assignment(text: str) -> tuple[str, float]:
+    name, sep, value = text.partition("=")
+    if not sep or not name.strip():
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE, got {text!r}")
+    try:
+        return name.strip(), float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: {value!r} is not a number") from None
+
+
+def _cmd_underwater(args: argparse.Namespace) -> int:
+    robot = rd.load(args.robot)
+    series = effect_series(
+        robot, start=args.start, end=args.end, move_time=args.move_time,
+        hold_time=args.hold_time, free_time=args.free_time, dt=args.dt, bandwidth=args.bandwidth,
+        current=args.current, lift=args.lift, parameters=dict(args.set or []),
+        backend=args.backend, progress=True)
+    for path in write_study(series, args.output):
+        print(path)
+    return 0
+
+
+def add_underwater_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
+    """Register ``robodyn underwater`` on the main parser's subcommands."""
+    p = sub.add_parser(
+        "underwater", help="effect series of an underwater arm (buoyancy, added mass, drag, ...)",
+        formatter_class=fmt,
+        description="Simulate the robot in air and in water with the hydrodynamic effects switched "
+                    f"on one at a time ({', '.join(EFFECTS)}): a quintic move tracked by the same "
+                    "PD controller, and a free motion from rest. Writes effects.csv and effects.md "
+                    "(peak/RMS torque per joint, tracking error, settling, difference against dry, "
+                    "free-motion amplitude), figures, underwater_section.html and underwater.html "
+                    "to DIR. The robot needs hydro blocks (see docs/underwater.md).",
+        epilog="example:\n  robodyn underwater underwater_2r -o out/underwater")
+    p.add_argument("robot", metavar="ROBOT", help="built-in name or a .yaml description")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder (created)")
+    p.add_argument("--start", type=float, nargs="+", metavar="Q",
+                   help="start of the move, one value per joint, rad or m (default: 0)")
+    p.add_argument("--end", type=float, nargs="+", metavar="Q",
+                   help="end of the move (default: start + 0.8 rad / 0.1 m per joint)")
+    p.add_argument("--move-time", type=_seconds, default=2.0, metavar="S",
+                   help="duration of the move, s (default: %(default)s)")
+    p.add_argument("--hold-time", type=_seconds, default=1.0, metavar="S",
+                   help="hold after the move, s (default: %(default)s)")
+    p.add_argument("--free-time", type=_seconds, default=3.0, metavar="S",
+                   help="duration of the free motion, s (default: %(default)s)")
+    p.add_argument("--dt", type=_seconds, default=1e-3, metavar="S",
+                   help="RK4 step, s (default: %(default)s)")
+    p.add_argument("--bandwidth", type=_seconds, default=2.0, metavar="HZ",
+                   help="PD closed-loop natural frequency, Hz (default: %(default)s)")
+    p.add_argument("--current", type=float, nargs=3, metavar=("VX", "VY", "VZ"),
+                   help="current of the last variant, base frame, m/s (default: the description's "
+                        f"when not zero, else {' '.join(f'{c:g}' for c in DEFAULT_CURRENT)})")
+    p.add_argument("--lift", type=float, metavar="CL",
+                   help="lift coefficient of every wet link from the lift variant on "
+                        "(default: the description's)")
+    p.add_argument("--set", type=_assignment, action="append", metavar="NAME=VALUE",
+                   help="value of a named parameter of the description (repeatable)")
+    p.add_argument("--backend", choices=("c", "numpy"), default="c",
+                   help="compiled C or the NumPy fallback (default: %(default)s)")
+    p.set_defaults(func=_cmd_underwater)
