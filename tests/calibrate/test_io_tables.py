@@ -151,3 +151,16 @@ def test_approach_csv_matches_the_array_function(tmp_path):
     ov = overshoot_from_csv(write(tmp_path, text), band=1e-3)
     ref = overshoot_stabilisation(t, x, band=1e-3)
     assert ov == ref
+
+
+def test_cli_bad_calibration_csv_is_exit_2_in_one_line_and_writes_nothing(tmp_path, capsys):
+    from robodyn.cli import main
+
+    data = (HEADER + "9," + ROW).encode()
+    path = write(tmp_path, data)
+    out = tmp_path / "out"
+    assert main(["calibrate", "puma560", "--data", str(path), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"robodyn: error: {path}: line 2: 10 values, but the header (line 1) has 9 "
+                   "columns\n")
+    assert not out.exists() and path.read_bytes() == data

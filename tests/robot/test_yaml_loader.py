@@ -583,3 +583,14 @@ def test_description_hash_is_canonical() -> None:
     assert a.description_hash == b.description_hash
     assert a.description_hash != c.description_hash
     assert re.fullmatch(r"[0-9a-f]{64}", a.description_hash)
+
+
+def test_oversized_description_file_is_refused_before_reading(tmp_path: Path) -> None:
+    from robodyn.robot.yaml_loader import MAX_DESCRIPTION_BYTES
+
+    path = tmp_path / "huge.yaml"
+    with path.open("wb") as fh:  # a sparse file: nothing is written but the size
+        fh.truncate(MAX_DESCRIPTION_BYTES + 1)
+    pattern = rf"^{re.escape(str(path))}: 4,194,305 bytes is too large for a robot description"
+    with pytest.raises(DescriptionError, match=pattern):
+        load_yaml_file(path)

@@ -28,7 +28,13 @@ from robodyn.robot.errors import DescriptionError
 from robodyn.robot.expressions import parameter_symbol, parse_value
 from robodyn.robot.model import Drive, Friction, Link, Robot
 
-__all__ = ["JOINT_TYPES", "MAX_YAML_DEPTH", "load_yaml_file", "load_yaml_text"]
+__all__ = [
+    "JOINT_TYPES",
+    "MAX_DESCRIPTION_BYTES",
+    "MAX_YAML_DEPTH",
+    "load_yaml_file",
+    "load_yaml_text",
+]
 
 #: Joint types accepted in ``joints[i].type`` and the type they load as.
 JOINT_TYPES: Mapping[str, str] = MappingProxyType(
@@ -49,6 +55,9 @@ _ZERO = sp.Integer(0)
 
 #: Deepest nesting of YAML collections accepted (a description needs about 8 levels).
 MAX_YAML_DEPTH = 32
+
+#: Largest description file read, bytes (the 7-joint Kinova Gen3 built-in is 6 kB).
+MAX_DESCRIPTION_BYTES = 4 * 2**20
 
 
 def load_yaml_file(path: str | Path, *, strict: bool = False) -> Robot:
@@ -74,6 +83,10 @@ def load_yaml_file(path: str | Path, *, strict: bool = False) -> Robot:
         The file cannot be read.
     """
     p = Path(path)
+    size = p.stat().st_size
+    if size > MAX_DESCRIPTION_BYTES:
+        raise DescriptionError(f"{p}: {size:,} bytes is too large for a robot description (at "
+                               f"most {MAX_DESCRIPTION_BYTES:,}); is it the right file?")
     try:
         text = p.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
