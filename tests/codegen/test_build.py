@@ -127,3 +127,20 @@ def test_cli_cache_info_before_the_cache_exists(cache: Path, capsys) -> None:
     assert main(["cache", "info"]) == 0
     assert f"location  {cache} (not created yet)" in capsys.readouterr().out
     assert not cache.exists()  # info creates nothing
+
+
+def test_default_cache_folder_left_open_is_closed_but_a_chosen_one_is_not(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("ROBODYN_CACHE", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    old = tmp_path / "robodyn"
+    old.mkdir(mode=0o755)
+    os.chmod(old, 0o755)  # as an older robodyn created it
+    assert build.cache_dir() == old
+    assert stat.S_IMODE(old.stat().st_mode) == 0o700
+    chosen = tmp_path / "shared"
+    chosen.mkdir()
+    os.chmod(chosen, 0o755)
+    monkeypatch.setenv("ROBODYN_CACHE", str(chosen))
+    assert build.cache_dir() == chosen
+    assert stat.S_IMODE(chosen.stat().st_mode) == 0o755  # the user's folder: left as it is

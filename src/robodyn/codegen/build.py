@@ -85,7 +85,8 @@ def cache_dir(*, create: bool = True) -> Path:
     Parameters
     ----------
     create : bool
-        Create it (mode 0700: other users can neither read nor plant libraries) when missing.
+        Create it (mode 0700: other users can neither read nor plant libraries) when missing;
+        the default folder (not ``$ROBODYN_CACHE``) is also made 0700 when it is open to others.
 
     Returns
     -------
@@ -100,6 +101,11 @@ def cache_dir(*, create: bool = True) -> Path:
     if create and not path.is_dir():
         path.mkdir(mode=0o700, parents=True, exist_ok=True)
         os.chmod(path, 0o700)  # mkdir's mode is filtered by the umask
+    elif create and not root:
+        # the default folder is robodyn's own: one an older version left open is closed
+        st = path.stat()
+        if st.st_mode & 0o077 and st.st_uid == os.getuid():
+            os.chmod(path, 0o700)
     return path
 
 
