@@ -11,7 +11,7 @@ Public API::
 
 from robodyn.calibrate import Calibration, calibrate
 from robodyn.identify import Identification, identify
-from robodyn.measure import Recording, read_recording
+from robodyn.measure import Recording, excitation, read_recording
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.load import builtin_names, load
 from robodyn.robot.model import Drive, Friction, Joint, Link, Robot
@@ -37,6 +37,7 @@ __all__ = [
     "calibrate",
     "compile_model",
     "derive",
+    "excitation",
     "identify",
     "load",
     "read_recording",
