@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -181,3 +183,30 @@ def test_default_target_and_public_export(puma):
     val = validate(robot, rec, model=model, gains=np.ones(6), window=None)
     assert val.target == "current"
     assert val.estimated == frozenset({"qd", "qdd"})
+
+
+def test_cutoff_evaluates_the_model_on_filtered_states(tmp_path):
+    from robodyn.measure.filtering import differentiate
+
+    robot = slider(tmp_path)
+    dt = 1e-3
+    t = np.arange(0.0, 2.0, dt)
+    w = 2 * np.pi * 1.0
+    rng = np.random.default_rng(6)
+    q = (0.2 * np.sin(w * t) + rng.normal(scale=2e-5, size=t.size))[:, None]
+    # raw second differences of noisy positions: the noise is amplified by 1/dt^2
+    qdd_raw = np.gradient(np.gradient(q[:, 0], t), t)[:, None]
+    tau = SLIDER_MASS * (-0.2 * w**2 * np.sin(w * t))[:, None]
+    rec = recording(t=t, q=q, qd=np.gradient(q[:, 0], t)[:, None], qdd=qdd_raw, tau=tau,
+                    joint_names=("x",))
+    raw = validate(robot, rec, window=None)
+    filt = validate(robot, rec, window=None, cutoff=5.0)
+    np.testing.assert_array_equal(filt.qd, differentiate(t, q, 5.0)[1])
+    assert raw.prediction.relative[0] > 1.0
+    assert filt.prediction.relative[0] < 0.05
+    # an identification result's filter is used when no cutoff is given
+    ident = SimpleNamespace(target="tau", preprocess=SimpleNamespace(cutoff=5.0, velocity="position"),
+                            predict=lambda r: np.zeros((t.size, 1)))
+    via_ident = validate(robot, rec, window=None, ident=ident)
+    np.testing.assert_array_equal(via_ident.qd, filt.qd)
+    np.testing.assert_allclose(via_ident.prediction.relative, 1.0)

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from robodyn.measure.filtering import lowpass
+from robodyn.measure.filtering import differentiate, lowpass
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import ValidationError
 from robodyn.robot.model import Robot
@@ -62,7 +62,8 @@ class Validation:
     t : (N,) ndarray
         s.
     qd : (N, n) ndarray
-        Velocities used (measured, or estimated when ``"qd" in estimated``).
+        Velocities the model was evaluated at: the recording's (measured, or estimated when
+        ``"qd" in estimated``), or differentiated from the filtered positions (``cutoff``).
     measured, predicted : (N, n) ndarray
         Measured and predicted target.
     filtered : (N, n) ndarray
@@ -165,7 +166,8 @@ class Validation:
 
 def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: Any = None,
              model: Model | None = None, gains: np.ndarray | None = None, window: float | None = 0.2,
-             noise_cutoff: float = 10.0, backend: str = "c") -> Validation:
+             noise_cutoff: float = 10.0, cutoff: float | None = None,
+             backend: str = "c") -> Validation:
     """Validate ``robot``'s dynamic model against a measured recording.
 
     Parameters
@@ -189,6 +191,14 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
         ``ident`` is given, else the robot's drives, ``|gear_ratio| * torque_constant``).
     window : float or None
         Simulation window, s (None: no simulation check).
+    cutoff : float, optional
+        When given, the model's states are the positions low-passed at ``cutoff`` Hz (zero-phase
+        Butterworth) with velocities and accelerations differentiated from them
+        (:func:`robodyn.measure.filtering.differentiate`), as identification does; when None,
+        the recording's ``q``, ``qd``, ``qdd`` as they are, except with ``ident``: then its
+        ``preprocess.cutoff`` (and ``preprocess.velocity == "measured"``: the measured velocity
+        filtered and differentiated), so that the friction cloud and the simulation's start
+        states are those of the prediction.
     noise_cutoff : float
         Cut-off of the zero-phase Butterworth low-pass (order 4) that separates the target
         from its noise, Hz (limited to 0.4 x the sample rate).
@@ -225,6 +235,17 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
     y = np.array(measured_target(rec, tgt))
     has = ~np.all(np.isnan(y), axis=0)  # an all-NaN column: that joint has no such sensor
     q, qd, qdd = arrays["q"], arrays["qd"], arrays["qdd"]
+    settings = getattr(ident, "preprocess", None)
+    if cutoff is None and settings is not None:
+        cutoff = getattr(settings, "cutoff", None)
+    if cutoff is not None:
+        cut = min(float(cutoff), 0.4 / float(np.median(np.diff(t))))
+        if getattr(settings, "velocity", "position") == "measured":
+            # qd = lowpass(qd_measured), qdd = d/dt of it
+            qd, qdd, _ = differentiate(t, qd, cut)
+        else:
+            # q = lowpass(q), qd and qdd its derivatives
+            q, qd, qdd = differentiate(t, q, cut)
     if model is None:
         model = compile_model(robot, backend=backend)
     if ident is not None and getattr(ident, "target", tgt) != tgt:
@@ -242,7 +263,7 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
     # tau_model = M(q) qdd + C(q, qd) qd + g(q) + friction(qd)
     tau_model = model.inverse_dynamics(q, qd, qdd)
     if ident is not None:
-        predicted = np.array(ident.predict(recording), dtype=float)
+        predicted = np.array(ident.predict(rec), dtype=float)  # joints in chain order
         if predicted.shape != y.shape:
             raise ValidationError(f"{where}: ident.predict returned shape {predicted.shape}, the "
                                   f"recording's {tgt} is {y.shape}")
@@ -274,7 +295,7 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
         notes.append("simulation check skipped: the measured torque is missing on some joints")
     elif window is not None:
         try:
-            simulation = simulate_windows(model, t, q, qd, tau_meas, window)
+            simulation = simulate_windows(model, t, q, qd, tau_meas, window, q_measured=arrays["q"])
         except ValueError as exc:
             notes.append(f"simulation check skipped: {exc}")
     out = Validation(

@@ -77,7 +77,7 @@ def _nan_stat(fn, values: np.ndarray) -> np.ndarray:
 
 
 def simulate_windows(model: Model, t: np.ndarray, q: np.ndarray, qd: np.ndarray, tau: np.ndarray,
-                     window: float = 0.2) -> WindowDrift:
+                     window: float = 0.2, q_measured: np.ndarray | None = None) -> WindowDrift:
     """Simulate consecutive windows from the measured state under the measured torque.
 
     Each window starts at a sample ``i0`` (windows tile the recording without overlap), from
@@ -97,6 +97,9 @@ def simulate_windows(model: Model, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
         Measured joint torques (N m, N) driving the simulation.
     window : float
         Window length, s.
+    q_measured : (N, n) array_like, optional
+        Positions the simulation is compared with (default ``q``; e.g. the raw positions when
+        ``q``, ``qd`` are filtered start states).
 
     Returns
     -------
@@ -110,6 +113,7 @@ def simulate_windows(model: Model, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
     """
     t = np.asarray(t, dtype=float)
     q, qd, tau = (np.asarray(a, dtype=float) for a in (q, qd, tau))
+    q_ref = q if q_measured is None else np.asarray(q_measured, dtype=float)
     dt = float(np.median(np.diff(t)))
     if not window > 0:
         raise ValueError(f"simulation window must be positive, got {window:g} s")
@@ -132,7 +136,7 @@ def simulate_windows(model: Model, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
             break
         grid = t0 + dt * np.arange(steps + 1)
         ff = _interp(grid[:-1], t, tau)
-        q_meas = _interp(grid, t, q)
+        q_meas = _interp(grid, t, q_ref)
         qd_end = _interp(grid[-1:], t, qd)[0]
         x0 = np.concatenate([q[i0], qd[i0]])
         try:
