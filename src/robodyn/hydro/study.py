@@ -53,6 +53,7 @@ from robodyn.hydro.schema import fluid_of
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import StudyError
 from robodyn.robot.model import Robot
+from robodyn.robot.overrides import checked_parameter_values
 from robodyn.simulate.controllers import PD
 from robodyn.simulate.simulation import Trajectory, simulate
 from robodyn.simulate.trajectory import JointTrajectory, quintic
@@ -327,6 +328,8 @@ def effect_series(robot: Robot, *, start: Sequence[float] | None = None,
                          f"{', '.join(EFFECTS)}")
     chosen = [e for e in EFFECTS if e == "dry" or e in effects]
     effect_variant(robot, "dry")  # refuses a robot without hydro blocks before any work
+    # unknown names and impossible values are refused before the progress bar starts
+    checked_parameter_values(robot, params, where="effect_series(parameters=...)")
     c = _series_current(robot, params, current)
     n = robot.dof
     q0, q1 = _default_move(robot, params)

@@ -1,0 +1,38 @@
+"""``robodyn underwater ROBOT -o DIR``: files written, exit codes, one-line errors."""
+
+from __future__ import annotations
+
+import csv
+
+from robodyn.cli import main
+
+
+def test_underwater_writes_table_figures_and_report(tmp_path, capsys) -> None:
+    out = tmp_path / "uw"
+    code = main(["underwater", "underwater_2r", "-o", str(out), "--move-time", "0.5",
+                 "--hold-time", "0.2", "--free-time", "0.5", "--end", "0.8", "0.8",
+                 "--current", "0.5", "0", "0"])
+    assert code == 0
+    printed = capsys.readouterr().out.split()
+    for name in ("effects.csv", "effects.md", "tracking_q.png", "tracking_tau.png", "free_q.png",
+                 "ideal_tau.png", "underwater_section.html", "underwater.html"):
+        assert (out / name).stat().st_size > 0 and str(out / name) in printed
+    with (out / "effects.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    assert [r["effect"] for r in rows[::2]] == ["dry", "buoyancy", "added_mass", "drag", "lift",
+                                                "current"]
+    assert float(rows[2]["peak_tau"]) < float(rows[0]["peak_tau"])  # buoyancy unloads joint 1
+
+
+def test_robot_without_hydro_blocks_exits_2_with_one_line(tmp_path, capsys) -> None:
+    code = main(["underwater", "planar_2r", "-o", str(tmp_path / "x")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert err.count("\n") == 0 and "planar_2r" in err and "no hydro blocks" in err
+    assert not (tmp_path / "x").exists()
+
+
+def test_unknown_parameter_exits_2(tmp_path, capsys) -> None:
+    code = main(["underwater", "underwater_2r", "-o", str(tmp_path / "x"), "--set", "nope=1"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "nope" in err and err.count("\n") == 0

@@ -1,0 +1,129 @@
+"""The underwater effect series: each effect changes what physics says it should."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import robodyn as rd
+from robodyn.hydro.study import EFFECTS, effect_series, effect_variant
+from robodyn.hydro.study_plots import write_study
+from robodyn.robot.errors import StudyError
+
+RHO, CA, CD = 1000.0, 1.0, 1.2
+R1, L1, R2, L2 = 0.06, 1.0, 0.05, 0.8
+END = np.array([0.8, 0.8])
+CURRENT = (0.5, 0.0, 0.0)
+
+
+@pytest.fixture(scope="module")
+def series():
+    # short runs; the compiled variants are cached by description and values
+    return effect_series(rd.load("underwater_2r"), end=END, move_time=1.0, hold_time=0.5,
+                         free_time=1.5, current=CURRENT)
+
+
+def test_series_runs_every_variant_and_fills_the_table(series) -> None:
+    assert [r.effect for r in series.runs] == list(EFFECTS)
+    table = series.table
+    assert len(table) == len(EFFECTS) * 2
+    numbers = table.drop(columns=["variant", "effect", "joint"]).to_numpy()
+    assert np.all(np.isfinite(numbers))
+    dry = table[table.effect == "dry"]
+    assert (dry[["diff_vs_dry", "free_diff_vs_dry", "effect_peak_tau"]].to_numpy() == 0).all()
+    # every effect but lift (C_L = 0 for the circular links of underwater_2r) changes the motion
+    for effect in ("buoyancy", "added_mass", "drag", "current"):
+        rows = table[table.effect == effect]
+        assert (rows["effect_peak_tau"] > 1.0).all(), effect
+    # the same PD controller in every variant: its torque is what the table reports
+    run = series.run("drag")
+    np.testing.assert_array_equal(table[table.effect == "drag"]["peak_tau"].to_numpy(),
+                                  np.abs(run.tracked.tau).max(axis=0))
+    assert "| + added mass | added_mass | q2 |" in series.markdown()
+
+
+def test_zero_lift_coefficient_adds_nothing(series) -> None:
+    np.testing.assert_array_equal(series.run("lift").ideal_tau, series.run("drag").ideal_tau)
+    np.testing.assert_array_equal(series.run("lift").free.q, series.run("drag").free.q)
+
+
+def test_drag_dissipates_free_motion(series) -> None:
+    no_drag, drag = series.run("added_mass").free, series.run("drag").free
+    rows = series.table.set_index(["effect", "joint"])["free_amplitude"]
+    for joint in ("q1", "q2"):
+        assert rows["drag", joint] < 0.5 * rows["added_mass", joint]
+    assert np.abs(drag.qd).max() < 0.7 * np.abs(no_drag.qd).max()
+
+
+def test_added_mass_of_link_2_about_joint_2_equals_strip_theory(series) -> None:
+    # same acceleration, more torque: M_22 grows by C_a rho pi r2^2 L2^3 / 3 (link 2 turning
+    # about its own end), independently of q
+    before = rd.compile_model(series.run("buoyancy").robot)
+    after = rd.compile_model(series.run("added_mass").robot)
+    expected = CA * RHO * math.pi * R2**2 * L2**3 / 3
+    for q in ([0.0, 0.0], [0.7, -1.9], [-2.0, 2.5]):
+        dm = after.mass_matrix(np.array(q)) - before.mass_matrix(np.array(q))
+        assert dm[1, 1] == pytest.approx(expected, rel=1e-12)
+        assert np.all(np.linalg.eigvalsh(dm) > -1e-12) and np.linalg.eigvalsh(dm).max() > 0.1
+    # along the plan the inverse-dynamics torque is larger on both joints (RMS)
+    rows = series.table.set_index(["effect", "joint"])["ideal_rms_tau"]
+    for joint in ("q1", "q2"):
+        assert rows["added_mass", joint] > rows["buoyancy", joint]
+
+
+def test_a_current_on_the_arm_at_rest_needs_the_strip_integrated_drag_torque(series) -> None:
+    # at the end of the plan the arm is at rest; link 2 (angle phi = q1 + q2 from base x) sees
+    # the normal current c_n = c sin(phi): joint 2 must resist 1/2 rho C_d D |c_n| c sin(phi) L^2/2
+    phi = END.sum()
+    c_n = CURRENT[0] * abs(math.sin(phi))
+    expected = 0.5 * RHO * CD * 2 * R2 * c_n * CURRENT[0] * math.sin(phi) * L2**2 / 2
+    d_tau = series.run("current").ideal_tau[-1] - series.run("lift").ideal_tau[-1]
+    assert d_tau[1] == pytest.approx(expected, rel=1e-9)
+
+
+def test_buoyancy_of_a_neutrally_buoyant_arm_removes_the_gravity_torque() -> None:
+    # each link as dense as the water, centre of mass at the centre of buoyancy
+    neutral = {"m1": RHO * math.pi * R1**2 * L1, "m2": RHO * math.pi * R2**2 * L2}
+    s = effect_series(rd.load("underwater_2r"), end=END, move_time=0.5, hold_time=0.1,
+                      free_time=0.5, parameters=neutral, effects=("buoyancy",))
+    assert [r.effect for r in s.runs] == ["dry", "buoyancy"]
+    dry, wet = s.run("dry"), s.run("buoyancy")
+    assert np.abs(dry.free.q[-1] - dry.free.q[0]).max() > 0.1  # in air it falls
+    assert np.abs(wet.free.q - wet.free.q[0]).max() < 1e-12  # in water it stays
+    model = rd.compile_model(dry.robot, parameters=neutral)
+    q_r = s.reference.at(dry.tracked.t)[0]
+    # only the inertial torque remains: tau_wet = tau_dry - g_dry(q)
+    np.testing.assert_allclose(wet.ideal_tau, dry.ideal_tau - model.gravity(q_r), atol=1e-9)
+
+
+def test_variants_are_new_robots_and_the_input_is_untouched() -> None:
+    robot = rd.load("underwater_2r")
+    before = robot.description_hash
+    hashes = {effect_variant(robot, e, current=CURRENT).description_hash for e in EFFECTS}
+    assert len(hashes) == len(EFFECTS) and robot.description_hash == before
+    dry = effect_variant(robot, "dry")
+    assert dry.fluid is None and all(lk.hydro is None for lk in dry.links)
+    wet = effect_variant(robot, "drag")
+    assert wet.links[0].hydro["lift"] == 0.0 and wet.links[0].hydro["drag"] == "Cd"
+    assert wet.fluid["current"] == [0.0, 0.0, 0.0]
+    assert robot.links[0].hydro["lift"] == "CL"
+
+
+def test_robot_without_hydro_blocks_is_refused_by_name() -> None:
+    with pytest.raises(StudyError, match=r"builtin:planar_2r: robot 'planar_2r' has no hydro "
+                                         r"blocks"):
+        effect_series(rd.load("planar_2r"))
+    with pytest.raises(StudyError, match="unknown effect"):
+        effect_series(rd.load("underwater_2r"), effects=("sonar",))
+
+
+def test_write_study_files(series, tmp_path) -> None:
+    files = write_study(series, tmp_path / "out")
+    names = {p.name for p in files}
+    assert {"effects.csv", "effects.md", "tracking_q.png", "free_q.png",
+            "underwater.html", "underwater_section.html"} <= names
+    assert all(p.stat().st_size > 0 for p in files)
+    html = (tmp_path / "out" / "underwater.html").read_text()
+    assert "+ added mass" in html and "data:image/png;base64," in html
