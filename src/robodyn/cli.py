@@ -22,6 +22,7 @@ import sympy as sp
 
 import robodyn as rd
 from robodyn.cli_cache import add_cache_parser
+from robodyn.cli_excite import add_excite_parsers
 from robodyn.cli_identify import add_parsers as add_identify_parsers
 from robodyn.cli_record import add_record_parser
 from robodyn.cli_sweep import add_sweep_parser
@@ -307,6 +308,7 @@ def _parser() -> argparse.ArgumentParser:
     add_parsers(sub, fmt, _ROBOT_HELP)
     add_identify_parsers(sub, fmt, _ROBOT_HELP)
     add_record_parser(sub, fmt, _ROBOT_HELP)
+    add_excite_parsers(sub, fmt, _ROBOT_HELP)
     add_cache_parser(sub, fmt)
     add_sweep_parser(sub, fmt)
     add_underwater_parser(sub, fmt)

@@ -1,0 +1,83 @@
+"""``robodyn excite`` and ``robodyn testprog``: excitation design and the thesis' test programs.
+
+Thin: parse, call :func:`robodyn.excitation` / :mod:`robodyn.measure.testprog`, write CSV, print.
+Bad input raises ``ValueError`` (or a description error), which ``robodyn.cli.main`` turns into
+one line and exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import warnings
+from pathlib import Path
+
+import robodyn as rd
+
+
+def _cmd_excite(args: argparse.Namespace) -> int:
+    from robodyn.measure.excitation import excitation_limits
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = rd.load(args.robot)
+    limits = excitation_limits(robot, velocity=args.velocity, acceleration=args.acceleration)
+    ex = rd.excitation(robot, harmonics=args.harmonics, base_frequency=args.frequency,
+                       duration=args.duration, limits=limits, criterion=args.criterion,
+                       starts=args.starts, seed=args.seed, dt=args.dt)
+    path = ex.to_csv(args.output)
+    print(f"{robot.name}: {ex.series.harmonics} harmonics at {ex.series.base_frequency:g} Hz, "
+          f"{ex.duration:g} s, {len(ex.columns)} base columns")
+    print(f"condition number {ex.condition_number:.1f} (starts: "
+          f"{', '.join(f'{c:.1f}' for c in ex.history)}); {ex.elapsed:.1f} s")
+    print(f"wrote {path} ({ex.t.size} rows)")
+    return 0
+
+
+def _cmd_testprog(args: argparse.Namespace) -> int:
+    from robodyn.measure.testprog import iso_cube, jointwise
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = rd.load(args.robot)
+    if args.kind == "jointwise":
+        prog = jointwise(robot, speeds=args.speeds, dt=args.dt)
+    else:
+        prog = iso_cube(robot, size=args.size, cycles=args.cycles, dt=args.dt)
+    traj, segs = prog.to_csv(Path(args.output))
+    moves = sum(s.kind == "move" for s in prog.segments)
+    print(f"{robot.name}: {prog.name} program, {moves} moves, {prog.duration:.1f} s")
+    print(f"wrote {traj} and {segs}")
+    return 0
+
+
+def add_excite_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
+    """Register ``excite`` and ``testprog`` on the ``robodyn`` sub-parsers."""
+    p = sub.add_parser("excite", help="design an optimal excitation trajectory (CSV a controller can play)",
+                       formatter_class=fmt,
+                       epilog="example:\n  robodyn excite puma560 -o traj.csv")
+    p.add_argument("robot", metavar="ROBOT", help=robot_help)
+    p.add_argument("-o", "--output", required=True, metavar="FILE.csv", help="trajectory CSV")
+    p.add_argument("--harmonics", type=int, default=5, help="harmonics per joint")
+    p.add_argument("--frequency", type=float, default=0.1, help="base frequency, Hz")
+    p.add_argument("--duration", type=float, default=None, help="s, whole periods (default one)")
+    p.add_argument("--velocity", type=float, default=None, help="speed limit, rad/s (all joints)")
+    p.add_argument("--acceleration", type=float, default=None, help="acceleration limit, rad/s^2")
+    p.add_argument("--criterion", choices=("cond", "logdet"), default="cond")
+    p.add_argument("--starts", type=int, default=6, help="optimiser starts")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--dt", type=float, default=1e-3, help="sample step of the CSV, s")
+    p.set_defaults(func=_cmd_excite)
+
+    p = sub.add_parser("testprog", help="thesis test programs: one joint at a time, ISO 9283 cube",
+                       formatter_class=fmt,
+                       epilog="examples:\n  robodyn testprog puma560 --kind jointwise -o prog/\n"
+                              "  robodyn testprog kinova_gen3 --kind iso-cube --size 0.4 -o cube/")
+    p.add_argument("robot", metavar="ROBOT", help=robot_help)
+    p.add_argument("--kind", required=True, choices=("jointwise", "iso-cube"))
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="output directory")
+    p.add_argument("--speeds", type=float, nargs="+", default=[0.5, 1.0],
+                   help="jointwise: speed fractions")
+    p.add_argument("--size", type=float, default=0.5, help="iso-cube: cube edge, m")
+    p.add_argument("--cycles", type=int, default=1, help="iso-cube: P1..P5 cycles")
+    p.add_argument("--dt", type=float, default=1e-3, help="sample step, s")
+    p.set_defaults(func=_cmd_testprog)
