@@ -226,7 +226,9 @@ class EquationsOfMotion:
             ``M`` with rotor inertia (n, n); ``C`` from the Christoffel symbols of this
             formulation's ``M`` program (n, n); ``g`` (n, 1); ``tau`` the full inverse dynamics
             (n, 1): Newton-Euler's recursion, Kane's ``-(F* + F)``, Lagrange's
-            ``M qdd + C qd + g``, each plus rotor inertia and friction.
+            ``M qdd + C qd + g``, each plus rotor inertia and friction. Under water every
+            output includes its hydrodynamic terms (:attr:`hydro`): ``M_a`` in ``M``, ``C_a``
+            in ``C``, buoyancy in ``g``, all of them in ``tau``.
 
         Returns
         -------
@@ -240,26 +242,35 @@ class EquationsOfMotion:
         return self._extra[key]
 
     def _straight_line(self, name: str) -> Program:
+        # under water the hydrodynamic terms (expressions) are added to each output
+        h = self.hydro
         if name == "M":
             m = _as_program(self.M_rigid_form)
-            return Program(m.assignments, sp.ImmutableMatrix(m.outputs + _rotor_matrix(self.robot)))
+            out = m.outputs + _rotor_matrix(self.robot)
+            return Program(m.assignments, sp.ImmutableMatrix(out if h is None else out + h.mass_matrix))
         if name == "g":
-            return _as_program(self.g_form)
+            g = _as_program(self.g_form)
+            return g if h is None else Program(g.assignments, sp.ImmutableMatrix(g.outputs + h.buoyancy))
         if name == "C":
             m = self.M_rigid_form
             if isinstance(m, Program):
-                return christoffel_program(m, self.q, self.qd)
-            return Program((), self.C)
+                c = christoffel_program(m, self.q, self.qd)
+                return c if h is None else Program(c.assignments,
+                                                   sp.ImmutableMatrix(c.outputs + h.coriolis))
+            return Program((), self.C)  # the Christoffel symbols of M, added mass included
         extra = self.rotor + self.friction
         rigid = self.tau_rigid_form if isinstance(self.tau_rigid_form, Program) else self.tau_rigid_program
         if rigid is not None:
+            extra = extra if h is None else extra + h.tau
             return Program(rigid.assignments, sp.ImmutableMatrix(rigid.outputs + extra))
-        # tau = M qdd + C qd + g + friction from the programs (Lagrange; M has the rotor inertia)
+        # tau = M qdd + C qd + g + friction from the programs (Lagrange; M has the rotor inertia;
+        # under water M, C and g hold the added mass and buoyancy, the fluid forces are added)
         m, c, g = (self.straight_line(k) for k in ("M", "C", "g"))
         (rm, rc, rg), assignments = _merge(m, c, g)
         tau = (m.outputs.xreplace(rm) * sp.Matrix(self.qdd) + c.outputs.xreplace(rc) * sp.Matrix(self.qd)
                + g.outputs.xreplace(rg) + self.friction)
-        return Program(tuple(assignments), sp.ImmutableMatrix(tau))
+        return Program(tuple(assignments),
+                       sp.ImmutableMatrix(tau if h is None else tau + h.velocity_forces))
 
     def numeric_function(self, name: str) -> Callable[..., np.ndarray]:
         """A NumPy function of ``M``, ``C``, ``g`` or ``tau`` of this formulation.
