@@ -3,9 +3,14 @@
 The compiled :class:`~robodyn.numeric.model.Model` has no energy kernel, so the potential energy
 is built once per robot (and parameter values) from the symbolic forward kinematics::
 
-    V(q) = - sum_i m_i g . p_ci(q)
+    V(q) = - sum_i m_i g . p_ci(q)  +  sum_i rho V_i g . p_Bi(q)
 
-with ``p_ci`` the centre of mass of link ``i`` in the world frame and ``g`` the gravity vector.
+with ``p_ci`` the centre of mass of link ``i`` in the world frame, ``g`` the gravity vector and,
+for a robot under water (``fluid``/``hydro`` blocks), the buoyancy potential of each wet link:
+displaced volume ``V_i`` at its centre of buoyancy ``p_Bi`` in a fluid of density ``rho``
+(:mod:`robodyn.hydro.buoyancy`). The compiled mass matrix holds the added mass, so the kinetic
+energy ``1/2 qd^T M qd`` of a simulation includes the added-mass (fluid) kinetic energy, and
+``K + V`` is conserved in a passive run without drag, skin friction and lift.
 It is exact (no quadrature) and consistent with the model's gravity load: ``dV/dq = g(q)``, the
 torque that holds the arm still (checked in the tests). The expression is turned into a NumPy
 function by ``sympy.lambdify`` and memoised.
@@ -19,6 +24,7 @@ import numpy as np
 import sympy as sp
 
 from robodyn import spatial as S
+from robodyn.hydro.schema import fluid_of, hydro_of
 from robodyn.numeric.model import Model
 from robodyn.symbolic.kinematics import forward_kinematics, joint_symbols
 
@@ -34,7 +40,8 @@ def _values(model: Model) -> dict[sp.Symbol, float]:
 
 
 def potential_energy(model: Model, q: np.ndarray) -> np.ndarray:
-    """Gravitational potential energy ``V(q) = -sum_i m_i g . p_ci`` (J), () for (n,), (N,) for (N, n).
+    """Potential energy ``V(q) = -sum_i m_i g . p_ci`` (J), plus the buoyancy potential
+    ``sum_i rho V_i g . p_Bi`` under water; () for (n,), (N,) for (N, n).
 
     The zero of ``V`` is at the world origin's height.
     """
@@ -48,6 +55,13 @@ def potential_energy(model: Model, q: np.ndarray) -> np.ndarray:
             p_c = S.rotation(t) * link.com + S.translation(t)
             # V -= m g . p_c
             v -= link.mass * (model.robot.gravity.T * p_c)[0, 0]
+        fluid = fluid_of(model.robot)
+        if fluid is not None:
+            for h, t in zip(hydro_of(model.robot), kin.links, strict=True):
+                if h is not None:
+                    # V += rho V_B g . p_B (buoyancy: a mass -rho V_B at the centre of buoyancy)
+                    p_b = S.rotation(t) * h.center_of_buoyancy + S.translation(t)
+                    v += fluid.density * h.volume * (model.robot.gravity.T * p_b)[0, 0]
         _MEMO[key] = sp.lambdify(qs, v.xreplace(_values(model)), modules="numpy", cse=True)
     q = _states(model, q)
     out = np.asarray(_MEMO[key](*q.T), dtype=float)
