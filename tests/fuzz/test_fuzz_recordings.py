@@ -5,17 +5,13 @@ truncated MCAP (ROS 2) bags. The only outcomes allowed are a Recording or a
 
 from __future__ import annotations
 
-import struct
 import tempfile
 import warnings
 from pathlib import Path
 
 import numpy as np
-import pytest
-import zstandard
 from hypothesis import given
 from hypothesis import strategies as st
-from mcap_ros2._vendor.rosidl_adapter import parser as _ros2_parser
 
 import robodyn as rd
 from robodyn.measure.csv_io import write_csv
@@ -83,20 +79,6 @@ def _mutate_bytes(data: bytes, ops: list[tuple[str, int, bytes]]) -> bytes:
     return data[:MAX_BYTES]
 
 
-# Known defects (src/robodyn/measure/mcap_io.py, read_mcap, the except clause around
-# make_reader/iter_decoded_messages), found by this test: a corrupted zstd chunk raises
-# zstandard.ZstdError, a truncated record struct.error, a damaged length field OverflowError or
-# MemoryError (a huge allocation from a 3 KB file), a damaged schema text NameError,
-# InvalidFieldDefinition or InvalidResourceName (mcap_ros2's schema parser); and a damaged
-# position value reaches the velocity estimate as a RuntimeWarning (overflow in
-# scipy.signal.detrend). None of them is a RecordingError. Any other exception fails this test.
-_MCAP_DEFECTS = (zstandard.ZstdError, struct.error, OverflowError, MemoryError, NameError,
-                 _ros2_parser.InvalidFieldDefinition, _ros2_parser.InvalidResourceName,
-                 RuntimeWarning)
-
-
-@pytest.mark.xfail(raises=_MCAP_DEFECTS, strict=False,
-                   reason="read_mcap lets errors of a corrupt bag escape (see comment)")
 @fuzz_settings(deadline_s=20, report_multiple_bugs=False)  # one exception, for xfail to judge
 @given(st.builds(_mutate_bytes, st.just(MCAP), _byte_ops))
 def test_mutated_mcap_recording(data: bytes) -> None:

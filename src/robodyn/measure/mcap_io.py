@@ -64,7 +64,6 @@ def read_mcap(path: str | PathLike[str], robot: Any = None, joint_topic: str | N
         ``q`` from ``position``; ``qd`` from ``velocity`` and ``tau`` from ``effort`` when the
         messages carry them; ``tool_t``/``tool_points`` from the tracker topic.
     """
-    from mcap.exceptions import McapError
     from mcap.reader import make_reader
     from mcap_ros2.decoder import DecoderFactory
 
@@ -74,7 +73,7 @@ def read_mcap(path: str | PathLike[str], robot: Any = None, joint_topic: str | N
     topics: dict[str, str] = {}
     try:
         with p.open("rb") as fh:
-            reader = make_reader(fh, decoder_factories=[DecoderFactory()])
+            reader = make_reader(fh, validate_crcs=True, decoder_factories=[DecoderFactory()])
             for schema, channel, _, msg in reader.iter_decoded_messages(log_time_order=True):
                 kind, topic = schema.name, channel.topic
                 topics[topic] = kind
@@ -84,7 +83,9 @@ def read_mcap(path: str | PathLike[str], robot: Any = None, joint_topic: str | N
                 elif kind in (POINT_STAMPED, POSE_STAMPED) and (tool_topic is None or topic == tool_topic):
                     pt = msg.point if kind == POINT_STAMPED else msg.pose.position
                     tool.setdefault(topic, []).append((_stamp(msg), (pt.x, pt.y, pt.z)))
-    except (McapError, ValueError, KeyError, EOFError, OSError) as exc:
+    except Exception as exc:  # noqa: BLE001 - McapError, and any failure of the third-party
+        # decoders on a damaged file (zstd/lz4 chunk errors, struct.error, an overflowing length
+        # field, mcap_ros2's schema-parser errors), is a property of the file, reported as such
         raise RecordingError(f"{p.name}: not a readable ROS 2 MCAP bag ({type(exc).__name__}: "
                              f"{' '.join(str(exc).split())})") from None
     if not joints:

@@ -185,7 +185,12 @@ class Recording:
             if self.n_samples < 8:
                 raise RecordingError(f"{self._where('qd')}: cannot estimate velocities from "
                                      f"{self.n_samples} samples (at least 8 are needed)")
-            _, qd, qdd = differentiate(self.t, self.q)
+            with np.errstate(over="ignore", invalid="ignore"):
+                _, qd, qdd = differentiate(self.t, self.q)
+            if not (np.all(np.isfinite(qd)) and np.all(np.isfinite(qdd))):
+                raise RecordingError(f"{self._where('q')}: positions too large to differentiate "
+                                     f"(largest magnitude {np.max(np.abs(self.q)):.3g}); check "
+                                     "the units and the file")
             if self.qd is None:
                 object.__setattr__(self, "qd", _readonly(qd))
                 estimated.add("qd")
