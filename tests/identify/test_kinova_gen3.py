@@ -55,12 +55,13 @@ def test_held_out_current_error_beats_the_readme_baseline(gen3):
               f"noise floor {figures[friction][2]:.3f}  (cut-off {ident.preprocess.cutoff:g} Hz, "
               f"decimate {ident.preprocess.decimate}, lambda {ident.regularization:.3g}, "
               f"cond {ident.condition:.3g})")
-    raw, filtered, floor = figures["load"]
-    assert raw < BASELINE_RAW and filtered < BASELINE_FILTERED
-    assert 0.2 < floor < 0.3
+    for friction in ("linear", "load"):  # measured: linear 0.318 / 0.206, load 0.303 / 0.184
+        raw, filtered, floor = figures[friction]
+        assert raw < BASELINE_RAW, friction
+        assert filtered < BASELINE_FILTERED, friction
+        assert 0.2 < floor < 0.3
     # friction is the decisive term: without it the error nearly doubles
     assert figures["none"][0] > 1.5 * figures["linear"][0]
-    assert figures["linear"][0] < 0.34  # the linear default is at the baseline
 
 
 @data
@@ -86,4 +87,4 @@ def test_consistent_estimate_on_real_data_loads_strict(gen3, tmp_path):
     rd.load(str(path), strict=True)  # the manufacturer's URDF itself fails this (joint 1 inertia)
     raw, filtered, floor = _errors(ident, test)
     print(f"consistent: raw {raw:.3f}  filtered {filtered:.3f}  noise floor {floor:.3f}")
-    assert raw < 0.34
+    assert raw < BASELINE_RAW and filtered < BASELINE_FILTERED  # noqa: PT018 (measured 0.318 / 0.206)

@@ -4,7 +4,8 @@ Steps (each a function of its own module):
 
 1. check the recordings (joints, shapes, finite values, a target signal);
 2. preprocess each recording (:mod:`robodyn.identify.preprocess`: zero-phase filter, derivatives,
-   the same filter on the target, decimation);
+   the same filter on the target; :func:`filtered_regressor`: the same filter on every column
+   of the regressor, then decimation);
 3. base parameters of the robot (:mod:`robodyn.identify.base`, Gautier's QR on random states);
 4. identification matrix: the compiled, batched regressor ``Y(q, qd, qdd)`` (N, n, 15 n) of every
    sample, restricted to the base columns and stacked, one row per joint per sample;
@@ -32,6 +33,7 @@ from robodyn.identify.preprocess import Preprocess, Samples, preprocess, resolve
 from robodyn.identify.prior import joint_prior
 from robodyn.identify.result import BaseParameters, Identification
 from robodyn.identify.to_robot import robot_with_parameters
+from robodyn.measure.filtering import lowpass
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
@@ -189,8 +191,9 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     relations = base_relations(model)
     if friction == "none":
         relations = _without_friction_columns(relations)
-    samples = [_decimated(preprocess(r, settings, target), settings) for r in recs]
-    y_full = [model.regressor(s.q, s.qd, s.qdd) for s in samples]
+    full = [preprocess(r, settings, target) for r in recs]
+    y_full = [filtered_regressor(model, s, settings) for s in full]
+    samples = [_decimated(s, settings) for s in full]
     count = sum(s.q.shape[0] for s in samples)
     b = relations.independent.size
     if count * robot.dof < 2 * b:
@@ -235,6 +238,19 @@ def _without_friction_columns(relations: BaseRelations) -> BaseRelations:
     ever combine among themselves, so the other base parameters are unchanged."""
     keep = np.array([c % PER_JOINT <= len(INERTIAL_NAMES) for c in relations.independent])
     return replace(relations, independent=relations.independent[keep], beta=relations.beta[keep])
+
+
+def filtered_regressor(model: Model, s: Samples, settings: Preprocess) -> np.ndarray:
+    """Full regressor (N / decimate, n, 15 n) of processed samples, low-passed column by column
+    with the target's filter before decimation (parallel filtering, Gautier 1997): the filter is
+    linear, so ``H(Y p) = H(Y) p`` holds exactly, and the fit of the filtered target is not biased
+    by terms the filter smooths (Coulomb steps at velocity reversals)."""
+    y = model.regressor(s.q, s.qd, s.qdd)
+    if settings.cutoff is not None:
+        count = y.shape[0]
+        # H Y: the same zero-phase low-pass as the target, along time
+        y = lowpass(s.t, y.reshape(count, -1), settings.cutoff, order=settings.order).reshape(y.shape)
+    return y[::settings.decimate]
 
 
 def _decimated(s: Samples, settings: Preprocess) -> Samples:

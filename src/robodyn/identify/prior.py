@@ -46,11 +46,10 @@ def description_gains(robot: Robot) -> np.ndarray:
                      for j in robot.joints])
 
 
-def _joint_columns(s: Samples, j: int) -> np.ndarray:
-    qd = s.qd[:, j]
+def _joint_columns(y: np.ndarray, j: int) -> np.ndarray:
+    """Joint ``j``'s own regressor columns (Ia, Fv, Fcp, Fcn, Fo) of its row, (N, 5)."""
     # Ia qdd + Fv qd + Fcp H(qd) - Fcn H(-qd) + Fo
-    return np.column_stack([s.qdd[:, j], qd, (qd > 0).astype(float), -(qd < 0).astype(float),
-                            np.ones_like(qd)])
+    return y[:, j, PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)]
 
 
 def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.ndarray],
@@ -64,7 +63,7 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
     samples : sequence of Samples
         Processed, decimated samples with targets ``y`` (N_k, n).
     y_full : sequence of numpy.ndarray, shape (N_k, n, 15 n)
-        Full regressor at those samples.
+        Full regressor at those samples (filtered like the target).
     nominal : numpy.ndarray, shape (15 n,)
     target : {"tau", "current"}
     mode : {"auto", "description", "absorbed"}
@@ -96,7 +95,7 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
     prior = rigid.copy()
     for j in range(n):
         tau_nom = np.concatenate([y[:, j, :] @ rigid for y in y_full])
-        cols = np.vstack([_joint_columns(s, j) for s in samples])
+        cols = np.vstack([_joint_columns(y, j) for y in y_full])
         b = np.concatenate([s.y[:, j] for s in samples])
         if fixed is None:
             a = np.column_stack([tau_nom, cols])
