@@ -107,3 +107,18 @@ def test_bad_input(puma, program):
     planar = rd.compile_model(rd.load("planar_2r"))
     with pytest.raises(ValueError, match="the trajectory has 6 joints, robot 'planar_2r' has 2"):
         virtual_lab(planar, program)
+
+
+def test_synchronisation_recovers_the_lab_tracker_latency(puma):
+    """The tracker stream of the virtual lab lags by a latency the sync step must find (1 sample)."""
+    from robodyn.measure.sync import synchronise
+    from robodyn.measure.testprog import jointwise as program_of
+
+    prog = program_of(puma, joints=["q1", "q2"], speeds=(1.0,), dwell=0.1)
+    latency = 0.0137
+    run = virtual_lab(puma, prog, sensors=Sensors(tracker_latency=latency), seed=3)
+    assert run.truth.latency == pytest.approx(latency)
+    sync = synchronise(run.recording, puma)
+    # the tracker sees the tool ``latency`` late: shifting it back by the found offset aligns them
+    assert abs(abs(sync.offset) - latency) <= run.sensors.sample_period
+    assert sync.correlation > 0.9

@@ -99,13 +99,22 @@ def synchronise(rec: Recording, model: Any, max_offset: float | None = None,
     h = rec.dt
     t0a, a = _on_grid(rec.t, v_fk, h)
     t0b, b = _on_grid(rec.tool_t, v_tr, h)
-    a, b = a - a.mean(), b - b.mean()
-    # c[lag] = sum_n b[n + lag] a[n]; b[i] = a[j] when t0b + i h - d = t0a + j h
-    c = signal.correlate(b, a, mode="full", method="fft")
+    # Pearson correlation over the overlap at every lag (a global mean subtraction biases the
+    # peak toward zero lag for signals that are not zero-mean, e.g. speeds)
     lags = signal.correlation_lags(b.size, a.size, mode="full")
+    sab = signal.correlate(b, a, mode="full", method="fft")  # sum_n b[n + lag] a[n]
+    ia, ib = np.maximum(0, -lags), np.maximum(0, lags)
+    m = np.minimum(a.size - ia, b.size - ib)
+    ca, cb = np.concatenate(([0.0], np.cumsum(a))), np.concatenate(([0.0], np.cumsum(b)))
+    ca2, cb2 = np.concatenate(([0.0], np.cumsum(a * a))), np.concatenate(([0.0], np.cumsum(b * b)))
+    sa, sb = ca[ia + m] - ca[ia], cb[ib + m] - cb[ib]
+    va = np.maximum(ca2[ia + m] - ca2[ia] - sa * sa / m, 0.0)
+    vb = np.maximum(cb2[ib + m] - cb2[ib] - sb * sb / m, 0.0)
+    # r = (sum ab - sum a sum b / m) / sqrt(var_a var_b)
+    r = (sab - sa * sb / m) / (np.sqrt(va * vb) + 1e-300)
     offsets = t0b - t0a + lags * h
     limit = 0.25 * min(a.size, b.size) * h if max_offset is None else float(max_offset)
-    c = np.where(np.abs(offsets) <= limit, c, -np.inf)
+    c = np.where(np.abs(offsets) <= limit, r, -np.inf)
     k = int(np.argmax(c))
     frac = 0.0
     if 0 < k < c.size - 1 and np.isfinite(c[k - 1]) and np.isfinite(c[k + 1]):
@@ -113,11 +122,6 @@ def synchronise(rec: Recording, model: Any, max_offset: float | None = None,
         den = c[k - 1] - 2 * c[k] + c[k + 1]
         frac = 0.5 * (c[k - 1] - c[k + 1]) / den if den < 0 else 0.0
     offset = float(offsets[k] + frac * h)
-    # normalised correlation over the overlap at the integer lag
-    lag = int(lags[k])
-    ia, ib = max(0, -lag), max(0, lag)
-    m = min(a.size - ia, b.size - ib)
-    sa, sb = a[ia:ia + m], b[ib:ib + m]
-    rho = float(np.dot(sa, sb) / (np.linalg.norm(sa) * np.linalg.norm(sb) + 1e-300))
+    rho = float(r[k])
     shifted = replace(rec, tool_t=rec.tool_t - offset)
     return Synchronisation(offset=offset, correlation=rho, recording=shifted)
