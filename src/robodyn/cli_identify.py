@@ -119,6 +119,21 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     print()
     for kind, path in paths.items():
         print(f"wrote {kind:<10} {path}")
+    return _check_loadable(paths["yaml"])
+
+
+def _check_loadable(path: Path) -> int:
+    """0 when the identified description loads again, else 1 with the loader's reason."""
+    from robodyn.robot.errors import DescriptionError
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            rd.load(str(path))
+    except DescriptionError as exc:
+        err(f"robodyn: warning: the identified description does not load: {' '.join(str(exc).split())}"
+            " (an unconstrained estimate can be non-physical; try --method consistent)")
+        return 1
     return 0
 
 
@@ -189,7 +204,8 @@ def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
                     "identified description (ROBOT_identified.yaml and .urdf, readable by "
                     "robodyn), parameters.csv (estimates, standard deviations, the standard "
                     "parameters each base parameter combines), validation.csv (per-joint "
-                    "errors) and report.html with the figures.",
+                    "errors) and report.html with the figures. Exit code 1 if the identified "
+                    "description does not load again (non-physical values, named).",
         epilog="examples:\n"
                "  robodyn identify kinova_gen3 --spec kinova_gen3 --target current \\\n"
                "      --data run1.csv.gz run2.csv.gz --validate run3.csv.gz -o ident/\n"
