@@ -4,8 +4,9 @@ Step 1 is :func:`robodyn.identify` with the linear friction of the regressor (vi
 +/-, offset). Step 2 keeps its rigid-body and rotor-inertia parameters and fits, joint by joint, a
 nonlinear friction law ``f_j(qd_j)`` to what they leave of the target,
 ``r_j = y_j - [Y(q, qd, qdd) p_nf]_j`` (``p_nf``: the identified parameters with friction set to
-zero), by nonlinear least squares (``scipy.optimize.least_squares``, trust-region reflective,
-started from the linear step's values). Models, ``v = qd_j``, ``s(v) = tanh(v / V_EPS)`` a sign
+zero; the filtered regressor and target of the linear step), by nonlinear least squares
+(``scipy.optimize.least_squares``, trust-region reflective, started from the linear step's
+values). Models, ``v = qd_j``, ``s(v) = tanh(v / V_EPS)`` a sign
 smoothed over ``V_EPS = 0.01`` rad/s (so that a joint at rest, whose filtered velocity wanders
 around zero, is not given full Coulomb friction of random sign):
 
@@ -104,15 +105,17 @@ def _start(model: str, linear: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray
             (np.array([0, -inf, -inf, -inf, -inf]), np.full(5, inf)))
 
 
-def fit_friction_samples(ident: Any, samples: Sequence[Samples], model: str) -> FrictionFit:
-    """Step 2 on already processed (and decimated) samples; see :func:`fit_friction`."""
+def fit_friction_samples(ident: Any, samples: Sequence[Samples], y_full: Sequence[np.ndarray],
+                         model: str) -> FrictionFit:
+    """Step 2 on already processed, decimated samples and their (filtered) full regressors
+    (:func:`robodyn.identify.pipeline.filtered_regressor`); see :func:`fit_friction`."""
     if model not in NONLINEAR:
         raise IdentificationError(f"friction: expected one of {FRICTION_MODELS}, got {model!r}")
     p_nf = without_friction(ident.standard)
     n = ident.robot.dof
     qd = np.vstack([s.qd for s in samples])
-    load = np.vstack([ident._model.regressor(s.q, s.qd, s.qdd) @ p_nf for s in samples])
-    r = np.vstack([s.y for s in samples]) * ident.gains[None, :] - load  # r = K y - Y p_nf
+    load = np.vstack([y @ p_nf for y in y_full])
+    r = np.vstack([s.y for s in samples]) * ident.gains[None, :] - load  # r = K H y - H Y p_nf
     params = []
     for j in range(n):
         b = PER_JOINT * j + len(INERTIAL_NAMES) + 1
@@ -147,13 +150,16 @@ def fit_friction(ident: Any, recordings: Any, model: str = "stribeck") -> Any:
         ``ident`` with :attr:`~Identification.friction_fit` set; its :meth:`predict` then uses
         the nonlinear law in place of the linear friction.
     """
+    from robodyn.identify.pipeline import filtered_regressor
+
     recs = [recordings] if hasattr(recordings, "q") else list(recordings)
     d = ident.preprocess.decimate
-    samples = []
+    samples, y_full = [], []
     for r in recs:
         s = preprocess(r, ident.preprocess, ident.target)
+        y_full.append(filtered_regressor(ident._model, s, ident.preprocess))
         samples.append(Samples(s.t[::d], s.q[::d], s.qd[::d], s.qdd[::d], s.y[::d], s.source))
-    return replace(ident, friction_fit=fit_friction_samples(ident, samples, model))
+    return replace(ident, friction_fit=fit_friction_samples(ident, samples, y_full, model))
 
 
 def friction_table(robot: Any, train: Any, test: Sequence[Any], models: Sequence[str] = FRICTION_MODELS,

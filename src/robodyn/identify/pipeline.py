@@ -229,7 +229,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         residual_std=fit.sigma / k, samples=count, relations=relations,
         _model=model)
     if friction in NONLINEAR:
-        result = replace(result, friction_fit=fit_friction_samples(result, samples, friction))
+        result = replace(result, friction_fit=fit_friction_samples(result, samples, y_full, friction))
     return result
 
 
