@@ -6,6 +6,7 @@ Array rules (DESIGN.md): one state is ``(n,)``, a batch is ``(N, n)``; results a
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib.util
 import os
@@ -349,6 +350,8 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
             printer = CPrinter(_PREFIX)
             _write_atomic(decl, printer.declarations(kset))
             _write_atomic(src, printer.source(kset))
+        else:
+            _touch(src, decl)
         impl: CompiledLibrary | ModuleType = compile_library(src.read_text(), decl.read_text())
     else:
         path = directory / f"rd_model_{key}.py"
@@ -356,8 +359,17 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
             kset = _kernels_cached(robot, values)
             _check_structure(robot, kset)
             _write_atomic(path, PythonPrinter().module(kset))
+        else:
+            _touch(path)
         impl = _import_file(path, f"robodyn_generated_{key}")
     return Model(robot, backend, tuple(sorted(values.items())), impl)
+
+
+def _touch(*paths: Path) -> None:
+    """Mark cached generated sources as recently used (the cache evicts least-recently used)."""
+    for p in paths:
+        with contextlib.suppress(OSError):
+            os.utime(p)
 
 
 def _check_structure(robot: Robot, kset: KernelSet) -> None:
