@@ -171,3 +171,21 @@ def test_defaults_on_a_noisy_log(rate):
     err = np.linalg.norm(pred[inner] - tau[inner]) / np.linalg.norm(tau[inner])
     print(f"{rate}: {ident.preprocess}, relative error against the noise-free torque {err:.4f}")
     assert err < 0.01  # measured 0.0029 (100 Hz) and 0.0044 (1 kHz)
+
+
+def test_coulomb_split_is_non_negative_and_keeps_the_base_parameters():
+    """Offset and asymmetric Coulomb friction are one base direction; the identified robot
+    gets the split with both Coulomb levels >= 0 (a description rejects negative ones)."""
+    robot = load_quiet("puma560")
+    model = rd.compile_model(robot)
+    rec, _ = simulated(model, seconds=8.0, dt=0.02, seed=21, noise=0.5)
+    tau = rec.tau.copy()
+    tau[:, 1] += 30.0  # sensor offsets: without the split, Fcn2 comes out at -0.16 N m
+    tau[:, 2] -= 20.0
+    rec = rd.Recording(t=rec.t, q=rec.q, qd=rec.qd, qdd=rec.qdd, tau=tau, source="offsets")
+    ident = rd.identify(robot, rec, method="wls", cutoff=None, model=model)
+    for j in range(robot.dof):
+        fcp, fcn = ident.standard[PER_JOINT * j + 12], ident.standard[PER_JOINT * j + 13]
+        assert fcp >= 0 and fcn >= 0, (j, fcp, fcn)  # noqa: PT018
+    np.testing.assert_allclose(ident.relations.to_base(ident.standard), ident.base_parameters.values,
+                               rtol=1e-10, atol=1e-10)

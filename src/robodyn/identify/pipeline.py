@@ -267,7 +267,40 @@ def _complete(relations: Any, theta: np.ndarray, nominal: np.ndarray) -> np.ndar
     p = nominal.copy()
     # theta = p_b + beta p_d  ->  p_b = theta - beta p_d
     p[relations.independent] = theta - relations.beta @ nominal[relations.dependent]
-    return p
+    return _split_coulomb(relations, p)
+
+
+def _split_coulomb(relations: BaseRelations, p: np.ndarray) -> np.ndarray:
+    """Move along the one direction the data cannot see among a joint's (Fcp, Fcn, Fo) (an
+    offset against asymmetric Coulomb friction) so that both Coulomb levels are non-negative,
+    as a description requires, staying as close as possible to the prior's split."""
+    k = relations.matrix
+    out = p.copy()
+    for j in range(p.size // PER_JOINT):
+        idx = PER_JOINT * j + len(INERTIAL_NAMES) + np.array([2, 3, 4])  # Fcp, Fcn, Fo
+        _, sv, vt = np.linalg.svd(k[:, idx])
+        null = vt[np.sum(sv > 1e-9 * max(sv[0], 1e-300)):]
+        if null.shape[0] != 1:
+            continue
+        d = null[0]
+        c = out[idx[:2]]
+        # Fcp, Fcn + t d[:2] >= 0: an interval of t (or none)
+        lo, hi = -np.inf, np.inf
+        for ci, di in zip(c, d[:2], strict=True):
+            if abs(di) < 1e-12:
+                continue
+            if di > 0:
+                lo = max(lo, -ci / di)
+            else:
+                hi = min(hi, -ci / di)
+        if lo <= hi:
+            t = float(np.clip(0.0, lo, hi))
+        elif abs(d[0] - d[1]) > 1e-12:
+            t = float((c[1] - c[0]) / (d[0] - d[1]))  # no such split: equal levels
+        else:
+            continue
+        out[idx] += t * d
+    return out
 
 
 def _table(relations: Any, theta: np.ndarray, fit: LinearFit, theta0: np.ndarray) -> BaseParameters:
