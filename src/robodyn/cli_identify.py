@@ -84,13 +84,17 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     from robodyn.robot.yaml_writer import dump_yaml
 
     robot = rd.load(args.robot)
+    gains = _gains(args.gains, robot.dof)
+    if gains is not None:
+        robot = _with_gains(robot, gains)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
     recs = _read(args.data, args.spec, robot, "identification data")
     held = _read(args.validate or [], args.spec, robot, "validation data")
     with progress(f"identifying {robot.name} ({args.method}, {len(recs)} recording(s))"):
         ident = rd.identify(robot, recs, target=args.target, method=args.method,
-                            friction=args.friction)
+                            friction=args.friction,
+                            **({"gains": "description"} if gains is not None else {}))
     stem = f"{robot.name}_identified"
     paths = {"yaml": out / f"{stem}.yaml", "urdf": out / f"{stem}.urdf",
              "parameters": out / "parameters.csv"}
@@ -120,6 +124,23 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     for kind, path in paths.items():
         print(f"wrote {kind:<10} {path}")
     return _check_loadable(paths["yaml"])
+
+
+def _with_gains(robot: rd.Robot, gains: np.ndarray) -> rd.Robot:
+    """A copy of ``robot`` whose drives give ``gains`` N m/A: ``torque_constant = K / |gear_ratio|``
+    (gear ratio, hence the reflected rotor inertia, unchanged)."""
+    import dataclasses
+
+    import sympy as sp
+
+    joints = []
+    for j, k in zip(robot.joints, gains, strict=True):
+        ratio = abs(float(sp.sympify(j.drive.gear_ratio).subs(robot.defaults())))
+        if ratio == 0:
+            raise ValueError(f"--gains: joint {j.name} has gear ratio 0 in {robot.source}")
+        drive = dataclasses.replace(j.drive, torque_constant=sp.Float(float(k) / ratio))
+        joints.append(dataclasses.replace(j, drive=drive))
+    return dataclasses.replace(robot, joints=tuple(joints), description_hash="")
 
 
 def _check_loadable(path: Path) -> int:
@@ -209,6 +230,8 @@ def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
         epilog="examples:\n"
                "  robodyn identify kinova_gen3 --spec kinova_gen3 --target current \\\n"
                "      --data run1.csv.gz run2.csv.gz --validate run3.csv.gz -o ident/\n"
+               "  robodyn identify kinova_gen3 --spec kinova_gen3 --target current \\\n"
+               "      --gains 9.13,9.13,9.13,9.13,5.852,5.852,5.852 --data run1.csv.gz -o ident/\n"
                "  robodyn identify my_arm.yaml --data bag.mcap --method consistent -o ident/")
     p.add_argument("robot", metavar="ROBOT", help=robot_help)
     p.add_argument("--data", required=True, nargs="+", metavar="FILE",
@@ -217,6 +240,9 @@ def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
     p.add_argument("--method", choices=("ols", "wls", "consistent"), default="wls",
                    help="estimator: ordinary or weighted least squares, or physically consistent "
                         "(pseudo-inertia LMIs) (default: %(default)s)")
+    p.add_argument("--gains", type=_floats, metavar="K",
+                   help="drive gains, joint torque per motor ampere (N m/A), one or one per joint, "
+                        "for --target current: fixed instead of absorbed per joint")
     p.add_argument("--friction", default="linear", choices=FRICTION_MODELS,
                    help="friction model: linear (viscous, Coulomb +/-, offset, in the linear fit), "
                         "none, or a nonlinear law fitted after the linear step (default: "

@@ -94,3 +94,21 @@ def test_validate_command_rejects_bad_gains(files, tmp_path, capsys):
                "-o", str(tmp_path)])
     assert rc == 2
     assert "--gains: expected 1 or 6" in capsys.readouterr().err
+
+
+def test_identify_gains_set_the_drives_and_are_checked(files, tmp_path, capsys):
+    from robodyn.cli_identify import _with_gains
+    from robodyn.validate.effort import drive_gains
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        puma = rd.load("puma560")
+    k = np.array([10.0, 20.0, 30.0, 1.0, 2.0, 3.0])
+    geared = _with_gains(puma, k)
+    np.testing.assert_allclose(drive_gains(geared), k, rtol=1e-12)
+    assert [j.drive.gear_ratio for j in geared.joints] == [j.drive.gear_ratio for j in puma.joints]
+    assert geared.description_hash != puma.description_hash
+    train, _ = files
+    rc = main(["identify", "puma560", "--data", str(train), "--gains", "1,2", "-o", str(tmp_path)])
+    assert rc == 2
+    assert "--gains: expected 1 or 6" in capsys.readouterr().err
