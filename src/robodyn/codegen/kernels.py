@@ -19,6 +19,17 @@ terms, ``g`` the buoyancy, and the inverse and forward dynamics also drag, skin 
     forward_kinematics(q)        -> T (4, 4)      end-effector pose in the base frame
     jacobian(q)                  -> J (6, n)      [v; omega] of the tool origin, base frame
     regressor(q, qd, qdd)        -> Y (n, 15 n)   Y @ params == tau
+
+Derivative kernels (:data:`DERIVATIVE_KERNEL_NAMES`, built on request), by forward-mode
+differentiation of the recorded programs (:mod:`robodyn.symbolic.forward_mode`)::
+
+    inverse_dynamics_derivatives(q, qd, qdd) -> dtau (n, 2 n)      [d tau/dq, d tau/dqd]
+    forward_dynamics_derivatives(q, qd, tau) -> dqdd (n, 3 n)      [d qdd/dq, d qdd/dqd, d qdd/dtau]
+
+``d qdd/dx = -M^-1 d tau/dx`` at ``qdd = FD(q, qd, tau)`` (differentiating ``tau(q, qd, qdd) = u``)
+and ``d qdd/dtau = M^-1``, both by the Cholesky factor of the forward dynamics. Coulomb
+friction's step contributes nothing (exact away from ``qd = 0``); viscous friction, rotor
+inertia and the hydrodynamic terms are differentiated like the rest.
 """
 
 from __future__ import annotations
@@ -32,7 +43,7 @@ import sympy as sp
 from robodyn.codegen import optimize as opt
 from robodyn.hydro.terms import HydroTerms, hydro_terms
 from robodyn.robot.model import Robot
-from robodyn.symbolic import crba
+from robodyn.symbolic import crba, forward_mode
 from robodyn.symbolic import newton_euler as ne
 from robodyn.symbolic.kinematics import end_effector_jacobian, forward_kinematics, joint_symbols
 from robodyn.symbolic.program import Recorder
@@ -129,6 +140,9 @@ class KernelSet:
 KERNEL_NAMES = ("inverse_dynamics", "mass_matrix", "gravity", "coriolis", "forward_dynamics",
                 "state_derivative", "forward_kinematics", "jacobian", "regressor")
 
+#: Kernels built only when asked for by name (larger: 2 n or 3 n directions).
+DERIVATIVE_KERNEL_NAMES = ("inverse_dynamics_derivatives", "forward_dynamics_derivatives")
+
 
 def kernel_signature(name: str, n: int) -> tuple[tuple[tuple[str, int], ...], tuple[int, ...]]:
     """``((input name, width), ...), output shape`` of kernel ``name`` for ``n`` joints."""
@@ -143,9 +157,12 @@ def kernel_signature(name: str, n: int) -> tuple[tuple[tuple[str, int], ...], tu
         "forward_kinematics": ((q,), (4, 4)),
         "jacobian": ((q,), (6, n)),
         "regressor": ((q, qd, qdd), (n, 15 * n)),
+        "inverse_dynamics_derivatives": ((q, qd, qdd), (n, 2 * n)),
+        "forward_dynamics_derivatives": ((q, qd, tau), (n, 3 * n)),
     }
     if name not in table:
-        raise ValueError(f"unknown kernel {name!r}; choose from {', '.join(KERNEL_NAMES)}")
+        raise ValueError(f"unknown kernel {name!r}; choose from "
+                         f"{', '.join(KERNEL_NAMES + DERIVATIVE_KERNEL_NAMES)}")
     return table[name]
 
 
@@ -177,6 +194,7 @@ def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
     inputs = {"q": _arg("q", q), "qd": _arg("qd", qd), "qdd": _arg("qdd", qdd), "tau": _arg("tau", u)}
     reserved = {s.name for s in (*q, *qd, *qdd, *u)} | set(merged) | set(KERNEL_NAMES)
     reserved |= {"q", "qd", "qdd", "tau", "M", "g", "c", "T", "J", "Y", "xd", "u", "qdd_out"}
+    reserved |= {"dtau", "dqdd", *DERIVATIVE_KERNEL_NAMES}
 
     hyd = _pi_as_number(hydro_terms(robot, q, qd, qdd))
 
@@ -221,11 +239,20 @@ def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
             "Regressor Y(q, qd, qdd) with Y @ params == tau (15 parameters per joint)",
             (inputs["q"], inputs["qd"], inputs["qdd"]), "Y", (n, 15 * n),
             lambda rec: list(regressor(robot, q, qd, qdd, rec))),
+        "inverse_dynamics_derivatives": (
+            "Derivatives [d tau/dq, d tau/dqd] of the inverse dynamics (Coulomb step: 0)",
+            (inputs["q"], inputs["qd"], inputs["qdd"]), "dtau", (n, 2 * n),
+            lambda rec: _tau_derivatives(robot, q, qd, qdd, rec, hyd)),
+        "forward_dynamics_derivatives": (
+            "Derivatives [d qdd/dq, d qdd/dqd, d qdd/dtau] of the forward dynamics",
+            (inputs["q"], inputs["qd"], inputs["tau"]), "dqdd", (n, 3 * n),
+            lambda rec: _qdd_derivatives(robot, q, qd, u, rec, hyd)),
     }
     kernels = []
     for name in names:
         if name not in builders:
-            raise ValueError(f"unknown kernel {name!r}; choose from {', '.join(KERNEL_NAMES)}")
+            raise ValueError(f"unknown kernel {name!r}; choose from "
+                             f"{', '.join(KERNEL_NAMES + DERIVATIVE_KERNEL_NAMES)}")
         summary, ins, out_name, shape, build = builders[name]
         rec = Recorder(reserved)
         outs = build(rec)
@@ -298,6 +325,14 @@ def _forward_dynamics(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symb
                       tau: Sequence[sp.Symbol], rec: Recorder,
                       hyd: HydroTerms | None = None) -> list[sp.Expr]:
     """qdd by an unrolled Cholesky factorisation ``M = L L^T`` and two triangular solves."""
+    return _forward_dynamics_factored(robot, q, qd, tau, rec, hyd)[0]
+
+
+def _forward_dynamics_factored(
+        robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol], tau: Sequence[sp.Symbol],
+        rec: Recorder, hyd: HydroTerms | None = None,
+) -> tuple[list[sp.Expr], dict[tuple[int, int], sp.Expr], list[sp.Expr]]:
+    """``qdd``, the Cholesky factor ``L`` of ``M`` ({(i, j): L_ij}) and ``1 / L_jj``."""
     n = robot.dof
     m = _mass_matrix(robot, q, rec, hyd)
     # b = tau - (C qd + g + friction): inverse dynamics at qdd = 0
@@ -305,6 +340,13 @@ def _forward_dynamics(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symb
     bias = _tau_full(robot, q, qd, [0] * n, rec, hyd)
     rec.prefix = ""
     b = [rec.scalar(tau[j] - bias[j], f"b{j + 1}") for j in range(n)]
+    lower, inv_diag = _cholesky(m, rec)
+    return _cholesky_solve(lower, inv_diag, b, rec, "y{i}", "qddot{i}"), lower, inv_diag
+
+
+def _cholesky(m: sp.MatrixBase, rec: Recorder) -> tuple[dict[tuple[int, int], sp.Expr], list[sp.Expr]]:
+    """Unrolled ``M = L L^T``: ``({(i, j): L_ij}, [1 / L_jj])``."""
+    n = m.shape[0]
     lower: dict[tuple[int, int], sp.Expr] = {}
     inv_diag: list[sp.Expr] = []
     for j in range(n):
@@ -317,14 +359,60 @@ def _forward_dynamics(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symb
             # L_ij = (M_ij - sum_k L_ik L_jk) / L_jj
             s = m[i, j] - sum((lower[i, k] * lower[j, k] for k in range(j)), sp.Integer(0))
             lower[i, j] = rec.scalar(s * inv_diag[j], f"L{i + 1}_{j + 1}")
+    return lower, inv_diag
+
+
+def _cholesky_solve(lower: dict[tuple[int, int], sp.Expr], inv_diag: Sequence[sp.Expr],
+                    b: Sequence[sp.Expr], rec: Recorder, y_name: str, x_name: str) -> list[sp.Expr]:
+    """``x = M^-1 b`` by ``L y = b``, ``L^T x = y``; locals named ``y_name``/``x_name`` (``{i}``)."""
+    n = len(b)
     y: list[sp.Expr] = []
     for i in range(n):
         # L y = b
         y.append(rec.scalar((b[i] - sum((lower[i, k] * y[k] for k in range(i)), sp.Integer(0)))
-                            * inv_diag[i], f"y{i + 1}"))
+                            * inv_diag[i], y_name.format(i=i + 1)))
     x: list[sp.Expr] = [sp.Integer(0)] * n
     for i in reversed(range(n)):
-        # L^T qdd = y
+        # L^T x = y
         x[i] = rec.scalar((y[i] - sum((lower[k, i] * x[k] for k in range(i + 1, n)), sp.Integer(0)))
-                          * inv_diag[i], f"qddot{i + 1}")
+                          * inv_diag[i], x_name.format(i=i + 1))
     return x
+
+
+def _tau_derivatives(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
+                     qdd: Sequence[sp.Symbol], rec: Recorder,
+                     hyd: HydroTerms | None = None) -> list[sp.Expr]:
+    """``[d tau/dq, d tau/dqd]`` (n, 2 n) row-major, by forward mode over the tau program."""
+    tau = _tau_full(robot, q, qd, qdd, rec, hyd)
+    d = forward_mode.jacobian(list(rec.assignments), tau, [*q, *qd], rec)
+    return list(d)
+
+
+def _qdd_derivatives(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
+                     tau: Sequence[sp.Symbol], rec: Recorder,
+                     hyd: HydroTerms | None = None) -> list[sp.Expr]:
+    """``[d qdd/dq, d qdd/dqd, d qdd/dtau]`` (n, 3 n) row-major.
+
+    ``tau(q, qd, qdd) = u`` defines ``qdd``; its derivative gives ``M dqdd = du - dtau/dq dq -
+    dtau/dqd dqd``, so ``d qdd/dx = -M^-1 d tau/dx`` at ``qdd = FD(q, qd, u)`` and ``d qdd/du =
+    M^-1``, each column solved with the Cholesky factor the forward dynamics computes anyway.
+    """
+    n = robot.dof
+    qdd, lower, inv_diag = _forward_dynamics_factored(robot, q, qd, tau, rec, hyd)
+    rec.prefix = "i_"
+    full = _tau_full(robot, q, qd, qdd, rec, hyd)
+    rec.prefix = ""
+    # qdd is held fixed: d tau/dx at constant qdd
+    held = [s for s in qdd if isinstance(s, sp.Symbol)]
+    d = forward_mode.jacobian(list(rec.assignments), full, [*q, *qd], rec, constants=held)
+    columns = []
+    for k in range(2 * n):
+        # M dqdd/dx_k = -dtau/dx_k
+        columns.append(_cholesky_solve(lower, inv_diag, [-d[i, k] for i in range(n)], rec,
+                                       f"dy{{i}}_{k + 1}", f"dqdd{{i}}_{k + 1}"))
+    for k in range(n):
+        # M dqdd/dtau_k = e_k
+        e = [sp.Integer(int(i == k)) for i in range(n)]
+        columns.append(_cholesky_solve(lower, inv_diag, e, rec, f"my{{i}}_{k + 1}",
+                                       f"minv{{i}}_{k + 1}"))
+    return [columns[k][i] for i in range(n) for k in range(3 * n)]
