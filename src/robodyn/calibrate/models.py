@@ -34,7 +34,8 @@ redundant ones are found and held fixed by :mod:`robodyn.calibrate.identifiabili
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -47,7 +48,10 @@ from robodyn.calibrate.nominal import (
     parallel_links,
 )
 
-__all__ = ["MODELS", "ErrorModel", "build_model", "model_frames"]
+if TYPE_CHECKING:
+    from robodyn.calibrate.nongeometric import NonGeometric
+
+__all__ = ["MODELS", "ErrorModel", "build_model", "extend_model", "model_frames"]
 
 #: The error models, by name.
 MODELS = ("dh", "hayati", "s-model", "poe")
@@ -88,6 +92,12 @@ class ErrorModel:
     joint_types : tuple of str, length n
     hayati : tuple of bool, length n
         Links built with Hayati's parametrisation.
+    targets : int
+        ``K``, targets measured at each pose: the chain ends at the first; the others are
+        ``tool<k>.x/y/z`` (their positions in the last link frame, after the chain's parameters).
+    nongeometric : NonGeometric or None
+        Joint corrections ``q + B(q) theta`` (:mod:`robodyn.calibrate.nongeometric`), whose
+        parameters are the last ``M``.
     """
 
     name: str
@@ -104,6 +114,8 @@ class ErrorModel:
     orientation: bool
     joint_types: tuple[str, ...]
     hayati: tuple[bool, ...]
+    targets: int = 1
+    nongeometric: NonGeometric | None = None
 
     @property
     def n_params(self) -> int:
@@ -119,9 +131,61 @@ class ErrorModel:
         """Position of the parameter called ``name``."""
         return self.names.index(name)
 
+    @property
+    def nongeometric_slice(self) -> slice:
+        """Positions of the non-geometric parameters (empty without them)."""
+        m = self.nongeometric.n_params if self.nongeometric is not None else 0
+        return slice(self.n_params - m, self.n_params)
+
     def evaluate(self, params: np.ndarray, q: np.ndarray, *, derivatives: bool = True) -> ChainEval:
-        """Target frame (and Jacobians) for joint readings ``q`` of shape (N, n)."""
-        return evaluate(self.ops, params, q, self.n_params, derivatives=derivatives)[0]
+        """Target frames (and Jacobians) for joint readings ``q`` of shape (N, n).
+
+        With ``K`` targets the rows are ``N K`` (pose-major: row ``i K + k`` is target ``k`` at
+        pose ``i``). ``jac_joint`` is the chain's Jacobian at the corrected joint values (the
+        derivative of the small non-geometric correction itself is left out).
+        """
+        params = np.asarray(params, dtype=float)
+        q = np.asarray(q, dtype=float)
+        basis = None
+        if self.nongeometric is not None:
+            basis = self.nongeometric.basis(q)
+            # q_link = q + B(q) theta
+            q = q + basis @ params[self.nongeometric_slice]
+        ev = evaluate(self.ops, params, q, self.n_params, derivatives=derivatives)[0]
+        jp, jq = ev.jac_param, ev.jac_joint
+        if derivatives and basis is not None:
+            # d p / d theta = J_q B
+            jp[:, :, self.nongeometric_slice] = jq @ basis
+        if self.targets == 1:
+            return ChainEval(ev.position, ev.rotation, jp, jq)
+        return self._targets(params, ev.position, ev.rotation, jp, jq)
+
+    def _targets(self, params, p1, r, jp, jq) -> ChainEval:
+        """All ``K`` targets from the first one's evaluation (rows pose-major)."""
+        big_n, k_count = len(p1), self.targets
+        tool = [self.index(f"tool.{a}") for a in "xyz"]
+        t1 = params[tool]
+        pos = np.empty((big_n, k_count, 3))
+        pos[:, 0] = p1
+        offsets = []
+        for k in range(1, k_count):
+            cols = [self.index(f"tool{k + 1}.{a}") for a in "xyz"]
+            d = r @ (params[cols] - t1)  # p_k = p_1 + R (t_k - t_1)
+            pos[:, k] = p1 + d
+            offsets.append((cols, d))
+        rot_all = np.repeat(r, k_count, axis=0)
+        if jp is None:
+            return ChainEval(pos.reshape(-1, 3), rot_all, None, None)
+        jp_all = np.repeat(jp[:, None], k_count, axis=1)
+        jq_all = np.repeat(jq[:, None], k_count, axis=1)
+        for k, (cols, d) in enumerate(offsets, start=1):
+            # a rotation w moves p_k by w x (p_k - o) = (that of p_1) + w x d
+            jp_all[:, k, :3] += np.cross(jp[:, 3:], d[:, :, None], axisa=1, axisb=1, axisc=1)
+            jq_all[:, k, :3] += np.cross(jq[:, 3:], d[:, :, None], axisa=1, axisb=1, axisc=1)
+            jp_all[:, k, :3][:, :, tool] = 0.0
+            jp_all[:, k, :3][:, :, cols] = r
+        return ChainEval(pos.reshape(-1, 3), rot_all, jp_all.reshape(big_n * k_count, 6, -1),
+                         jq_all.reshape(big_n * k_count, 6, -1))
 
 
 class _Builder:
@@ -322,6 +386,60 @@ def build_model(
         joint_types=geometry.joint_types,
         hayati=tuple(k == "hayati" for k in kinds),
     )
+
+
+def extend_model(model: ErrorModel, offsets: np.ndarray | None = None,
+                 nongeometric: NonGeometric | None = None) -> ErrorModel:
+    """``model`` with more targets and non-geometric terms.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        A geometric model (one target, no non-geometric terms).
+    offsets : numpy.ndarray, shape (K - 1, 3), optional
+        Initial positions of targets 2..K in the last link frame, m.
+    nongeometric : NonGeometric, optional
+        Their parameters start at zero.
+
+    Raises
+    ------
+    ValueError
+        ``model`` is already extended, or several targets with measured orientations.
+    """
+    if model.targets != 1 or model.nongeometric is not None:
+        raise ValueError("extend_model: the model is already extended")
+    offsets = np.zeros((0, 3)) if offsets is None else np.asarray(offsets, dtype=float).reshape(-1, 3)
+    if len(offsets) and model.orientation:
+        raise ValueError("several targets per pose cannot be combined with measured orientations; "
+                         "give the orientation of one target only")
+    names, units, values = list(model.names), list(model.units), list(model.initial)
+    placement = [k for k in model.priority if names[k].startswith(("base.", "tool."))]
+    extra = [k for k in model.priority if k in _extra_group(model)]
+    core = [k for k in model.priority if k not in placement and k not in extra]
+    targets = []
+    for k, off in enumerate(offsets, start=2):
+        for a, v in zip("xyz", off, strict=True):
+            targets.append(len(names))
+            names.append(f"tool{k}.{a}")
+            units.append("m")
+            values.append(float(v))
+    ng = []
+    if nongeometric is not None:
+        ng = list(range(len(names), len(names) + nongeometric.n_params))
+        names += nongeometric.names
+        units += nongeometric.units
+        values += [0.0] * nongeometric.n_params
+    # placement and targets first, then the joints' parameters, then the terms, then the redundant
+    priority = placement + targets + core + ng + extra
+    return replace(model, names=tuple(names), units=tuple(units), initial=np.array(values),
+                   priority=tuple(priority), targets=len(offsets) + 1, nongeometric=nongeometric)
+
+
+def _extra_group(model: ErrorModel) -> set[int]:
+    """The S-model's redundant screw parameters ``b`` and ``beta`` (last in priority)."""
+    if model.name != "s-model":
+        return set()
+    return {k for k, n in enumerate(model.names) if n.endswith((".b", ".beta"))}
 
 
 def _frames(ops, params, joint_ops, base_op, n) -> tuple[np.ndarray, np.ndarray]:

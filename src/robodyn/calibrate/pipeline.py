@@ -31,7 +31,7 @@ from robodyn.calibrate.identifiability import (
     observability,
 )
 from robodyn.calibrate.kinematics import hom, inv
-from robodyn.calibrate.models import MODELS, ErrorModel, build_model, model_frames
+from robodyn.calibrate.models import MODELS, ErrorModel, build_model, extend_model, model_frames
 from robodyn.calibrate.nominal import RobotGeometry, default_frame0, robot_geometry
 from robodyn.calibrate.result import Calibration, ErrorStats, Parameter
 from robodyn.calibrate.solve import LOSSES, fit
@@ -60,7 +60,9 @@ def _array(name: str, value, shape_text: str) -> np.ndarray:
 
 def check_data(robot: Robot, q, points, orientations=None, sigma=5e-5,
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray]:
-    """Validate calibration data; returns arrays q (N, n), points (N, 3), orientations, sigma (N, 3).
+    """Validate calibration data; returns q (N, n), points, orientations and sigma (shape of points).
+
+    ``points`` is (N, 3), or (N, K, 3) for K targets measured at each pose.
 
     Raises
     ------
@@ -69,15 +71,19 @@ def check_data(robot: Robot, q, points, orientations=None, sigma=5e-5,
     """
     n = robot.dof
     q = _array("q", q, f"(N, {n})")
-    points = _array("points", points, "(N, 3)")
+    points = _array("points", points, "(N, 3) or (N, K, 3)")
     if q.ndim != 2 or q.shape[1] != n:
         raise ValueError(f"q must have shape (N, {n}) for {robot.name}'s {n} joints "
                          f"({', '.join(robot.joint_names)}); got {q.shape}")
-    if points.ndim != 2 or points.shape[1] != 3:
-        raise ValueError(f"points must have shape (N, 3); got {points.shape}")
+    if points.ndim not in (2, 3) or points.shape[-1] != 3 or (points.ndim == 3 and points.shape[1] < 1):
+        raise ValueError(f"points must have shape (N, 3) or (N, K, 3) for K targets per pose; "
+                         f"got {points.shape}")
     if len(q) != len(points):
         raise ValueError(f"mismatched lengths: q has {len(q)} poses but points has {len(points)}")
     if orientations is not None:
+        if points.ndim == 3 and points.shape[1] > 1:
+            raise ValueError("orientations cannot be combined with several targets per pose; "
+                             "give the orientation of one target only")
         orientations = _array("orientations", orientations, "(N, 3, 3)")
         if orientations.shape != (len(q), 3, 3):
             raise ValueError(f"orientations must have shape ({len(q)}, 3, 3); got {orientations.shape}")
@@ -86,17 +92,111 @@ def check_data(robot: Robot, q, points, orientations=None, sigma=5e-5,
         bad = np.flatnonzero((err > 1e-6) | (det < 0))
         if bad.size:
             raise ValueError(f"orientations[{bad[0]}] is not a rotation matrix ({bad.size} such rows)")
-    s = _array("sigma", sigma, "scalar, (N,) or (N, 3)")
+    s = _array("sigma", sigma, "scalar, (N,), (N, 3) or the shape of points")
     if s.ndim == 1:
-        s = s[:, None]
+        s = s.reshape((-1,) + (1,) * (points.ndim - 1))
+    elif s.ndim == 2 and points.ndim == 3:
+        s = s[:, None, :]
     try:
         s = np.broadcast_to(s, points.shape).copy()
     except ValueError:
-        raise ValueError(f"sigma must be a scalar, (N,) or (N, 3) for N = {len(points)}; "
+        raise ValueError(f"sigma must be a scalar, (N,), (N, 3) or {points.shape} for N = {len(points)}; "
                          f"got shape {np.shape(sigma)}") from None
     if not np.all(s > 0):
         raise ValueError("sigma must be positive")
     return q, points, orientations, s
+
+
+#: Length and angle units accepted by :func:`calibrate`, with their factor to SI.
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3}
+ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180}
+
+
+def convert_units(robot: Robot, q, points, sigma, sigma_rot, length_unit: str, angle_unit: str):
+    """Copies of q, points, sigma and sigma_rot in m and rad (revolute joints' readings only).
+
+    Raises
+    ------
+    ValueError
+        An unknown unit.
+    """
+    if length_unit not in LENGTH_UNITS:
+        raise ValueError(f"length_unit must be one of {', '.join(LENGTH_UNITS)}, got {length_unit!r}")
+    if angle_unit not in ANGLE_UNITS:
+        raise ValueError(f"angle_unit must be one of {', '.join(ANGLE_UNITS)}, got {angle_unit!r}")
+    if length_unit == "m" and angle_unit == "rad":
+        return q, points, sigma, sigma_rot
+    lf, af = LENGTH_UNITS[length_unit], ANGLE_UNITS[angle_unit]
+    q = _array("q", q, f"(N, {robot.dof})")
+    if q.ndim == 2 and q.shape[1] == robot.dof:
+        scale = np.array([af if j.type == "revolute" else 1.0 for j in robot.joints])
+        q = q * scale  # a new array: the caller's is not modified
+    return q, _array("points", points, "(N, 3)") * lf, _array("sigma", sigma, "") * lf, sigma_rot * af
+
+
+def check_magnitude(geometry: RobotGeometry, q: np.ndarray, points: np.ndarray, length_unit: str) -> None:
+    """Reject data whose spread contradicts the declared length unit.
+
+    The spread (RMS distance from the mean) of the measured points is compared with that of the
+    nominal model's target over the same readings; they differ by a rigid placement and small
+    errors only, so a ratio beyond 30 (or below 1/30) means the unit is wrong (millimetres given
+    as metres gives 1000).
+
+    Raises
+    ------
+    ValueError
+        Naming the declared unit, the two spreads and the likely unit.
+    """
+    if len(q) < 3:
+        return
+    nominal = build_model("dh", geometry)
+    p = nominal.evaluate(nominal.initial, q, derivatives=False).position
+    y = points.reshape(len(q), -1, 3)[:, 0]
+    spread_n = float(np.sqrt(((p - p.mean(axis=0)) ** 2).sum(axis=1).mean()))
+    spread_y = float(np.sqrt(((y - y.mean(axis=0)) ** 2).sum(axis=1).mean()))
+    if spread_n <= 0 or spread_y <= 0:
+        return
+    ratio = spread_y / spread_n
+    if ratio > 30 or ratio < 1 / 30:
+        hint = ("the data look like millimetres: give length_unit='mm' (CLI --length-unit mm)"
+                if 300 < ratio < 3000 else
+                "the data look like metres: give length_unit='m'" if 3e-4 < ratio < 3e-3 else
+                "check the units of the points and of the joint readings (deg vs rad)")
+        raise ValueError(f"points contradict length_unit {length_unit!r}: the measured points spread "
+                         f"{spread_y:.4g} {'units' if length_unit != 'm' else 'm'} (as given, converted: "
+                         f"{spread_y:.4g} m) where the nominal model's target spreads {spread_n:.4g} m over "
+                         f"the same readings (ratio {ratio:.3g}); {hint}")
+
+
+def target_offsets(model: ErrorModel, params: np.ndarray, q: np.ndarray, points: np.ndarray,
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Positions in the last link frame of further targets, by linear least squares.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        A geometric model with one target (its tool parameters are set to zero here).
+    params : numpy.ndarray, shape (P,)
+    q : numpy.ndarray, shape (N, n)
+    points : numpy.ndarray, shape (N, K', 3)
+        Measured positions of the further targets, m.
+
+    Returns
+    -------
+    offsets : numpy.ndarray, shape (K', 3)
+    residuals : numpy.ndarray, shape (N, K', 3)
+    """
+    p = np.array(params, dtype=float)
+    p[[model.index(f"tool.{a}") for a in "xyz"]] = 0.0
+    ev = model.evaluate(p, q, derivatives=False)
+    offsets = np.zeros((points.shape[1], 3))
+    res = np.zeros(points.shape)
+    for k in range(points.shape[1]):
+        # R_i t = y_ik - o_i, stacked over poses
+        offsets[k], *_ = np.linalg.lstsq(ev.rotation.reshape(-1, 3), (points[:, k] - ev.position).ravel(),
+                                         rcond=None)
+        res[:, k] = points[:, k] - ev.position - ev.rotation @ offsets[k]
+    return offsets, res
 
 
 def random_configurations(robot: Robot, count: int, rng: np.random.Generator | int = 0) -> np.ndarray:
@@ -199,9 +299,10 @@ def identifiable_parameters(robot: Robot, model: ErrorModel, params: np.ndarray,
         Indices of the identifiable parameters, in the model's priority order.
     unidentifiable : list of Unidentifiable
     """
-    weights = np.broadcast_to(np.asarray(weights, dtype=float), (len(q), 3))
+    weights = np.broadcast_to(np.asarray(weights, dtype=float).reshape(-1, 3) if np.ndim(weights) else
+                              weights, (len(q) * model.targets, 3))
     qr = random_configurations(robot, max(3 * model.n_params, 60), rng=12345)
-    ones = np.ones((len(qr), 3))
+    ones = np.ones((len(qr) * model.targets, 3))
     js = _rows(model, params, qr, ones, 1.0)
     kept_s = independent_columns(js, model.priority, RANK_TOL)
     drop_s = [k for k in model.priority if k not in kept_s]
@@ -235,6 +336,10 @@ def calibrate(
     loss_scale: float = 3.0,
     parallel_tol: float = math.radians(1.0),
     max_nfev: int | None = None,
+    nongeometric: Sequence[str] = (),
+    payload: tuple[float, Sequence[float]] | None = None,
+    length_unit: str = "m",
+    angle_unit: str = "rad",
 ) -> Calibration:
     """Identify a robot's kinematics from measured target positions.
 
@@ -244,9 +349,11 @@ def calibrate(
         The nominal robot.
     q : array_like, shape (N, n)
         Joint readings at the measured poses, rad (m for prismatic joints).
-    points : array_like, shape (N, 3)
-        Measured target positions in the instrument's frame, m. The instrument-to-base transform
-        and the target's offset on the last link are unknown and estimated.
+    points : array_like, shape (N, 3) or (N, K, 3)
+        Measured target positions in the instrument's frame, m; (N, K, 3) for K targets
+        (reflectors) measured at each pose, each with its own offset on the last link, all fitted
+        together. The instrument-to-base transform and the target offsets are unknown and
+        estimated.
     model : {"s-model", "hayati", "dh", "poe"}
         The error model (:mod:`robodyn.calibrate.models`).
     sigma : float or array_like, shape (N,) or (N, 3)
@@ -268,6 +375,16 @@ def calibrate(
         Nominal consecutive axes closer than this to parallel (rad) get Hayati's link.
     max_nfev : int, optional
         Most residual evaluations of the final fit.
+    nongeometric : sequence of {"compliance", "harmonics"}
+        Non-geometric joint errors identified with the geometry
+        (:mod:`robodyn.calibrate.nongeometric`): joint compliance under the gravity model's
+        holding torques, first harmonics of the joint (and motor) angles.
+    payload : (float, sequence of float), optional
+        Known payload for the compliance torques: mass (kg) and centre of mass in the tool frame (m).
+    length_unit : {"m", "mm"}
+        Unit of ``points`` and ``sigma`` (converted to m; the result is in m).
+    angle_unit : {"rad", "deg"}
+        Unit of the revolute joints' readings in ``q`` and of ``sigma_rot`` (converted to rad).
 
     Returns
     -------
@@ -287,11 +404,19 @@ def calibrate(
         raise ValueError(f"initial must be 'nominal' or 'circle-point', got {initial!r}")
     if initial == "circle-point" and circle_data is None:
         raise ValueError("initial='circle-point' needs circle_data: one (q, points) set per joint")
+    q, points, sigma, sigma_rot = convert_units(robot, q, points, sigma, sigma_rot, length_unit,
+                                                angle_unit)
     q, points, orientations, sig = check_data(robot, q, points, orientations, sigma)
     geometry = robot_geometry(robot)
+    check_magnitude(geometry, q, points, length_unit)
     oriented = orientations is not None
-    world, before_res, placed, placed_params = nominal_placement(geometry, q, points, orientations, sig,
-                                                          sigma_rot)
+    pts3 = points if points.ndim == 3 else points[:, None]
+    sig3 = sig.reshape(pts3.shape)
+    k_count = pts3.shape[1]
+    world, before1, placed, placed_params = nominal_placement(geometry, q, pts3[:, 0], orientations,
+                                                              sig3[:, 0], sigma_rot)
+    _, before_k = target_offsets(placed, placed_params, q, pts3[:, 1:])
+    before_res = np.concatenate((before1[:, None], before_k), axis=1).reshape(points.shape)
     target = model_frames(placed, placed_params)[2]
     cp: CirclePointResult | None = None
     if initial == "circle-point":
@@ -303,10 +428,20 @@ def calibrate(
     else:
         em = build_model(model, geometry, base=world, target=target, orientation=oriented,
                          parallel_tol=parallel_tol)
+    if k_count > 1 or nongeometric:
+        ng = None
+        if nongeometric:
+            from robodyn.calibrate.nongeometric import build_nongeometric, nominal_frames
+
+            ng = build_nongeometric(robot, nongeometric, nominal_frames(geometry), payload=payload)
+        offsets, _ = target_offsets(em, em.initial, q, pts3[:, 1:])
+        em = extend_model(em, offsets, ng)
+    points = pts3.reshape(-1, 3)
+    sig = sig3.reshape(-1, 3)
     weights = 1.0 / sig
     rot_weight = 1.0 / sigma_rot if oriented else 0.0
     free, unid = identifiable_parameters(robot, em, em.initial, q, weights, rot_weight)
-    rows = q.shape[0] * (6 if oriented else 3)
+    rows = q.shape[0] * k_count * (6 if oriented else 3)
     n_struct = em.n_params - sum(u.kind == "structural" for u in unid)
     if rows <= n_struct:
         per = 6 if oriented else 3
@@ -320,6 +455,13 @@ def calibrate(
     if not res.success:
         warnings.warn(f"calibration of {robot.name} did not converge: {res.message}", RuntimeWarning,
                       stacklevel=2)
+    ratio = math.sqrt(res.variance_factor)
+    if ratio > 3.0 or ratio < 1.0 / 3.0:
+        warnings.warn(f"calibration of {robot.name}: the variance factor {res.variance_factor:.4g} says the "
+                      f"given sigma is wrong by a factor of about {ratio:.3g} (residuals "
+                      f"{'larger' if ratio > 1 else 'smaller'} than sigma); the standard uncertainties "
+                      "are scaled by it, but check sigma (or the data's units, or unmodelled errors)",
+                      RuntimeWarning, stacklevel=2)
     std = np.sqrt(np.diag(res.covariance))
     parameters = tuple(
         Parameter(em.names[k], float(res.params[k]), float(s), float(em.initial[k]), em.units[k])
@@ -334,7 +476,7 @@ def calibrate(
         parameters=parameters,
         covariance=res.covariance,
         unidentifiable=tuple(unid),
-        residuals=res.residuals,
+        residuals=res.residuals.reshape(before_res.shape),
         rotation_residuals=res.rotation_residuals,
         before_residuals=before_res,
         before=ErrorStats.from_residuals(before_res),
@@ -350,6 +492,7 @@ def calibrate(
         message=res.message,
         circle_point=cp,
         before_robot=calibrated_robot(robot, geometry, placed, placed_params, name=f"{robot.name}_placed"),
+        targets_axis=before_res.ndim == 3,
     )
 
 
@@ -404,6 +547,9 @@ def compensate(
         If a point is out of reach (no convergence from its seed).
     """
     q, pts, _, _ = check_data(calibration.robot, q_seed, points)
+    if pts.ndim != 2:
+        raise ValueError(f"compensate: points must have shape (M, 3) (positions of the first target); "
+                         f"got {pts.shape}")
     if frame == "base":
         b = calibration.base()
         pts = pts @ b[:3, :3].T + b[:3, 3]
@@ -424,14 +570,15 @@ def inverse_kinematics(model: ErrorModel, params: np.ndarray, points: np.ndarray
         If a point is not reached within ``tol`` (m).
     """
     q = np.array(q_seed, dtype=float)
+    step = model.targets  # the first target of each pose
     for _ in range(max_iter):
         ev = model.evaluate(params, q)
-        err = points - ev.position
+        err = points - ev.position[::step]
         if np.all(np.linalg.norm(err, axis=1) < tol):
             return q
         # dq = J^+ e (minimum-norm step)
-        q += np.einsum("mij,mj->mi", np.linalg.pinv(ev.jac_joint[:, :3], rcond=1e-10), err)
-    err = np.linalg.norm(points - model.evaluate(params, q, derivatives=False).position, axis=1)
+        q += np.einsum("mij,mj->mi", np.linalg.pinv(ev.jac_joint[::step, :3], rcond=1e-10), err)
+    err = np.linalg.norm(points - model.evaluate(params, q, derivatives=False).position[::step], axis=1)
     bad = np.flatnonzero(err >= tol)
     if bad.size:
         raise ValueError(f"compensate: {bad.size} point(s) not reached (first: index {bad[0]}, "

@@ -72,6 +72,11 @@ class Parameter:
     unit: str
 
 
+#: Display scale and unit of each parameter unit in :meth:`Calibration.summary`.
+_DISPLAY = {"m": (1e3, "mm"), "rad": (180 / np.pi, "deg"), "rad/(N m)": (1e6, "urad/(N m)"),
+            "m/N": (1e6, "um/N")}
+
+
 def _frozen(a: np.ndarray | None) -> np.ndarray | None:
     if a is None:
         return None
@@ -128,6 +133,8 @@ class Calibration:
     before_robot : Robot or None
         The nominal robot placed in the instrument frame with the fitted target as its tool: the
         model behind ``before_residuals``.
+    targets_axis : bool
+        The points were given as (N, K, 3): residuals and predictions keep that shape.
     """
 
     robot: Robot
@@ -152,6 +159,7 @@ class Calibration:
     message: str
     circle_point: CirclePointResult | None = None
     before_robot: Robot | None = None
+    targets_axis: bool = False
 
     def __post_init__(self) -> None:
         for name in ("params", "covariance", "residuals", "rotation_residuals", "before_residuals"):
@@ -178,15 +186,31 @@ class Calibration:
         return np.array([p.std for p in self.parameters])
 
     def predict(self, q: np.ndarray) -> np.ndarray:
-        """Predicted target positions in the instrument frame for readings (N, n), shape (N, 3)."""
+        """Predicted target positions in the instrument frame for readings (N, n), m.
+
+        Every term is included (geometry, targets, non-geometric corrections). Shape (N, 3), or
+        (N, K, 3) when the calibration's points were (N, K, 3).
+        """
         q = np.atleast_2d(np.asarray(q, dtype=float))
-        return self.model.evaluate(self.params, q, derivatives=False).position
+        pos = self.model.evaluate(self.params, q, derivatives=False).position
+        return pos.reshape(len(q), -1, 3) if self.targets_axis else pos
+
+    @property
+    def nongeometric(self) -> dict:
+        """The non-geometric terms and their values (``{}`` without them), plain data."""
+        ng = self.model.nongeometric
+        return ng.as_dict(self.params[self.model.nongeometric_slice]) if ng is not None else {}
+
+    def target_offsets(self) -> np.ndarray:
+        """Positions of all targets in the last link frame, shape (K, 3), m."""
+        names = ["tool"] + [f"tool{k}" for k in range(2, self.model.targets + 1)]
+        return np.array([[self.params[self.model.index(f"{t}.{a}")] for a in "xyz"] for t in names])
 
     def predict_frames(self, q: np.ndarray) -> np.ndarray:
         """Predicted target frames (N, 4, 4); the orientation is meaningful only when measured."""
         q = np.atleast_2d(np.asarray(q, dtype=float))
         ev = self.model.evaluate(self.params, q, derivatives=False)
-        out = np.zeros((len(q), 4, 4))
+        out = np.zeros((len(ev.position), 4, 4))
         out[:, :3, :3], out[:, :3, 3], out[:, 3, 3] = ev.rotation, ev.position, 1.0
         return out
 
@@ -218,7 +242,7 @@ class Calibration:
             f"{'parameter':<18}{'initial':>14}{'estimate':>14}{'std':>12}  unit",
         ]
         for p in self.parameters:
-            scale, unit = (1e3, "mm") if p.unit == "m" else (180 / np.pi, "deg")
+            scale, unit = _DISPLAY.get(p.unit, (1.0, p.unit))
             lines.append(f"{p.name:<18}{p.initial * scale:>14.6f}{p.value * scale:>14.6f}"
                          f"{p.std * scale:>12.3g}  {unit}")
         if self.unidentifiable:

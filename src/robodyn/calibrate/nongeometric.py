@@ -1,0 +1,239 @@
+"""Non-geometric joint errors: joint compliance and transmission harmonics.
+
+Both are corrections of the joint readings, linear in their parameters ``theta``::
+
+    q_link = q + B(q) theta          B (N, n, M): one column per parameter
+
+so the position Jacobian with respect to ``theta`` is the joint Jacobian times ``B`` and every
+geometric error model (:mod:`robodyn.calibrate.models`) can carry them.
+
+Compliance (elastostatic joints): joint ``j`` twists under the load its drive holds,
+``dq_j = -c_j tau_j(q)``, with ``tau_j(q)`` the static torque that holds the arm still
+(``rd.compile_model(robot).gravity(q)``, plus a payload when given) and ``c_j >= 0`` the joint's
+compliance in rad/(N m) (m/N for a prismatic joint). When the description has no masses, ``tau``
+is a gravity-shaped basis instead: the holding torque of a 1 kg point mass at the origin of every
+joint frame after joint ``j`` and at the tool (then ``c_j`` absorbs the unknown mass scale and its
+unit is rad/(N m) per that unit-mass torque).
+
+Harmonics (transmission errors): ``dq_j = k_j q_j + a_j cos(q_j) + b_j sin(q_j)``: a
+transmission ratio error ``k_j`` (the reading's scale) and the first harmonic of the joint angle
+(eccentricity of the output gear), and, when the description gives a gear ratio ``G_j`` other than 1, also
+``a'_j cos(G_j q_j) + b'_j sin(G_j q_j)`` (the motor's first harmonic seen at the link), rad.
+Only revolute joints get harmonics.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from robodyn.robot.model import Robot
+
+__all__ = ["NONGEOMETRIC", "NonGeometric", "build_nongeometric", "nominal_frames"]
+
+#: The non-geometric terms, by name.
+NONGEOMETRIC = ("compliance", "harmonics")
+
+
+@dataclass(frozen=True, eq=False)
+class NonGeometric:
+    """Non-geometric joint corrections of one robot (module docstring).
+
+    Attributes
+    ----------
+    terms : tuple of str
+        Subset of :data:`NONGEOMETRIC`.
+    names : tuple of str, length M
+        Parameter names: ``"q2.compliance"``, ``"q1.ratio"``, ``"q1.cos1"``, ``"q1.sin1"``, ``"q1.motor_cos1"``,
+        ``"q1.motor_sin1"``.
+    units : tuple of str, length M
+        ``"rad/(N m)"``, ``"m/N"``, ``"rad"`` or ``"1"`` (ratio error).
+    joints : tuple of int, length M
+        The joint each parameter corrects.
+    kinds : tuple of str, length M
+        ``"compliance"``, ``"ratio"``, ``"cos"``, ``"sin"``, ``"motor_cos"``, ``"motor_sin"``.
+    gear_ratio : numpy.ndarray, shape (n,)
+        Gear ratios (NaN where the description gives none).
+    torque : callable or None
+        ``torque(q)``: holding torques (N, n) for readings (N, n), N m; None without compliance.
+    torque_source : str
+        ``"gravity model"``, ``"gravity model + payload"`` or ``"gravity-shaped basis"`` (or ``""``).
+    """
+
+    terms: tuple[str, ...]
+    names: tuple[str, ...]
+    units: tuple[str, ...]
+    joints: tuple[int, ...]
+    kinds: tuple[str, ...]
+    gear_ratio: np.ndarray
+    torque: Callable[[np.ndarray], np.ndarray] | None
+    torque_source: str
+
+    @property
+    def n_params(self) -> int:
+        """Number of parameters M."""
+        return len(self.names)
+
+    def basis(self, q: np.ndarray) -> np.ndarray:
+        """``B(q)``, shape (N, n, M): ``q_link = q + B(q) theta`` for readings ``q`` (N, n)."""
+        q = np.asarray(q, dtype=float)
+        out = np.zeros((len(q), q.shape[1], self.n_params))
+        tau = self.torque(q) if "compliance" in self.kinds else None
+        for m, (j, kind) in enumerate(zip(self.joints, self.kinds, strict=True)):
+            if kind == "compliance":
+                out[:, j, m] = -tau[:, j]  # dq = -c tau: the joint gives way under its load
+            elif kind == "ratio":
+                out[:, j, m] = q[:, j]  # dq = k q: scale error of the transmission
+            elif kind == "cos":
+                out[:, j, m] = np.cos(q[:, j])
+            elif kind == "sin":
+                out[:, j, m] = np.sin(q[:, j])
+            elif kind == "motor_cos":
+                out[:, j, m] = np.cos(self.gear_ratio[j] * q[:, j])  # motor angle G q
+            else:
+                out[:, j, m] = np.sin(self.gear_ratio[j] * q[:, j])
+        return out
+
+    def as_dict(self, values: np.ndarray) -> dict:
+        """The terms and their values as plain data (for the YAML/JSON output)."""
+        return {
+            "terms": list(self.terms),
+            "torque_source": self.torque_source,
+            "parameters": [{"name": n, "joint": int(j), "kind": k, "value": float(v), "unit": u}
+                           for n, j, k, v, u in zip(self.names, self.joints, self.kinds, values,
+                                                    self.units, strict=True)],
+        }
+
+
+def _point_mass_torque(frames: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
+                       types: Sequence[str], gravity: np.ndarray, masses: Sequence[tuple[int, float]],
+                       payload: tuple[float, np.ndarray] | None = None,
+                       ) -> Callable[[np.ndarray], np.ndarray]:
+    """Holding torques of point masses on the nominal chain.
+
+    ``frames(q)`` gives joint origins (N, n, 3), axes (N, n, 3) and tool frames (N, 4, 4) in the
+    frame of ``gravity``; ``masses`` are (after-joint index, kg) with the mass at the origin of the
+    next joint's frame (index n: the tool); ``payload`` is (kg, point in the tool frame).
+    """
+    types = tuple(types)
+    n = len(types)
+
+    def torque(q: np.ndarray) -> np.ndarray:
+        origins, axes, tool = frames(q)
+        pts = np.concatenate((origins, tool[:, None, :3, 3]), axis=1)  # (N, n + 1, 3)
+        out = np.zeros((len(q), n))
+        loads = [(pts[:, k], m, k) for k, m in masses]
+        if payload is not None:
+            p = tool[:, :3, :3] @ payload[1] + tool[:, :3, 3]
+            loads.append((p, payload[0], n))
+        for p, m, k in loads:
+            for j in range(min(k, n)):
+                z = axes[:, j]
+                # dp/dq_j = z x (p - o_j) (revolute) or z (prismatic); g_j = -m gravity . dp/dq_j
+                dp = np.cross(z, p - origins[:, j]) if types[j] == "revolute" else z
+                out[:, j] -= m * dp @ gravity
+        return out
+
+    return torque
+
+
+def nominal_frames(geometry) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """``frames(q)`` of :func:`build_nongeometric` from the nominal geometry (Hayati chain, world frame)."""
+    from robodyn.calibrate.kinematics import evaluate
+    from robodyn.calibrate.models import build_model
+
+    chain = build_model("hayati", geometry, orientation=True)
+
+    def frames(q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        ev, rec = evaluate(chain.ops, chain.initial, q, derivatives=False, frames_after=chain.joint_ops)
+        origins = np.stack([f[:, :3, 3] for f in rec], axis=1)
+        axes = np.stack([f[:, :3, 2] for f in rec], axis=1)
+        tool = np.zeros((len(q), 4, 4))
+        tool[:, :3, :3], tool[:, :3, 3], tool[:, 3, 3] = ev.rotation, ev.position, 1.0
+        return origins, axes, tool
+
+    return frames
+
+
+def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
+                       payload: tuple[float, Sequence[float]] | None = None) -> NonGeometric:
+    """The non-geometric terms ``terms`` of ``robot``.
+
+    Parameters
+    ----------
+    robot : Robot
+        The nominal robot (masses, gravity, gear ratios).
+    terms : sequence of str
+        Subset of :data:`NONGEOMETRIC`.
+    frames : callable
+        ``frames(q)`` -> joint origins (N, n, 3), joint axes (N, n, 3) and tool frames
+        (N, 4, 4) of the nominal chain in the robot's world frame (for the gravity-shaped basis
+        and the payload).
+    payload : (float, sequence of float), optional
+        Payload mass (kg) and centre of mass in the tool frame (m): its holding torque is added
+        to the gravity model's.
+
+    Raises
+    ------
+    ValueError
+        An unknown term, a negative payload mass.
+    """
+    terms = tuple(dict.fromkeys(terms))
+    unknown = [t for t in terms if t not in NONGEOMETRIC]
+    if unknown:
+        raise ValueError(f"unknown non-geometric term {unknown[0]!r}; choose from {', '.join(NONGEOMETRIC)}")
+    subs = robot.defaults()
+    n = robot.dof
+    gear = np.full(n, np.nan)
+    for j, joint in enumerate(robot.joints):
+        g = float(joint.drive.gear_ratio.xreplace(subs))
+        if g != 1.0:
+            gear[j] = g
+    names, units, joints, kinds = [], [], [], []
+    torque = None
+    source = ""
+    if "compliance" in terms:
+        gravity = np.array(robot.gravity.xreplace(subs), dtype=float).ravel()
+        masses = [float(link.mass.xreplace(subs)) for link in robot.links]
+        load = None
+        if payload is not None:
+            mass, com = float(payload[0]), np.asarray(payload[1], dtype=float).reshape(3)
+            if not mass >= 0:
+                raise ValueError(f"payload mass must be >= 0 kg, got {mass}")
+            load = (mass, com)
+        types = [j.type for j in robot.joints]
+        if any(m > 0 for m in masses):
+            from robodyn.numeric.model import compile_model
+
+            model = compile_model(robot)
+            extra = _point_mass_torque(frames, types, gravity, [], load) if load else None
+
+            def torque(q: np.ndarray, model=model, extra=extra) -> np.ndarray:
+                tau = np.asarray(model.gravity(q), dtype=float).reshape(len(q), -1)
+                return tau + extra(q) if extra is not None else tau
+
+            source = "gravity model" + (" + payload" if load else "")
+        else:
+            torque = _point_mass_torque(frames, types, gravity, [(k, 1.0) for k in range(1, n + 1)], load)
+            source = "gravity-shaped basis"
+        for j, joint in enumerate(robot.joints):
+            names.append(f"{joint.name}.compliance")
+            units.append("rad/(N m)" if joint.type == "revolute" else "m/N")
+            joints.append(j)
+            kinds.append("compliance")
+    if "harmonics" in terms:
+        for j, joint in enumerate(robot.joints):
+            if joint.type != "revolute":
+                continue
+            pairs = [("ratio", "ratio"), ("cos", "cos1"), ("sin", "sin1")]
+            if np.isfinite(gear[j]):
+                pairs += [("motor_cos", "motor_cos1"), ("motor_sin", "motor_sin1")]
+            for kind, suffix in pairs:
+                names.append(f"{joint.name}.{suffix}")
+                units.append("1" if kind == "ratio" else "rad")
+                joints.append(j)
+                kinds.append(kind)
+    return NonGeometric(terms, tuple(names), tuple(units), tuple(joints), tuple(kinds), gear, torque,
+                        source)
