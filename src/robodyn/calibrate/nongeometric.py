@@ -46,8 +46,8 @@ class NonGeometric:
     terms : tuple of str
         Subset of :data:`NONGEOMETRIC`.
     names : tuple of str, length M
-        Parameter names: ``"q2.compliance"``, ``"q1.ratio"``, ``"q1.cos1"``, ``"q1.sin1"``, ``"q1.motor_cos1"``,
-        ``"q1.motor_sin1"``.
+        Parameter names: ``"q2.compliance"``, ``"q1.ratio"``, ``"q1.cos1"``, ``"q1.sin1"``,
+        ``"q1.motor_cos1"``, ``"q1.motor_sin1"``.
     units : tuple of str, length M
         ``"rad/(N m)"``, ``"m/N"``, ``"rad"`` or ``"1"`` (ratio error).
     joints : tuple of int, length M
