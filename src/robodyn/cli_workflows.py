@@ -155,38 +155,60 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
-    from robodyn.calibrate.io import read_calibration_csv, write_calibration
-    from robodyn.calibrate.pipeline import validate
+    import json
+
+    from robodyn.calibrate.io import read_calibration_csv, read_joint_map, write_calibration
+    from robodyn.calibrate.pipeline import LENGTH_UNITS, convert_units, validate
     from robodyn.report.calibration_report import calibration_html
 
     robot = rd.load(args.robot, tool=args.tool)
     stem = check_stem(args.stem) if args.stem is not None else f"{robot.name}_calibrated"
-    data = read_calibration_csv(args.data, robot)
+    jmap = read_joint_map(args.joint_map, robot) if args.joint_map else None
+    data = read_calibration_csv(args.data, robot, targets=args.targets, joint_map=jmap)
+    units = {"length_unit": args.length_unit, "angle_unit": args.angle_unit}
+
+    def si(d):  # q and points of a data set in rad and m
+        q, pts, _, _ = convert_units(robot, d.q, d.points, 1.0, 1.0, **units)
+        return q, pts
+
     circle = None
     if args.circle:
         if len(args.circle) != robot.dof:
             raise ValueError(f"--circle: give one file per joint in chain order ({robot.dof} for "
                              f"{robot.name}), got {len(args.circle)}")
-        circle = []
-        for path in args.circle:
-            d = read_calibration_csv(path, robot)
-            circle.append((d.q, d.points))
-    sigma = data.sigma if data.sigma is not None else args.sigma * 1e-3
+        circle = [si(read_calibration_csv(path, robot, joint_map=jmap)) for path in args.circle]
+    # sigma in the data's length unit (the option is in mm)
+    sigma = data.sigma if data.sigma is not None else args.sigma * 1e-3 / LENGTH_UNITS[args.length_unit]
     with progress(f"calibrating {robot.name} from {len(data.q)} poses ({args.model} model)"):
         cal = rd.calibrate(robot, data.q, data.points, args.model, sigma=sigma, loss=args.loss,
                            initial="circle-point" if circle else "nominal", circle_data=circle,
-                           orientations=data.orientations)
+                           orientations=data.orientations, nongeometric=tuple(args.nongeometric or ()),
+                           **units)
     validation = None
     if args.validate:
-        held = read_calibration_csv(args.validate, robot)
-        stats = validate(cal, held.q, held.points)
-        validation = (Path(args.validate).name, held.points - cal.predict(held.q))
+        from robodyn.calibrate.result import ErrorStats
+        from robodyn.calibrate.simulate_study import robot_positions
+
+        held_q, held_pts = si(read_calibration_csv(args.validate, robot, targets=args.targets,
+                                                   joint_map=jmap))
+        stats = validate(cal, held_q, held_pts)
+        first = held_pts if held_pts.ndim == 2 else held_pts[:, 0]
+        # before: the nominal kinematics placed in the instrument frame, first target
+        stats_before = ErrorStats.from_residuals(first - robot_positions(cal.before_robot, held_q))
+        validation = (Path(args.validate).name, (held_pts - cal.predict(held_q)).reshape(-1, 3))
     paths = write_calibration(cal, args.output, stem=stem)
+    if validation is not None:
+        report = json.loads(paths["json"].read_text(encoding="utf-8"))
+        report["validation"] = {"file": str(args.validate), "before_m": stats_before.__dict__,
+                                "before_targets": "first", "after_m": stats.__dict__}
+        paths["json"].write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
     paths["html"] = calibration_html(cal, output_path(args.output, stem, "_report.html"),
                                      source=str(args.data), validation=validation)
     print(cal.summary())
     if validation is not None:
-        print(f"\nheld-out ({args.validate}): {stats.text()}")
+        print(f"\nheld-out ({args.validate}) before: {stats_before.text()}"
+              + (" (first target)" if cal.targets_axis else ""))
+        print(f"held-out ({args.validate}) after:  {stats.text()}")
     print()
     for kind, path in paths.items():
         if path is not None:
@@ -330,6 +352,18 @@ def _calibrate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: st
                    help="circle-point data, one file per joint in chain order (only that joint "
                         "moves): start from Stone's circle-point estimate instead of the nominal")
     p.add_argument("--validate", metavar="FILE.csv", help="held-out poses to report errors on")
+    p.add_argument("--length-unit", choices=("m", "mm"), default="m",
+                   help="unit of x, y, z (and a sigma column) in the CSV files (default: %(default)s)")
+    p.add_argument("--angle-unit", choices=("rad", "deg"), default="rad",
+                   help="unit of the revolute joints' columns (default: %(default)s)")
+    p.add_argument("--joint-map", metavar="FILE.yaml",
+                   help="controller columns to model joints: per joint {column, sign, offset, "
+                        "coupling: {other column: factor}} (docs/calibration.md)")
+    p.add_argument("--targets", type=int, metavar="K",
+                   help="targets per pose (x, y, z, x2, y2, z2, ...); checked against the columns")
+    p.add_argument("--nongeometric", action="append", choices=("compliance", "harmonics"),
+                   help="add joint compliance (gravity model) and/or transmission errors (ratio, "
+                        "first harmonics); repeat for both")
     p.add_argument("--stem", help="file name stem (default: ROBOT_calibrated)")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
     p.set_defaults(func=_cmd_calibrate)

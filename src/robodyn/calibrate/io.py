@@ -7,7 +7,19 @@ comments. Columns (any order, extra columns ignored):
   for prismatic joints);
 * ``x``, ``y``, ``z``: the measured target position in the instrument frame, m;
 * optional ``qw``, ``qx``, ``qy``, ``qz``: the measured target orientation as a unit quaternion;
-* optional ``sigma``: the standard uncertainty of that pose's coordinates, m.
+* optional ``sigma``: the standard uncertainty of that pose's coordinates, m;
+* ``x2``, ``y2``, ``z2`` ... ``xK``, ``yK``, ``zK``: further targets (reflectors) measured at the
+  same pose (then the points are (N, K, 3)).
+
+Lengths and angles may be in other units (``mm``, ``deg``): :func:`robodyn.calibrate.calibrate`
+converts them (``length_unit``, ``angle_unit``; CLI ``--length-unit``, ``--angle-unit``).
+
+Joint mapping (controller joints to model joints), a mapping or a YAML file::
+
+    q3: {column: J3, sign: -1, offset: 0.0, coupling: {J2: 1.0}}   # q3 = -J3 + 0 + 1.0 J2
+
+Each model joint named in the spec is ``sign * column + offset + sum(factor * other column)``
+(offset in the file's angle unit); joints not named are read from their own column.
 
 Every error names the file, and the row (1-based line number in the file) and column where it
 is.
@@ -30,8 +42,8 @@ from robodyn.output_names import output_path
 from robodyn.robot.errors import DataFileError
 from robodyn.robot.model import Robot
 
-__all__ = ["MAX_ABS_VALUE", "CalibrationData", "read_calibration_csv", "read_table",
-           "write_calibration"]
+__all__ = ["MAX_ABS_VALUE", "CalibrationData", "JointMap", "read_calibration_csv", "read_joint_map",
+           "read_table", "write_calibration"]
 
 #: Largest magnitude of a measured value (m, rad, or a quaternion component) in a calibration or
 #: ISO 9283 file: 1000 km; beyond it squares overflow and nothing physical is measured.
@@ -177,13 +189,126 @@ def _quaternion_matrix(w, x, y, z) -> np.ndarray:
     ], 1)
 
 
-def read_calibration_csv(path: str | Path, robot: Robot) -> CalibrationData:
-    """Read measured poses for ``robot`` from a calibration CSV (module docstring)."""
+@dataclass(frozen=True)
+class JointMap:
+    """Controller columns to model joints: ``q_j = sign * column + offset + sum(factor * other)``.
+
+    Attributes
+    ----------
+    entries : dict of str to (str, float, float, dict of str to float)
+        Model joint -> (column, sign, offset, coupling).
+    source : str
+        The spec's file name (or ``"<mapping>"``) for error messages.
+    """
+
+    entries: dict
+    source: str = "<mapping>"
+
+
+def read_joint_map(spec, robot: Robot) -> JointMap:
+    """Validate a joint-mapping spec (a mapping, or a YAML file path) against ``robot``.
+
+    Raises
+    ------
+    DataFileError
+        A joint the robot does not have, an unknown key, a sign other than +-1, a non-numeric
+        offset or coupling factor (the message names the spec and the joint).
+    """
+    source = "<mapping>"
+    if isinstance(spec, (str, Path)):
+        import yaml
+
+        source = str(spec)
+        try:
+            spec = yaml.safe_load(Path(spec).read_text(encoding="utf-8"))
+        except (OSError, yaml.YAMLError) as exc:
+            raise DataFileError(f"{source}: cannot read the joint mapping: {exc}") from None
+    if not isinstance(spec, dict):
+        raise DataFileError(f"{source}: a joint mapping is a mapping of model joint -> "
+                            "{column, sign, offset, coupling}")
+    entries = {}
+    for joint, item in spec.items():
+        if joint not in robot.joint_names:
+            raise DataFileError(f"{source}: joint mapping names joint {joint!r}, which {robot.name} "
+                                f"does not have (its joints: {', '.join(robot.joint_names)})")
+        item = {"column": item} if isinstance(item, str) else item
+        if not isinstance(item, dict):
+            raise DataFileError(f"{source}: joint {joint!r}: expected a column name or a mapping")
+        unknown = set(item) - {"column", "sign", "offset", "coupling"}
+        if unknown:
+            raise DataFileError(f"{source}: joint {joint!r}: unknown key(s) {', '.join(sorted(unknown))} "
+                                "(allowed: column, sign, offset, coupling)")
+        column = str(item.get("column", joint))
+        sign, offset = item.get("sign", 1), item.get("offset", 0.0)
+        coupling = item.get("coupling", {}) or {}
+        if sign not in (1, -1):
+            raise DataFileError(f"{source}: joint {joint!r}, field 'sign': {sign!r} is not 1 or -1")
+        numbers = [("offset", offset)] + [(f"coupling.{k}", v) for k, v in dict(coupling).items()]
+        for field_name, v in numbers:
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise DataFileError(f"{source}: joint {joint!r}, field {field_name!r}: {v!r} is not a "
+                                    "finite number")
+        entries[joint] = (column, float(sign), float(offset), {str(k): float(v) for k, v in coupling.items()})
+    return JointMap(entries, source)
+
+
+def _target_count(path: Path) -> int:
+    """Number of targets in a calibration CSV's header (``x, y, z``, ``x2, y2, z2`` ...)."""
+    records = _records(path)
+    header = {h.strip() for h in records[0][1]} if records else set()
+    k = 1
+    while {f"x{k + 1}", f"y{k + 1}", f"z{k + 1}"} & header:
+        k += 1
+    return k
+
+
+def read_calibration_csv(path: str | Path, robot: Robot, *, targets: int | None = None,
+                         joint_map: JointMap | None = None) -> CalibrationData:
+    """Read measured poses for ``robot`` from a calibration CSV (module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+    robot : Robot
+    targets : int, optional
+        Expected number of targets per pose (checked against the columns); default: as found.
+    joint_map : JointMap, optional
+        Controller columns to model joints (:func:`read_joint_map`).
+
+    Raises
+    ------
+    DataFileError
+        Besides the table errors: a target count that differs from the data's columns, a
+        mapping column the file does not have.
+    """
     joints = list(robot.joint_names)
-    table, lines = _read_table(path, joints + ["x", "y", "z"],
+    found = _target_count(Path(path)) if Path(path).exists() else 1
+    if targets is not None and targets != found:
+        raise DataFileError(f"{path}: {targets} target(s) per pose were declared but the columns hold "
+                            f"{found} (x, y, z" + "".join(f", x{k}, y{k}, z{k}" for k in range(2, found + 1))
+                            + ")")
+    xyz = [f"{a}{k if k > 1 else ''}" for k in range(1, found + 1) for a in "xyz"]
+    mapping = joint_map.entries if joint_map is not None else {}
+    columns = []
+    for j in joints:
+        column, _, _, coupling = mapping.get(j, (j, 1.0, 0.0, {}))
+        columns += [column, *coupling]
+    columns = list(dict.fromkeys(columns))
+    table, lines = _read_table(path, columns + xyz,
                                ["qw", "qx", "qy", "qz", "sigma"], (), MAX_ABS_VALUE)
-    q = np.column_stack([table[j] for j in joints])
-    points = np.column_stack([table[c] for c in ("x", "y", "z")])
+    cols = []
+    for j in joints:
+        column, sign, offset, coupling = mapping.get(j, (j, 1.0, 0.0, {}))
+        # q_j = sign * column + offset + sum(factor * other column)
+        v = sign * np.array(table[column]) + offset
+        for other, factor in coupling.items():
+            v = v + factor * np.array(table[other])
+        cols.append(v)
+    q = np.column_stack(cols)
+    points = np.stack([np.column_stack([table[f"{a}{k if k > 1 else ''}"] for a in "xyz"])
+                       for k in range(1, found + 1)], axis=1)
+    if found == 1:
+        points = points[:, 0]
     orientations = None
     quat = [c for c in ("qw", "qx", "qy", "qz") if c in table]
     if quat and len(quat) != 4:
@@ -238,8 +363,21 @@ def _report_data(cal: Calibration) -> dict:
             for u in cal.unidentifiable
         ],
         "observability": cal.observability.as_dict(),
+        "targets_m": cal.target_offsets().tolist(),
+        "nongeometric": cal.nongeometric,
         "residuals_m": np.asarray(cal.residuals).tolist(),
     }
+
+
+def terms_data(cal: Calibration) -> dict:
+    """What the geometric description cannot hold: every target's offset and the non-geometric terms.
+
+    Targets are positions in the calibrated robot's last link frame (the first is the robot's
+    tool); the terms are ``q_link = q + B(q) theta`` (:mod:`robodyn.calibrate.nongeometric`).
+    """
+    return {"robot": cal.robot.name, "model": cal.model.name,
+            "targets_in_last_frame_m": cal.target_offsets().tolist(),
+            "nongeometric": cal.nongeometric}
 
 
 def write_calibration(cal: Calibration, out_dir: str | Path, *,
@@ -248,6 +386,8 @@ def write_calibration(cal: Calibration, out_dir: str | Path, *,
 
     Files: ``<stem>.yaml`` (robodyn description, :func:`robodyn.robot.yaml_writer.dump_yaml`),
     ``<stem>.urdf`` (:func:`robodyn.export.urdf.to_urdf`, when that exporter is available),
+    ``<stem>_terms.yaml`` (every target's offset and the non-geometric terms, when there are
+    several targets or non-geometric terms: :func:`terms_data`),
     ``<stem>_report.txt`` (:meth:`Calibration.summary`), ``<stem>_report.json`` (the same as
     data, with the residuals) and ``<stem>_residuals.csv``.
 
@@ -269,7 +409,8 @@ def write_calibration(cal: Calibration, out_dir: str | Path, *,
     stem = stem if stem is not None else cal.robot.name
     # every name is checked before anything is written: all files inside out_dir, or none
     names = {kind: output_path(out, stem, suffix)
-             for kind, suffix in (("yaml", ".yaml"), ("urdf", ".urdf"), ("report", "_report.txt"),
+             for kind, suffix in (("yaml", ".yaml"), ("terms", "_terms.yaml"), ("urdf", ".urdf"),
+                                  ("report", "_report.txt"),
                                   ("json", "_report.json"), ("residuals", "_residuals.csv"))}
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -278,6 +419,13 @@ def write_calibration(cal: Calibration, out_dir: str | Path, *,
     paths: dict[str, Path | None] = {}
     paths["yaml"] = names["yaml"]
     paths["yaml"].write_text(dump_yaml(cal.robot), encoding="utf-8")
+    paths["terms"] = None
+    if cal.model.targets > 1 or cal.model.nongeometric is not None:
+        import yaml
+
+        # the description's schema has no place for them: a companion file next to it
+        paths["terms"] = names["terms"]
+        paths["terms"].write_text(yaml.safe_dump(terms_data(cal), sort_keys=False), encoding="utf-8")
     try:
         from robodyn.export.urdf import to_urdf
     except ImportError:
@@ -301,8 +449,10 @@ def write_calibration(cal: Calibration, out_dir: str | Path, *,
     paths["residuals"] = names["residuals"]
     with paths["residuals"].open("w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
-        w.writerow(["pose", "dx", "dy", "dz", "distance"])
-        for k, r in enumerate(np.asarray(cal.residuals)):
-            w.writerow([k, repr(float(r[0])), repr(float(r[1])), repr(float(r[2])),
-                        repr(float(np.linalg.norm(r)))])
+        w.writerow(["pose", "target", "dx", "dy", "dz", "distance"])
+        res = np.asarray(cal.residuals).reshape(cal.pose_count, -1, 3)
+        for k, per_pose in enumerate(res):
+            for t, r in enumerate(per_pose, start=1):
+                w.writerow([k, t, repr(float(r[0])), repr(float(r[1])), repr(float(r[2])),
+                            repr(float(np.linalg.norm(r)))])
     return paths

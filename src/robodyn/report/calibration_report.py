@@ -32,8 +32,9 @@ def calibration_figure(cal: Calibration, path: Path, validation: np.ndarray | No
     """
     from matplotlib.figure import Figure
 
-    before = np.linalg.norm(cal.before_residuals, axis=1) * 1e3
-    after = np.linalg.norm(cal.residuals, axis=1) * 1e3
+    res = cal.residuals.reshape(-1, 3)  # (N, 3), or (N K, 3) for several targets per pose
+    before = np.linalg.norm(cal.before_residuals.reshape(-1, 3), axis=1) * 1e3
+    after = np.linalg.norm(res, axis=1) * 1e3
     fig = Figure(figsize=(10.0, 3.6), layout="constrained")
     ax0, ax1 = fig.subplots(1, 2)
     bins = np.linspace(0, max(before.max(), after.max()) * 1.02 + 1e-12, 40)
@@ -46,9 +47,9 @@ def calibration_figure(cal: Calibration, path: Path, validation: np.ndarray | No
     ax0.set_ylabel("poses")
     ax0.legend()
     ax0.set_title(f"{cal.model.name} model, {cal.pose_count} poses")
-    k = np.arange(len(cal.residuals))
+    k = np.arange(len(res))
     for j, lab in enumerate("xyz"):
-        ax1.plot(k, cal.residuals[:, j] * 1e3, ".", ms=3, label=f"d{lab}")
+        ax1.plot(k, res[:, j] * 1e3, ".", ms=3, label=f"d{lab}")
     ax1.axhspan(-2 * cal.sigma * 1e3, 2 * cal.sigma * 1e3, color="0.85", zorder=0,
                 label="±2σ measurement")
     ax1.set_xlabel("pose")

@@ -1,0 +1,95 @@
+"""``robodyn calibrate`` options against hand-converted equivalents: units, joint mapping, targets."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from robodyn.calibrate.io import read_calibration_csv, read_joint_map
+from robodyn.calibrate.simulate_study import perturbed_robot
+from robodyn.cli import main
+from robodyn.robot.errors import DataFileError
+from tests.calibrate.helpers import TRACKER, poses, robot
+from tests.calibrate.test_nongeometric import TARGETS, measured
+
+
+def _write(path, header, rows):
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        for r in rows:
+            w.writerow([repr(float(v)) for v in r])
+
+
+@pytest.fixture(scope="module")
+def data(tmp_path_factory):
+    r = robot("puma560")
+    true = perturbed_robot(r, 7, base=TRACKER, target=(0.0, 0.0, 0.0))
+    rng = np.random.default_rng(2)
+    q, q_test = poses("puma560", 60, 41), poses("puma560", 30, 42)
+    y = measured(true, q, TARGETS[:2]) + rng.normal(0, 5e-5, (60, 2, 3))
+    y_test = measured(true, q_test, TARGETS[:2]) + rng.normal(0, 5e-5, (30, 2, 3))
+    d = tmp_path_factory.mktemp("cal")
+    xyz = ["x", "y", "z", "x2", "y2", "z2"]
+    _write(d / "si.csv", [*r.joint_names, *xyz], np.hstack((q, y.reshape(60, 6))))
+    _write(d / "si_test.csv", [*r.joint_names, *xyz], np.hstack((q_test, y_test.reshape(30, 6))))
+    # controller file: degrees, millimetres, J3 measured against J2 with a flipped sign and an offset
+    def controller(qq, yy):
+        c = np.degrees(qq).copy()
+        c[:, 2] = -(np.degrees(qq[:, 2]) - 10.0 - c[:, 1])  # q3 = -J3 + 10 + J2
+        return np.hstack((c, yy.reshape(len(qq), 6) * 1e3))
+    header = ["J1", "J2", "J3", "J4", "J5", "J6", *xyz]
+    _write(d / "ctl.csv", header, controller(q, y))
+    _write(d / "ctl_test.csv", header, controller(q_test, y_test))
+    (d / "map.yaml").write_text(
+        "q1: J1\nq2: J2\nq3: {column: J3, sign: -1, offset: 10.0, coupling: {J2: 1.0}}\n"
+        "q4: J4\nq5: J5\nq6: J6\n")
+    return d
+
+
+def test_units_mapping_and_targets_match_the_hand_converted_run(data, tmp_path, capsys):
+    a, b = tmp_path / "si", tmp_path / "ctl"
+    assert main(["calibrate", "puma560", "--data", str(data / "si.csv"), "--validate",
+                 str(data / "si_test.csv"), "-o", str(a)]) == 0
+    assert main(["calibrate", "puma560", "--data", str(data / "ctl.csv"), "--validate",
+                 str(data / "ctl_test.csv"), "--length-unit", "mm", "--angle-unit", "deg",
+                 "--joint-map", str(data / "map.yaml"), "--targets", "2", "-o", str(b)]) == 0
+    out = capsys.readouterr().out
+    assert "held-out" in out and "before" in out
+    ja = json.loads((a / "puma560_calibrated_report.json").read_text())
+    jb = json.loads((b / "puma560_calibrated_report.json").read_text())
+    pa = {p["name"]: p["value"] for p in ja["parameters"]}
+    pb = {p["name"]: p["value"] for p in jb["parameters"]}
+    assert pa.keys() == pb.keys()
+    for k in pa:
+        assert pb[k] == pytest.approx(pa[k], abs=1e-9), k
+    for key in ("before_m", "after_m"):
+        assert jb["validation"][key]["rms"] == pytest.approx(ja["validation"][key]["rms"], abs=1e-9)
+    assert ja["validation"]["after_m"]["rms"] < ja["validation"]["before_m"]["rms"]
+    assert (b / "puma560_calibrated_terms.yaml").exists()
+
+
+def test_nongeometric_option_writes_the_terms(data, tmp_path):
+    assert main(["calibrate", "puma560", "--data", str(data / "si.csv"), "--model", "hayati",
+                 "--nongeometric", "compliance", "-o", str(tmp_path)]) == 0
+    j = json.loads((tmp_path / "puma560_calibrated_report.json").read_text())
+    assert j["nongeometric"]["torque_source"] == "gravity model"
+    assert "q2.compliance" in (tmp_path / "puma560_calibrated_terms.yaml").read_text()
+
+
+def test_bad_mapping_and_target_count(data, tmp_path, capsys):
+    r = robot("puma560")
+    with pytest.raises(DataFileError, match="names joint 'q9', which puma560 does not have"):
+        read_joint_map({"q9": "J9"}, r)
+    with pytest.raises(DataFileError, match="field 'sign'"):
+        read_joint_map({"q3": {"column": "J3", "sign": 2}}, r)
+    with pytest.raises(DataFileError,
+                       match=r"si.csv: 3 target\(s\) per pose were declared but the columns hold 2"):
+        read_calibration_csv(data / "si.csv", r, targets=3)
+    code = main(["calibrate", "puma560", "--data", str(data / "ctl.csv"), "--angle-unit", "deg",
+                 "--joint-map", str(data / "map.yaml"), "-o", str(tmp_path)])
+    assert code == 2
+    assert "look like millimetres" in capsys.readouterr().err
