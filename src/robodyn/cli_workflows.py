@@ -206,9 +206,9 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
                                      source=str(args.data), validation=validation)
     print(cal.summary())
     if validation is not None:
-        print(f"\nheld-out ({args.validate}) before: {stats_before.text()}"
+        print(f"\nheld-out ({args.validate}), after calibration: {stats.text()}")
+        print(f"held-out ({args.validate}), before (nominal, placed): {stats_before.text()}"
               + (" (first target)" if cal.targets_axis else ""))
-        print(f"held-out ({args.validate}) after:  {stats.text()}")
     print()
     for kind, path in paths.items():
         if path is not None:
