@@ -10,6 +10,11 @@ by a tracker with 0.05 mm noise (target: a whole calibration under 2 s):
      Jacobian and with a 2-point finite-difference Jacobian; the ratios and the agreement of
      the solutions.
 
+  3. 1000 poses x 3 targets with joint compliance and transmission errors in the truth:
+     S-model + compliance + harmonics end to end (target: under 3 s), its least-squares step
+     with the analytic and with a 2-point finite-difference Jacobian, and the CLI's total wall
+     time (``robodyn calibrate`` in a fresh process) against the solve time.
+
 Run: ``.venv/bin/python benchmarks/bench_calibration.py [--repeat N]``.
 """
 
@@ -80,6 +85,58 @@ def main() -> None:
     print(f"  ratio finite-difference / analytic (same solver): {t_fd / t_an:.1f}x")
     print(f"  ratio finite-difference LM / whole rd calibrate:  {t_fd / t_cal:.2f}x")
     print(f"  largest parameter difference between the two solutions: {diff:.2e}")
+    combined(robot, true, args.repeat)
+
+
+def combined(robot, true, repeat: int) -> None:
+    """Section 3: 1000 poses x 3 targets, S-model + compliance + harmonics."""
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    from robodyn.calibrate.io import write_calibration_csv  # noqa: F401 (format reference)
+    from robodyn.calibrate.simulate_study import robot_frames
+
+    n, targets = 1000, np.array([[0.031, -0.018, 0.076], [-0.045, 0.052, 0.060], [0.06, 0.04, 0.03]])
+    rng = np.random.default_rng(3)
+    q = random_configurations(robot, n, rng)
+    g = rd.compile_model(robot).gravity(q)
+    q_link = q - 4e-6 * g + 1e-4 * np.cos(q) - 5e-5 * np.sin(q)  # compliance and a harmonic
+    frames = robot_frames(true, q_link)
+    y = np.einsum("nij,kj->nki", frames[:, :3, :3], targets) + frames[:, None, :3, 3]
+    y = y + rng.normal(0, SIGMA, y.shape)
+    terms = ("compliance", "harmonics")
+    print(f"\n{n} poses x {len(targets)} targets, S-model + compliance + harmonics:")
+    run = lambda: calibrate(robot, q, y, "s-model", sigma=SIGMA, nongeometric=terms)  # noqa: E731
+    run()
+    t_cal, cal = best_of(run, repeat)
+    print(f"  rd.calibrate end to end: {t_cal:.3f} s ({len(cal.parameters)} parameters, {cal.nfev} "
+          f"evaluations, after RMS {cal.after.rms * 1e3:.4f} mm){'  ** over 3 s' if t_cal > 3 else ''}")
+    em = cal.model
+    free = [em.index(k) for k in cal.parameter_names]
+    pts, sig = y.reshape(-1, 3), SIGMA
+    times = {}
+    for jac in ("analytic", "2-point"):
+        times[jac] = best_of(lambda j=jac: fit(em, em.initial, free, q, pts, sigma=sig, jacobian=j),
+                             max(1, repeat // 2))[0]
+        print(f"  least-squares step, {jac:>8} Jacobian: {times[jac]:.3f} s")
+    print(f"  ratio finite-difference / analytic: {times['2-point'] / times['analytic']:.1f}x")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "poses.csv"
+        cols = [*robot.joint_names] + [f"{a}{k if k > 1 else ''}" for k in (1, 2, 3) for a in "xyz"]
+        np.savetxt(path, np.hstack((q, y.reshape(n, -1))), delimiter=",", header=",".join(cols),
+                   comments="")
+        cmd = [sys.executable, "-m", "robodyn.cli", "calibrate", "puma560", "--data", str(path),
+               "--nongeometric", "compliance", "--nongeometric", "harmonics", "-o", str(Path(tmp) / "o")]
+        start = time.perf_counter()
+        subprocess.run(cmd, check=True, capture_output=True)
+        t_cli = time.perf_counter() - start
+        start = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "robodyn.cli", "--help"], check=True, capture_output=True)
+        t_help = time.perf_counter() - start
+    print(f"  CLI total wall time {t_cli:.2f} s = {t_cli / t_cal:.2f}x the solve; "
+          f"'robodyn --help' (start-up alone) {t_help:.2f} s")
 
 
 if __name__ == "__main__":
