@@ -1,24 +1,36 @@
-"""C99: reentrant kernels (no globals, no allocation), batched loops and in-C integrators.
+"""C99: reentrant kernels (no globals, no allocation), batched, vectorised and threaded loops.
 
 For each kernel ``k`` the source defines::
 
     void PREFIXk(const double *in1, ..., double *out);                    one state
-    void PREFIXk_batch(long count, const double *in1, ..., double *out);  count states, looped in C
+    void PREFIXk_batch(long count, const double *in1, ..., double *out);  count states
+    void PREFIXk_batch_threads(long count, int threads, ...);             the same on threads
 
-plus :func:`simulation_source`'s ``PREFIXsimulate``: a whole trajectory (RK4 or semi-implicit
-Euler) with a sampled (zero-order-hold) state-feedback controller, in one call.
+plus :func:`simulation_source`'s ``PREFIXsimulate`` (a whole trajectory, RK4 or semi-implicit
+Euler, under a sampled state-feedback law, in one call) and ``PREFIXsimulate_ensemble`` (many
+trajectories at once, a block of them per vector loop).
 
-Sines and cosines of the joint angles dominate the cost of a small robot's kernels (the PUMA's
-inverse dynamics is about 450 multiplications and additions against ten libm calls), and
-Coulomb friction's ``qd > 0`` switches cost a mispredicted branch at every sign change. A kernel
-with either is therefore printed as a ``static`` core that reads them from arrays, and its batch
-function walks the states in blocks of :data:`BLOCK`: it gathers the block's angles and
-switches, evaluates all the sines and cosines in one loop of branch-free polynomial code that
-the compiler vectorises (``PREFIXsincos_block``: Cody-Waite reduction by pi/2 in three parts and
-fdlibm's minimax kernels, within 2 ulp of libm; beyond 1e5 rad, infinities and NaN go to libm),
-then runs the core for each state. The one-state function is the batch of one, so a state gives
-the same bits alone or in a batch. All of it is plain C99 with ordinary IEEE arithmetic: no
-pragmas, no intrinsics, no special flags (vectorisation needs only -O3 and a SIMD target).
+Every kernel is evaluated a block of :data:`BLOCK` states at a time. The states of a block are
+transposed into structure-of-arrays buffers (entry i of state k at ``[BLOCK * i + k]``), then
+``PREFIXk_block`` runs the whole straight-line body in one loop over the block's states: loads
+and stores are consecutive across states, the body has no calls (the sines and cosines were
+evaluated before, see below; sqrt and division are vector instructions) and no branches (the
+conditionals are selects), so the compiler vectorises the body itself, 4 or 8 states per
+instruction. The outputs are transposed back.
+
+The sines and cosines of the joint angles come from ``PREFIXsincos_block``: one branch-free loop
+of polynomial code per angle (Cody-Waite reduction by pi/2 in three parts and fdlibm's minimax
+kernels, within 2 ulp of libm; beyond 1e5 rad, infinities and NaN go to libm). Coulomb
+friction's ``qd > 0`` switches are computed while the block is transposed, as selects rather than
+mispredicted branches.
+
+The one-state function is the range of one state through the same code (the loop's scalar
+remainder runs the same operations as its vector lanes, IEEE arithmetic, the same contractions),
+so a state gives the same bits alone, in a batch, at any position of a block and on any number
+of threads; the tests check it bit for bit. Threads (OpenMP, when compiled with ``-fopenmp``)
+take whole blocks. All of it is plain C99 with ordinary IEEE arithmetic: no intrinsics, no
+special flags (vectorisation needs only -O3 and a SIMD target); the one pragma is OpenMP's,
+inside ``#ifdef _OPENMP``.
 """
 
 from __future__ import annotations
@@ -100,10 +112,13 @@ class CPrinter(Printer):
     def expr(self, e: sp.Expr) -> str:
         return self._printer.doprint(e)
 
-    def signature(self, kernel: Kernel, batch: bool = False) -> str:
+    def signature(self, kernel: Kernel, batch: bool = False, threads: bool = False) -> str:
         """The C prototype (without the trailing semicolon)."""
         args = [f"const double *restrict {a.name}" for a in kernel.inputs]
         args += [f"double *restrict {a.name}" for a in kernel.outputs]
+        if batch and threads:
+            return (f"void {self.prefix}{kernel.name}_batch_threads(long count, int threads, "
+                    f"{', '.join(args)})")
         if batch:
             return f"void {self.prefix}{kernel.name}_batch(long count, {', '.join(args)})"
         return f"void {self.prefix}{kernel.name}({', '.join(args)})"
@@ -126,10 +141,13 @@ class CPrinter(Printer):
         return f"{arg.name}[{flat}] = {self.expr(e)};"
 
     def kernel_source(self, kernel: Kernel) -> str:
-        """One-state and batch functions of ``kernel`` (through a static core, see the module)."""
+        """Block core, range loop, batch, threaded batch and one-state functions of ``kernel``.
+
+        The core (``PREFIXk_block``) evaluates the kernel body for ``m_ <= BLOCK`` states held
+        structure-of-arrays (entry i of state k at ``[BLOCK * i + k]``) in one loop whose body
+        is straight-line code: the compiler vectorises it across the states.
+        """
         angles, steps = _angles(kernel), _steps(kernel)
-        if not (angles or steps):
-            return self.function(kernel) + "\n" + self.batch(kernel)
         sines = [sp.Symbol(f"sin_{a.name}_", real=True) for a, _, _ in angles]
         cosines = [sp.Symbol(f"cos_{a.name}_", real=True) for a, _, _ in angles]
         given: dict[sp.Expr, sp.Expr] = {}
@@ -147,71 +165,129 @@ class CPrinter(Printer):
         extra = [_arg("sin_", sines), _arg("cos_", cosines), _arg("step_", switches)]
         # only the arrays the core reads (unused parameters would trip -Wextra)
         inputs = tuple(a for a in (*kernel.inputs, *extra) if used.intersection(a.entries))
-        core = Kernel(f"{kernel.name}_core",
-                      f"{kernel.summary}; given {', '.join(a.name for a in extra if a in inputs)}",
-                      inputs, outputs, body)
-        inline = "" if len(kernel.body) <= INLINE_LIMIT else f"{self.prefix.upper()}NOINLINE "
-        core_text = self.function(core).replace(f"void {self.prefix}{core.name}(",
-                                                f"{inline}static void {self.prefix}{core.name}(", 1)
+        core = Kernel(f"{kernel.name}_block", kernel.summary, inputs, outputs, body)
         single = "\n".join([
             *self.open_function(kernel),
-            f"    {self.prefix}{kernel.name}_batch(1, {', '.join(_names(kernel))});",
+            f"    {self.prefix}{kernel.name}_range(0, 1, {', '.join(_names(kernel))});",
             "}",
         ]) + "\n"
-        return "\n".join([core_text, self.blocked_batch(kernel, core, angles, steps), single])
+        return "\n".join([self.block_function(core, len(kernel.body) > INLINE_LIMIT),
+                          self.blocked_batch(kernel, core, angles, steps),
+                          self.threaded_batch(kernel), single])
+
+    def block_function(self, core: Kernel, noinline: bool = False) -> str:
+        """``static void PREFIXk_block(int m_, ...)``: the body for m_ states, one vector loop.
+
+        Every array is structure-of-arrays with stride :data:`BLOCK` (entry i of state k at
+        ``[BLOCK * i + k]``): the loads and stores of one entry are consecutive across the
+        states, and the body has no calls but sqrt and no branches but selects.
+        """
+        inline = f"{self.prefix.upper()}NOINLINE " if noinline else ""
+        args = [f"const double *restrict {a.name}" for a in core.inputs]
+        args += [f"double *restrict {a.name}" for a in core.outputs]
+        used: set[sp.Basic] = set()
+        for _, e in core.body:
+            used |= e.free_symbols
+        for arg in core.outputs:
+            for e in arg.entries:
+                used |= sp.sympify(e).free_symbols
+        lines = [f"/* {core.summary}, for m_ <= {BLOCK} states stored structure-of-arrays. */",
+                 f"{inline}static void {self.prefix}{core.name}(int m_, {', '.join(args)}) {{",
+                 "    for (int k_ = 0; k_ < m_; ++k_) {"]
+        ind = "        "
+        for arg in core.inputs:
+            lines += [f"{ind}const double {sym.name} = {arg.name}[{BLOCK * k} + k_];"
+                      for k, sym in enumerate(arg.entries) if sym in used]
+        lines += [ind + self.assign(s, e) for s, e in core.body]
+        lines += [f"{ind}{arg.name}[{BLOCK * k} + k_] = {self.expr(sp.sympify(e))};"
+                  for arg in core.outputs for k, e in enumerate(arg.entries)]
+        return "\n".join([*lines, "    }", "}"]) + "\n"
 
     def blocked_batch(self, kernel: Kernel, core: Kernel, angles: list[tuple[sp.Symbol, str, int]],
                       steps: list[sp.Piecewise]) -> str:
-        """The batch function through the core: per block, gather angles and switches first.
+        """``PREFIXk_range`` (states [begin, end), a block at a time) and ``PREFIXk_batch``.
 
-        The gathering loop and the sine/cosine loop have no branches; the switches (Coulomb
-        friction's ``qd > 0``) are computed there too, where they become vector selects rather
-        than conditional jumps the processor would mispredict on every sign change.
+        Per block: the inputs are transposed into structure-of-arrays buffers and the switches
+        (Coulomb friction's ``qd > 0``) computed there, where they become vector selects rather
+        than conditional jumps the processor would mispredict on every sign change; then one
+        vector loop per angle gives the sines and cosines, the core runs, and the outputs are
+        transposed back.
         """
         na, ns = len(angles), len(steps)
         element = {}
         for arg in kernel.inputs:
             for k, sym in enumerate(arg.entries):
                 element[sym] = sp.Symbol(f"{arg.name}[{arg.size} * j_ + {k}]", real=True)
-        gather = [f"            angle_[{na} * k_ + {i}] = {name}[{_size(kernel, name)} * j_ + {idx}];"
-                  for i, (_, name, idx) in enumerate(angles)]
-        gather += [f"            step_[{ns} * k_ + {i}] = {self.expr(e.xreplace(element))};"
+        core_inputs = {a.name for a in core.inputs}
+        gathered = [a for a in kernel.inputs
+                    if a.name in core_inputs or any(name == a.name for _, name, _ in angles)]
+        gather = [f"            for (int i_ = 0; i_ < {a.size}; ++i_) {a.name}_b_[{BLOCK} * i_ + k_] = "
+                  f"{a.name}[{a.size} * j_ + i_];" for a in gathered]
+        gather += [f"            step_[{BLOCK * i} + k_] = {self.expr(e.xreplace(element))};"
                    for i, e in enumerate(steps)]
-        arrays = ([f"angle_[{na * BLOCK}]", f"sin_[{na * BLOCK}]", f"cos_[{na * BLOCK}]"] if na else [])
+        arrays = [f"{a.name}_b_[{a.size * BLOCK}]" for a in (*gathered, *kernel.outputs)]
+        arrays += [f"sin_[{na * BLOCK}]", f"cos_[{na * BLOCK}]"] if na else []
         arrays += [f"step_[{ns * BLOCK}]"] if ns else []
-        block = {"sin_": f"sin_ + {na} * k_", "cos_": f"cos_ + {na} * k_", "step_": f"step_ + {ns} * k_"}
-        args = [block.get(a.name, f"{a.name} + {a.size} * j_") for a in (*core.inputs, *core.outputs)]
-        trig = [f"        {self.prefix}sincos_block({na} * m_, angle_, sin_, cos_);"] if na else []
+        trig = [f"        {self.prefix}sincos_block(m_, {name}_b_ + {BLOCK * idx}, sin_ + {BLOCK * i}, "
+                f"cos_ + {BLOCK * i});" for i, (_, name, idx) in enumerate(angles)]
+        args = [a.name if a.name in ("sin_", "cos_", "step_") else f"{a.name}_b_"
+                for a in (*core.inputs, *core.outputs)]
+        scatter = [f"            for (int i_ = 0; i_ < {a.size}; ++i_) {a.name}[{a.size} * j_ + i_] = "
+                   f"{a.name}_b_[{BLOCK} * i_ + k_];" for a in kernel.outputs]
+        params = ", ".join(f"const double *restrict {a.name}" for a in kernel.inputs)
+        params += ", " + ", ".join(f"double *restrict {a.name}" for a in kernel.outputs)
         return "\n".join([
-            f"/* {kernel.name} for count states stored one after another, {BLOCK} at a time. */",
-            self.signature(kernel, batch=True) + " {",
+            f"/* {kernel.name} for the states begin <= j < end stored one after another, {BLOCK} at a "
+            "time. */",
+            f"static void {self.prefix}{kernel.name}_range(long begin, long end, {params}) {{",
             f"    double {', '.join(arrays)};",
-            f"    for (long k0_ = 0; k0_ < count; k0_ += {BLOCK}) {{",
-            f"        const int m_ = count - k0_ < {BLOCK} ? (int)(count - k0_) : {BLOCK};",
+            f"    for (long k0_ = begin; k0_ < end; k0_ += {BLOCK}) {{",
+            f"        const int m_ = end - k0_ < {BLOCK} ? (int)(end - k0_) : {BLOCK};",
+            "        /* transpose the block's inputs: x_b_[BLOCK i + k] = x[size (k0 + k) + i] */",
             "        for (int k_ = 0; k_ < m_; ++k_) {",
             "            const long j_ = k0_ + k_;",
             *gather,
             "        }",
             *trig,
+            f"        {self.prefix}{core.name}(m_, {', '.join(args)});",
             "        for (int k_ = 0; k_ < m_; ++k_) {",
             "            const long j_ = k0_ + k_;",
-            f"            {self.prefix}{kernel.name}_core({', '.join(args)});",
+            *scatter,
             "        }",
             "    }",
             "}",
-        ]) + "\n"
-
-    def batch(self, kernel: Kernel) -> str:
-        """The loop over ``count`` states, calling the one-state function."""
-        strides = [a.size for a in (*kernel.inputs, *kernel.outputs)]
-        names = [a.name for a in (*kernel.inputs, *kernel.outputs)]
-        call = ", ".join(f"{nm} + k * {st}" for nm, st in zip(names, strides, strict=True))
-        return "\n".join([
+            "",
             f"/* {kernel.name} for count states stored one after another. */",
             self.signature(kernel, batch=True) + " {",
-            "    for (long k = 0; k < count; ++k) {",
-            f"        {self.prefix}{kernel.name}({call});",
+            f"    {self.prefix}{kernel.name}_range(0, count, {', '.join(_names(kernel))});",
+            "}",
+        ]) + "\n"
+
+    def threaded_batch(self, kernel: Kernel) -> str:
+        """``PREFIXk_batch_threads``: the batch on ``threads`` OpenMP threads, block by block.
+
+        Each block of :data:`BLOCK` states is computed by the same code whichever thread takes
+        it, so the result bits do not depend on the thread count. Compiled without OpenMP it is
+        the plain batch.
+        """
+        names = ", ".join(_names(kernel))
+        rng = f"{self.prefix}{kernel.name}_range"
+        return "\n".join([
+            f"/* {kernel.name} for count states on `threads` threads (OpenMP; one without). */",
+            self.signature(kernel, batch=True, threads=True) + " {",
+            "#ifdef _OPENMP",
+            f"    if (threads > 1 && count > {BLOCK}) {{",
+            f"        const long blocks = (count + {BLOCK - 1}) / {BLOCK};",
+            "#pragma omp parallel for num_threads(threads) schedule(static)",
+            "        for (long b_ = 0; b_ < blocks; ++b_) {",
+            f"            const long end = {BLOCK} * b_ + {BLOCK} < count ? {BLOCK} * b_ + {BLOCK} : count;",
+            f"            {rng}({BLOCK} * b_, end, {names});",
+            "        }",
+            "        return;",
             "    }",
+            "#endif",
+            "    (void)threads;",
+            f"    {rng}(0, count, {names});",
             "}",
         ]) + "\n"
 
@@ -221,6 +297,7 @@ class CPrinter(Printer):
         for kernel in kset.kernels:
             lines.append(self.signature(kernel).replace("restrict ", "") + ";")
             lines.append(self.signature(kernel, batch=True).replace("restrict ", "") + ";")
+            lines.append(self.signature(kernel, batch=True, threads=True).replace("restrict ", "") + ";")
         if with_simulation and "state_derivative" in kset.names:
             lines.append(simulate_signature(self.prefix) + ";")
         return "\n".join(lines) + "\n"
@@ -230,7 +307,7 @@ class CPrinter(Printer):
         parts = [self.header(kset), "#include <math.h>\n"]
         if any(_angles(k) for k in kset.kernels):
             parts.append(sincos_source(self.prefix))
-        if any((_angles(k) or _steps(k)) and len(k.body) > INLINE_LIMIT for k in kset.kernels):
+        if any(len(k.body) > INLINE_LIMIT for k in kset.kernels):
             macro = f"{self.prefix.upper()}NOINLINE"
             parts.append(f"#if defined(__GNUC__)\n#define {macro} __attribute__((noinline))\n#else\n"
                          f"#define {macro}\n#endif\n")
@@ -282,10 +359,6 @@ def _arg(name: str, symbols: list[sp.Symbol]) -> Argument:
 
 def _names(kernel: Kernel) -> list[str]:
     return [a.name for a in (*kernel.inputs, *kernel.outputs)]
-
-
-def _size(kernel: Kernel, name: str) -> int:
-    return next(a.size for a in kernel.inputs if a.name == name)
 
 
 def simulate_signature(prefix: str) -> str:

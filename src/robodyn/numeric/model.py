@@ -7,6 +7,7 @@ Array rules (DESIGN.md): one state is ``(n,)``, a batch is ``(N, n)``; results a
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import importlib.util
 import os
@@ -22,7 +23,7 @@ from typing import Literal
 import numpy as np
 import sympy as sp
 
-from robodyn.codegen.build import CompiledLibrary, cache_dir, compile_library
+from robodyn.codegen.build import CFLAGS, CompiledLibrary, cache_dir, compile_library
 from robodyn.codegen.c import CPrinter
 from robodyn.codegen.kernels import DERIVATIVE_KERNEL_NAMES, KernelSet, build_kernels, kernel_signature
 from robodyn.codegen.python import PythonPrinter
@@ -73,23 +74,29 @@ class Model:
         return _kernels_cached(self.robot, self.parameters)
 
     # --- public kernels ------------------------------------------------------------------------
-    def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
-        """Joint torques ``tau = M qdd + C qd + g + friction``, shape like ``q`` (N m or N)."""
-        return self._call("inverse_dynamics", q, qd, qdd)
+    def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, *,
+                         threads: int = 1) -> np.ndarray:
+        """Joint torques ``tau = M qdd + C qd + g + friction``, shape like ``q`` (N m or N).
 
-    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        ``threads``: threads of a batch call (every method takes it; the result bits do not
+        depend on it; the NumPy backend uses one).
+        """
+        return self._call("inverse_dynamics", q, qd, qdd, threads=threads)
+
+    def mass_matrix(self, q: np.ndarray, *, threads: int = 1) -> np.ndarray:
         """Joint-space inertia (rotor inertia included), (n, n) or (N, n, n)."""
-        return self._call("mass_matrix", q)
+        return self._call("mass_matrix", q, threads=threads)
 
-    def gravity(self, q: np.ndarray) -> np.ndarray:
+    def gravity(self, q: np.ndarray, *, threads: int = 1) -> np.ndarray:
         """Gravity load ``g(q)``: the torques that hold the arm still, shape like ``q``."""
-        return self._call("gravity", q)
+        return self._call("gravity", q, threads=threads)
 
-    def coriolis(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    def coriolis(self, q: np.ndarray, qd: np.ndarray, *, threads: int = 1) -> np.ndarray:
         """Coriolis and centrifugal torques ``C(q, qd) qd``, shape like ``q``."""
-        return self._call("coriolis", q, qd)
+        return self._call("coriolis", q, qd, threads=threads)
 
-    def forward_dynamics(self, q: np.ndarray, qd: np.ndarray, tau: np.ndarray) -> np.ndarray:
+    def forward_dynamics(self, q: np.ndarray, qd: np.ndarray, tau: np.ndarray, *,
+                         threads: int = 1) -> np.ndarray:
         """Joint accelerations ``qdd = M^-1 (tau - C qd - g - friction)``, shape like ``q``.
 
         Raises
@@ -97,9 +104,9 @@ class Model:
         SingularMassMatrixError
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
-        return self._nonsingular(self._call("forward_dynamics", q, qd, tau), q)
+        return self._nonsingular(self._call("forward_dynamics", q, qd, tau, threads=threads), q)
 
-    def state_derivative(self, x: np.ndarray, tau: np.ndarray) -> np.ndarray:
+    def state_derivative(self, x: np.ndarray, tau: np.ndarray, *, threads: int = 1) -> np.ndarray:
         """``[qd, qdd]`` of the state ``x = [q, qd]``, (2 n,) or (N, 2 n).
 
         Raises
@@ -107,7 +114,7 @@ class Model:
         SingularMassMatrixError
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
-        xd = self._call("state_derivative", x, tau)
+        xd = self._call("state_derivative", x, tau, threads=threads)
         return self._nonsingular(xd, np.asarray(x, dtype=float)[..., : self.dof])
 
     def check_mass_matrix(self, q: np.ndarray) -> None:
@@ -148,17 +155,18 @@ class Model:
         self.check_mass_matrix(rows[int(np.argmax(bad))])
         return out
 
-    def forward_kinematics(self, q: np.ndarray) -> np.ndarray:
+    def forward_kinematics(self, q: np.ndarray, *, threads: int = 1) -> np.ndarray:
         """End-effector pose in the base frame, (4, 4) or (N, 4, 4)."""
-        return self._call("forward_kinematics", q)
+        return self._call("forward_kinematics", q, threads=threads)
 
-    def jacobian(self, q: np.ndarray) -> np.ndarray:
+    def jacobian(self, q: np.ndarray, *, threads: int = 1) -> np.ndarray:
         """Geometric Jacobian ``[v; omega]`` of the tool origin, base frame, (6, n) or (N, 6, n)."""
-        return self._call("jacobian", q)
+        return self._call("jacobian", q, threads=threads)
 
-    def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+    def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, *,
+                  threads: int = 1) -> np.ndarray:
         """Regressor ``Y`` with ``Y @ params == tau``, (n, 15 n) or (N, n, 15 n)."""
-        return self._call("regressor", q, qd, qdd)
+        return self._call("regressor", q, qd, qdd, threads=threads)
 
     def inverse_dynamics_derivatives(self, q: np.ndarray, qd: np.ndarray,
                                      qdd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -335,7 +343,8 @@ class Model:
         return x_out, tau_out
 
     # --- plumbing ------------------------------------------------------------------------------
-    def _call(self, name: str, *arrays: np.ndarray) -> np.ndarray:
+    def _call(self, name: str, *arrays: np.ndarray, threads: int = 1) -> np.ndarray:
+        threads = _thread_count(threads)
         inputs, result_shape = kernel_signature(name, self.dof)
         batch_shape: tuple[int, ...] | None = None
         args = []
@@ -362,7 +371,9 @@ class Model:
         out = np.empty(out_shape)
         ptrs = [ffi.from_buffer("double[]", a) for a in args]
         out_ptr = ffi.from_buffer("double[]", out)
-        if batch_shape:
+        if batch_shape and threads > 1:
+            getattr(lib, f"{_PREFIX}{name}_batch_threads")(batch_shape[0], threads, *ptrs, out_ptr)
+        elif batch_shape:
             getattr(lib, f"{_PREFIX}{name}_batch")(batch_shape[0], *ptrs, out_ptr)
         else:
             getattr(lib, f"{_PREFIX}{name}")(*ptrs, out_ptr)
@@ -413,7 +424,8 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
             _write_atomic(src, printer.source(kset))
         else:
             _touch(src, decl)
-        impl: CompiledLibrary | ModuleType = compile_library(src.read_text(), decl.read_text())
+        impl: CompiledLibrary | ModuleType = compile_library(src.read_text(), decl.read_text(),
+                                                             flags=openmp_flags())
     else:
         path = directory / f"rd_model_{key}.py"
         if not path.exists():
@@ -453,6 +465,28 @@ def _compile_derivatives(model: Model) -> Model:
     return Model(robot, backend, model.parameter_values, impl)
 
 
+def _thread_count(threads: int) -> int:
+    """``threads`` checked: a positive integer."""
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise ValueError(f"threads must be a positive integer, got {threads!r}")
+    return int(threads)
+
+
+@functools.cache
+def openmp_flags() -> tuple[str, ...]:
+    """Compiler flags of the models: :data:`CFLAGS` plus ``-fopenmp`` when the compiler has it.
+
+    Without OpenMP the ``*_batch_threads`` functions run on one thread (same results).
+    """
+    flags = (*CFLAGS, "-fopenmp")
+    probe = "int rd_openmp_probe(void) {\n#ifdef _OPENMP\n    return 1;\n#else\n    return 0;\n#endif\n}\n"
+    try:
+        lib = compile_library(probe, "int rd_openmp_probe(void);", flags=flags)
+    except (RuntimeError, OSError):  # no compiler (CompilerNotFoundError) or no -fopenmp
+        return CFLAGS
+    return flags if lib.lib.rd_openmp_probe() == 1 else CFLAGS
+
+
 def _touch(*paths: Path) -> None:
     """Mark cached generated sources as recently used (the cache evicts least-recently used)."""
     for p in paths:
@@ -481,8 +515,14 @@ def _check_structure(robot: Robot, kset: KernelSet) -> None:
         "(or the links beyond it) a mass and an inertia, or the joint a rotor inertia")
 
 
+@functools.cache
 def _generator_hash() -> str:
-    """Hash of the source files that decide what is generated (cache invalidation)."""
+    """Hash of the source files that decide what is generated (cache invalidation).
+
+    Taken once per process, when this module is imported (with the generator's modules): a
+    process that loaded the generator before its files were edited must not store what it
+    generates under the hash of the edited files.
+    """
     import robodyn.codegen as codegen_pkg
     import robodyn.symbolic as symbolic_pkg
 
@@ -491,6 +531,9 @@ def _generator_hash() -> str:
         for path in sorted(Path(pkg.__file__).parent.glob("*.py")):
             digest.update(path.read_bytes())
     return digest.hexdigest()
+
+
+_generator_hash()
 
 
 def _write_atomic(path: Path, text: str) -> None:
