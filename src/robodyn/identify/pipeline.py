@@ -43,6 +43,8 @@ __all__ = ["check_recording", "identify", "nominal_standard"]
 
 TARGETS = ("tau", "current")
 METHODS = ("ols", "wls", "consistent")
+#: Samples per cut-off period kept for the parallel filtering of the regressor.
+MID_RATE = 100
 #: Unit directions whose singular value is below this fraction of the largest are reported.
 UNEXCITED_RTOL = 1e-6
 
@@ -244,13 +246,23 @@ def filtered_regressor(model: Model, s: Samples, settings: Preprocess) -> np.nda
     """Full regressor (N / decimate, n, 15 n) of processed samples, low-passed column by column
     with the target's filter before decimation (parallel filtering, Gautier 1997): the filter is
     linear, so ``H(Y p) = H(Y) p`` holds exactly, and the fit of the filtered target is not biased
-    by terms the filter smooths (Coulomb steps at velocity reversals)."""
-    y = model.regressor(s.q, s.qd, s.qdd)
-    if settings.cutoff is not None:
-        count = y.shape[0]
-        # H Y: the same zero-phase low-pass as the target, along time
-        y = lowpass(s.t, y.reshape(count, -1), settings.cutoff, order=settings.order).reshape(y.shape)
-    return y[::settings.decimate]
+    by terms the filter smooths (Coulomb steps at velocity reversals).
+
+    To bound memory and time on long fast logs, ``Y`` is evaluated and filtered on every
+    ``m``-th sample, ``m`` the largest divisor of the decimation factor with at least
+    ``MID_RATE`` samples per cut-off period left (the filtered states are smooth there; only the
+    timing of a Coulomb step moves, by less than ``1 / (MID_RATE cutoff)``)."""
+    d = settings.decimate
+    if settings.cutoff is None:
+        return model.regressor(s.q[::d], s.qd[::d], s.qdd[::d])
+    fs = 1.0 / float(np.median(np.diff(s.t)))
+    limit = max(1, int(fs / (MID_RATE * settings.cutoff)))
+    m = max(k for k in range(1, d + 1) if d % k == 0 and k <= limit)
+    y = model.regressor(s.q[::m], s.qd[::m], s.qdd[::m])
+    count = y.shape[0]
+    # H Y: the same zero-phase low-pass as the target, along time
+    y = lowpass(s.t[::m], y.reshape(count, -1), settings.cutoff, order=settings.order).reshape(y.shape)
+    return y[::d // m]
 
 
 def _decimated(s: Samples, settings: Preprocess) -> Samples:
