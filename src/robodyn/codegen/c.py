@@ -300,6 +300,7 @@ class CPrinter(Printer):
             lines.append(self.signature(kernel, batch=True, threads=True).replace("restrict ", "") + ";")
         if with_simulation and "state_derivative" in kset.names:
             lines.append(simulate_signature(self.prefix) + ";")
+            lines.append(ensemble_signature(self.prefix) + ";")
         return "\n".join(lines) + "\n"
 
     def source(self, kset: KernelSet, with_simulation: bool = True) -> str:
@@ -315,6 +316,7 @@ class CPrinter(Printer):
         if with_simulation and "state_derivative" in kset.names:
             parts.append(simulation_source(kset.dof, self.prefix, "gravity" in kset.names,
                                            "mass_matrix" in kset.names))
+            parts.append(ensemble_source(kset.dof, self.prefix))
         return "\n".join(parts)
 
 
@@ -367,6 +369,111 @@ def simulate_signature(prefix: str) -> str:
             "const double *feedforward, const double *reference, const double *gain, "
             "const double *integral_gain, int mode, const double *tau_limit, int continuous, "
             "double *x_out, double *tau_out)")
+
+
+def ensemble_signature(prefix: str) -> str:
+    """Prototype of the in-C integrator of many trajectories."""
+    return (f"int {prefix}simulate_ensemble(long count, long steps, double dt, int method, "
+            "const double *x0, const double *feedforward, const double *reference, "
+            "const double *gain, const double *integral_gain, int mode, const double *tau_limit, "
+            "int threads, double *x_out, double *tau_out, long *status)")
+
+
+def ensemble_source(n: int, prefix: str) -> str:
+    """C source of ``PREFIXsimulate_ensemble``: ``count`` trajectories of ``PREFIXsimulate``.
+
+    Trajectory i starts at ``x0[i]`` (2 n) and follows the sampled law of
+    :func:`simulation_source` (``continuous`` 0) with the same ``feedforward``, ``reference``,
+    gains and limits; its states go to ``x_out[i]`` ((steps + 1) x 2 n) and its torques to
+    ``tau_out[i]`` (steps x n, or NULL). Trajectories are integrated :data:`BLOCK` at a time:
+    each RK4 stage is one ``state_derivative`` over the block (the vectorised kernel, SIMD
+    across trajectories) and the updates are loops over the block's states. Every trajectory
+    gets the same bits as ``PREFIXsimulate`` alone. ``status[i]`` is 0, or k + 1 when trajectory i
+    stopped being finite at step k (its later rows are not written). Blocks go to ``threads``
+    OpenMP threads. Returns the number of trajectories that failed.
+    """
+    sd = f"{prefix}state_derivative_range"
+    law = f"{prefix}control_law"
+    args = "feedforward, reference, gain, integral_gain, mode, tau_limit"
+    stage = "        for (int i = 0; i < m * NX; ++i) xt[i] = x[i] + {h} * {k}[i];"
+    lines = [
+        f"/* trajectories first .. first + m - 1 (m <= {BLOCK}) of simulate_ensemble. */",
+        f"static void {prefix}ensemble_block(long first, int m, long steps, double dt, int method, "
+        "const double *x0, const double *feedforward, const double *reference, const double *gain, "
+        "const double *integral_gain, int mode, const double *tau_limit, double *x_out, "
+        "double *tau_out, long *status) {",
+        f"    enum {{ N = {n}, NX = {2 * n}, B = {BLOCK} }};",
+        "    double x[B * NX], xt[B * NX], k1[B * NX], k2[B * NX], k3[B * NX], k4[B * NX];",
+        "    double tau[B * N], integ[B * N], r[N];",
+        "    for (int j = 0; j < m; ++j) {",
+        "        status[first + j] = 0;",
+        "        for (int i = 0; i < NX; ++i)",
+        "            x[j * NX + i] = x_out[(first + j) * (steps + 1) * NX + i] = x0[(first + j) * NX + i];",
+        "        for (int i = 0; i < N; ++i) integ[j * N + i] = 0.0;",
+        "    }",
+        "    for (long k = 0; k < steps; ++k) {",
+        "        /* per trajectory: integral += e_q dt, then the sampled law */",
+        "        for (int j = 0; j < m; ++j) {",
+        f"            {prefix}error_rate(k, x + j * NX, reference, r);",
+        "            for (int i = 0; i < N; ++i) integ[j * N + i] += r[i] * dt;",
+        f"            {law}(k, x + j * NX, integ + j * N, {args}, tau + j * N);",
+        "        }",
+        "        if (method == 0) {",
+        "            /* RK4 over the block: x += dt/6 (k1 + 2 k2 + 2 k3 + k4) */",
+        f"            {sd}(0, m, x, tau, k1);",
+        stage.format(h="0.5 * dt", k="k1"),
+        f"            {sd}(0, m, xt, tau, k2);",
+        stage.format(h="0.5 * dt", k="k2"),
+        f"            {sd}(0, m, xt, tau, k3);",
+        stage.format(h="dt", k="k3"),
+        f"            {sd}(0, m, xt, tau, k4);",
+        "            for (int i = 0; i < m * NX; ++i)",
+        "                x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);",
+        "        } else {",
+        "            /* semi-implicit Euler: qd += dt qdd(q, qd); q += dt qd (new qd) */",
+        f"            {sd}(0, m, x, tau, k1);",
+        "            for (int j = 0; j < m; ++j) {",
+        "                for (int i = 0; i < N; ++i) x[j * NX + N + i] += dt * k1[j * NX + N + i];",
+        "                for (int i = 0; i < N; ++i) x[j * NX + i] += dt * x[j * NX + N + i];",
+        "            }",
+        "        }",
+        "        for (int j = 0; j < m; ++j) {",
+        "            if (status[first + j]) continue;",
+        "            double *row = x_out + ((first + j) * (steps + 1) + k + 1) * NX;",
+        "            for (int i = 0; i < NX; ++i) {",
+        "                if (!isfinite(x[j * NX + i])) {",
+        "                    /* stopped: restart it at zero so that it costs no libm fallbacks */",
+        "                    status[first + j] = k + 1;",
+        "                    for (int l = 0; l < NX; ++l) x[j * NX + l] = 0.0;",
+        "                    break;",
+        "                }",
+        "                row[i] = x[j * NX + i];",
+        "            }",
+        "            if (tau_out && !status[first + j])",
+        "                for (int i = 0; i < N; ++i)",
+        "                    tau_out[((first + j) * steps + k) * N + i] = tau[j * N + i];",
+        "        }",
+        "    }",
+        "}",
+        "",
+        f"/* count trajectories of {n}-joint dynamics, {BLOCK} per block, blocks on `threads` threads. */",
+        ensemble_signature(prefix) + " {",
+        f"    const long blocks = (count + {BLOCK - 1}) / {BLOCK};",
+        "    long failed = 0;",
+        "#ifdef _OPENMP",
+        "#pragma omp parallel for num_threads(threads > 0 ? threads : 1) schedule(dynamic)",
+        "#endif",
+        "    for (long b = 0; b < blocks; ++b) {",
+        f"        const int m = count - {BLOCK} * b < {BLOCK} ? (int)(count - {BLOCK} * b) : {BLOCK};",
+        f"        {prefix}ensemble_block({BLOCK} * b, m, steps, dt, method, x0, {args}, x_out, tau_out, "
+        "status);",
+        "    }",
+        "    (void)threads;",
+        "    for (long i = 0; i < count; ++i) failed += status[i] != 0;",
+        "    return (int)(failed < 2147483647L ? failed : 2147483647L);",
+        "}",
+    ]
+    return "\n".join(lines) + "\n"
 
 
 def _law_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) -> list[str]:

@@ -233,7 +233,7 @@ class Model:
                   feedforward: np.ndarray | None = None, reference: np.ndarray | None = None,
                   gain: np.ndarray | None = None, integral_gain: np.ndarray | None = None,
                   mode: str = "feedback", tau_limit: np.ndarray | None = None,
-                  control: str = "sampled") -> tuple[np.ndarray, np.ndarray]:
+                  control: str = "sampled", threads: int = 1) -> tuple[np.ndarray, np.ndarray]:
         """Fixed-step trajectory under a state-feedback law, in one call.
 
         With ``e = reference[row] - x``::
@@ -249,10 +249,15 @@ class Model:
         stage's state, with rows sampled every ``dt / 2`` (row 2k at the start of step k), and
         the integral is integrated by the same RK4: a continuous-time controller.
 
+        An ensemble: ``x0`` of shape (N, 2 n) integrates N trajectories under the same law and
+        inputs in one C call (sampled control only), a block of trajectories per vector loop
+        (SIMD across trajectories) and blocks on ``threads`` threads; each trajectory has the
+        same bits as its own run. Results gain a leading N.
+
         Parameters
         ----------
-        x0 : (2 n,)
-            Initial ``[q, qd]``.
+        x0 : (2 n,) or (N, 2 n)
+            Initial ``[q, qd]``, or one per trajectory.
         steps : int
         dt : float
             Step (s).
@@ -270,12 +275,14 @@ class Model:
         tau_limit : (n,), optional
             Actuator limits (N m or N), positive.
         control : {"sampled", "continuous"}
+        threads : int
+            Threads of an ensemble (C backend with OpenMP; results do not depend on it).
 
         Returns
         -------
-        x : (steps + 1, 2 n)
+        x : (steps + 1, 2 n) or (N, steps + 1, 2 n)
             States, ``x[0] = x0``.
-        tau : (steps, n)
+        tau : (steps, n) or (N, steps, n)
             Torques at the start of each step (those applied over it when sampled).
 
         Raises
@@ -299,14 +306,20 @@ class Model:
         steps = int(steps)
         if steps < 1:
             raise ValueError(f"integrate: steps must be a positive integer, got {steps}")
-        size = 8 * (steps + 1) * 3 * n
+        threads = _thread_count(threads)
+        ensemble = np.ndim(x0) == 2
+        if ensemble and continuous:
+            raise ValueError("integrate: an ensemble (x0 of shape (N, 2 n)) runs control='sampled' "
+                             "only; integrate continuous-time control one trajectory at a time")
+        count = np.shape(x0)[0] if ensemble else 1
+        size = 8 * (steps + 1) * 3 * n * count
         if size > MAX_INTEGRATE_BYTES:
             raise ValueError(f"integrate: {steps:,} steps of {n} joints need {size / 2**20:,.0f} MiB "
                              f"of output, above {MAX_INTEGRATE_BYTES / 2**20:,.0f} MiB; split the "
                              "run into several calls from the last state (simulate() does so)")
         rows = 2 * steps + 1 if continuous else steps
         arrays = {
-            "x0": (x0, (nx,)), "feedforward": (feedforward, (rows, n)),
+            "x0": (x0, (count, nx) if ensemble else (nx,)), "feedforward": (feedforward, (rows, n)),
             "reference": (reference, (rows, nx)), "gain": (gain, (n, nx)),
             "integral_gain": (integral_gain, (n,)), "tau_limit": (tau_limit, (n,)),
         }
@@ -319,6 +332,8 @@ class Model:
             if arr.shape != shape:
                 raise ValueError(f"integrate: {key} must have shape {shape}, got {arr.shape}")
             checked[key] = arr
+        if ensemble:
+            return self._integrate_ensemble(checked, steps, dt, methods[method], modes[mode], threads)
         x_out = np.empty((steps + 1, nx))
         tau_out = np.empty((steps, n))
         if isinstance(self._impl, ModuleType):
@@ -339,6 +354,39 @@ class Model:
                                   f"(t = {(status - 1) * dt:g} s); reduce dt or check the inputs")
             # the last finite state, for a caller's diagnosis
             exc.state = x_out[status - 1].copy()
+            raise exc
+        return x_out, tau_out
+
+    def _integrate_ensemble(self, a: dict[str, np.ndarray | None], steps: int, dt: float,
+                            method: int, mode: int, threads: int) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`integrate` of ``a["x0"]`` (N, 2 n) checked: one C call, or N NumPy runs."""
+        n, nx = self.dof, 2 * self.dof
+        count = a["x0"].shape[0]
+        x_out = np.empty((count, steps + 1, nx))
+        tau_out = np.empty((count, steps, n))
+        status = np.zeros(count, dtype=np.int64)
+        if isinstance(self._impl, ModuleType):
+            for i in range(count):
+                status[i] = _integrate_numpy(self, steps, dt, method, mode, {**a, "x0": a["x0"][i]},
+                                             x_out[i], tau_out[i])
+        elif count:
+            ffi = self._impl.ffi
+            ptr = {k: (ffi.NULL if v is None else ffi.from_buffer("double[]", v)) for k, v in a.items()}
+            self._impl.lib.rd_simulate_ensemble(
+                count, steps, float(dt), method, ptr["x0"], ptr["feedforward"], ptr["reference"],
+                ptr["gain"], ptr["integral_gain"], mode, ptr["tau_limit"], threads,
+                ffi.from_buffer("double[]", x_out), ffi.from_buffer("double[]", tau_out),
+                ffi.from_buffer("long[]", status))
+        failed = np.flatnonzero(status)
+        if failed.size:
+            i, k = int(failed[0]), int(status[failed[0]])
+            self.check_mass_matrix(x_out[i, k - 1, :n])
+            exc = SimulationError(
+                f"{failed.size} of {count} trajectories stopped being finite; the first, "
+                f"trajectory {i}, at step {k - 1} (t = {(k - 1) * dt:g} s); reduce dt or check "
+                "the inputs")
+            exc.state = x_out[i, k - 1].copy()
+            exc.trajectory = i
             raise exc
         return x_out, tau_out
 
