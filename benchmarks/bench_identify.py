@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 import robodyn as rd
+from robodyn.identify import identify
 from robodyn.identify.stacking import identification_matrix
 from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
 
@@ -91,7 +92,7 @@ def main() -> None:
     print(f"whole identification, Kinova whole-arm runs ({sum(r.n_samples for r in runs)} samples, "
           f"target current, defaults):")
     for method in ("ols", "wls", "consistent"):
-        t, ident = best_of(lambda m=method: rd.identify(robot, runs, target="current", method=m,
+        t, ident = best_of(lambda m=method: identify(robot, runs, target="current", method=m,
                                                         model=model), 1)
         print(f"  {method:>10}: {t:6.2f} s  (cut-off {ident.preprocess.cutoff:g} Hz, decimate "
               f"{ident.preprocess.decimate}, {len(ident.base_parameters)} base parameters, "

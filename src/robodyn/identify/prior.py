@@ -13,7 +13,9 @@ and friction left out). For ``target="tau"``, ``a_j = 1`` is fixed. For ``target
 * gains from the description (``"description"``, or ``"auto"`` when any joint's
   ``gear_ratio x torque_constant`` differs from 1, the default drive): ``a_j = 1 / K_j`` fixed;
 * otherwise (``"absorbed"``) ``a_j`` is fitted and ``K_j = 1 / a_j``: the gain that scales the
-  description's rigid-body torque onto the measured current. It thereby also absorbs a uniform
+  description's rigid-body torque onto the measured current (where that fails, ``a_j <= 0`` on a
+  joint whose nominal torque is too small to see, the geometric mean of the other joints' gains
+  is used, with an :class:`IdentificationWarning`). It thereby also absorbs a uniform
   error of the nominal load on that joint (an unmodelled tool); what is then identified are
   parameters in the torque units of the description's model, and currents ``i_j = tau_j / K_j``.
 
@@ -24,6 +26,7 @@ levels and rotor inertia are clipped at zero.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
@@ -34,9 +37,13 @@ from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
 from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
 
-__all__ = ["GAIN_MODES", "description_gains", "joint_prior"]
+__all__ = ["GAIN_MODES", "IdentificationWarning", "description_gains", "joint_prior"]
 
 GAIN_MODES = ("auto", "description", "absorbed")
+
+
+class IdentificationWarning(UserWarning):
+    """An identification went ahead with a fallback the user should know about."""
 
 
 def description_gains(robot: Robot) -> np.ndarray:
@@ -93,27 +100,45 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
         fixed, source = None, "absorbed"
     gains = np.ones(n) if fixed is None else fixed.copy()
     prior = rigid.copy()
-    for j in range(n):
+    failed = []
+
+    def fit(j: int, gain: float | None) -> bool:
         tau_nom = np.concatenate([y[:, j, :] @ rigid for y in y_full])
         cols = np.vstack([_joint_columns(y, j) for y in y_full])
         b = np.concatenate([s.y[:, j] for s in samples])
-        if fixed is None:
-            a = np.column_stack([tau_nom, cols])
-        else:
-            a, b = cols, b - tau_nom / fixed[j]
+        a = np.column_stack([tau_nom, cols]) if gain is None else cols
+        if gain is not None:
+            b = b - tau_nom / gain
         used = np.linalg.norm(a, axis=0) > 1e-12 * max(1.0, float(np.abs(a).max()))
         coef = np.zeros(a.shape[1])
         coef[used] = np.linalg.lstsq(a[:, used], b, rcond=None)[0]
-        if fixed is None:
+        if gain is None:
             if not used[0] or coef[0] <= 0:
-                raise IdentificationError(
-                    f"joint {robot.joint_names[j]!r} (joints[{j}]): its drive gain cannot be "
-                    f"absorbed: the description's torque does not explain the current "
-                    f"(1/K = {coef[0]:g}); give the gain in the description's drive "
-                    f"(gear_ratio x torque_constant)")
+                return False
             gains[j] = 1.0 / coef[0]
             coef = coef[1:]
         ia, fv, fcp, fcn, fo = coef * gains[j]
         prior[PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)] = (
             max(ia, 0.0), fv, max(fcp, 0.0), max(fcn, 0.0), fo)
+        return True
+
+    for j in range(n):
+        if not fit(j, None if fixed is None else float(fixed[j])):
+            failed.append(j)
+    if failed:
+        ok = [j for j in range(n) if j not in failed]
+        if not ok:
+            raise IdentificationError(
+                "recordings: no joint's drive gain can be absorbed (the description's torque "
+                "does not explain the current on any joint); give the gains in the description's "
+                "drives (gear_ratio x torque_constant)")
+        names = ", ".join(repr(robot.joint_names[j]) for j in failed)
+        warnings.warn(IdentificationWarning(
+            f"drive gain of joint(s) {names} cannot be absorbed (the description's torque does "
+            f"not explain their current): the geometric mean of the other joints' gains is used"),
+            stacklevel=3)
+        for j in failed:
+            gains[j] = float(np.exp(np.mean(np.log(gains[ok]))))
+            fit(j, gains[j])
+        source = "absorbed (" + ", ".join(robot.joint_names[j] for j in failed) + ": mean of the others)"
     return gains, source, prior
