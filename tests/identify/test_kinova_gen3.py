@@ -88,3 +88,17 @@ def test_consistent_estimate_on_real_data_loads_strict(gen3, tmp_path):
     raw, filtered, floor = _errors(ident, test)
     print(f"consistent: raw {raw:.3f}  filtered {filtered:.3f}  noise floor {floor:.3f}")
     assert raw < BASELINE_RAW and filtered < BASELINE_FILTERED  # noqa: PT018 (measured 0.318 / 0.206)
+
+
+@data
+def test_gain_that_cannot_be_absorbed_falls_back_with_a_warning(gen3):
+    """On the full runs joint 7's nominal torque cannot explain its current (1/K < 0)."""
+    from robodyn.identify.prior import IdentificationWarning
+
+    robot, model, _, _ = gen3
+    runs = [read(p) for p in WHOLE_ARM_FILES]
+    with pytest.warns(IdentificationWarning, match=r"'joint_7' cannot be absorbed"):
+        ident = rd.identify(robot, runs, target="current", method="ols", model=model)
+    assert np.all(ident.gains > 0) and "joint_7" in ident.gains_source  # noqa: PT018
+    others = np.delete(ident.gains, 6)
+    assert ident.gains[6] == pytest.approx(np.exp(np.mean(np.log(others))))
