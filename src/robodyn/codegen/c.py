@@ -234,6 +234,12 @@ class CPrinter(Printer):
                 for a in (*core.inputs, *core.outputs)]
         scatter = [f"            for (int i_ = 0; i_ < {a.size}; ++i_) {a.name}[{a.size} * j_ + i_] = "
                    f"{a.name}_b_[{BLOCK} * i_ + k_];" for a in kernel.outputs]
+        # (a kernel whose outputs are constants reads no input)
+        transpose = ["        /* transpose the block's inputs: x_b_[BLOCK i + k] = x[size (k0 + k) + i] */",
+                     "        for (int k_ = 0; k_ < m_; ++k_) {",
+                     "            const long j_ = k0_ + k_;",
+                     *gather,
+                     "        }"] if gather else []
         params = ", ".join(f"const double *restrict {a.name}" for a in kernel.inputs)
         params += ", " + ", ".join(f"double *restrict {a.name}" for a in kernel.outputs)
         return "\n".join([
@@ -243,11 +249,7 @@ class CPrinter(Printer):
             f"    double {', '.join(arrays)};",
             f"    for (long k0_ = begin; k0_ < end; k0_ += {BLOCK}) {{",
             f"        const int m_ = end - k0_ < {BLOCK} ? (int)(end - k0_) : {BLOCK};",
-            "        /* transpose the block's inputs: x_b_[BLOCK i + k] = x[size (k0 + k) + i] */",
-            "        for (int k_ = 0; k_ < m_; ++k_) {",
-            "            const long j_ = k0_ + k_;",
-            *gather,
-            "        }",
+            *transpose,
             *trig,
             f"        {self.prefix}{core.name}(m_, {', '.join(args)});",
             "        for (int k_ = 0; k_ < m_; ++k_) {",

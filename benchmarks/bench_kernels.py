@@ -1,0 +1,240 @@
+"""Kernel speed: vectorised, threaded and ensemble robodyn against peers measured in the same run.
+
+Prints (PUMA 560, 100,000 random states, ns per state, best of several runs):
+  1. Single thread: robodyn inverse dynamics (with the PUMA's joint friction, and a copy of the
+     robot without friction, like for like with Pinocchio, which computes none) against
+     Pinocchio's ``rneaInParallel`` on ONE thread (a batch call, no Python per state) and
+     against CasADi-generated C of the same inverse dynamics (robodyn's recorded Newton-Euler
+     program evaluated on CasADi SX symbols, ``CodeGenerator`` C, compiled with robodyn's flags
+     ``-O3 -march=native ...`` and driven by a C loop over the states); forward dynamics
+     against ``abaInParallel`` on one thread; mass matrix against ``crba`` called from Python
+     (the no-op loop's own cost is measured and printed).
+  2. Two threads: robodyn's ``threads=2`` against itself (scaling efficiency) and against
+     ``rneaInParallel``/``abaInParallel`` on 2 threads. The machine may be shared: the ratios
+     of one run are comparable, absolute times are not.
+  3. Ensemble RK4: 1000 trolley double-pendulum trajectories of 5 s at 1 ms: one
+     ``model.integrate`` call with x0 (1000, 6) against 1000 one-at-a-time calls and against
+     MuJoCo's ``rollout`` with 1000 initial states (its own RK4 at 1 ms, one thread).
+
+Run: ``.venv/bin/python benchmarks/bench_kernels.py [--quick]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import sympy as sp
+
+import robodyn as rd
+from robodyn.codegen.build import CFLAGS, compile_library
+from robodyn.numeric.model import _kernels_cached
+
+sys.path.insert(0, str(Path(__file__).parent))
+from bench_simulation import pinocchio_puma, trolley_mjcf  # noqa: E402
+
+
+def best_of(fn, repeat: int = 5) -> float:
+    """Smallest wall time of ``repeat`` calls, s."""
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def without_friction(robot: rd.Robot) -> rd.Robot:
+    """The same robot with every joint's friction removed (rigid body + rotor inertia only)."""
+    joints = tuple(dataclasses.replace(j, friction=type(j.friction)()) for j in robot.joints)
+    # description_hash "" is recomputed from the new description (the compiled-model cache key)
+    return dataclasses.replace(robot, joints=joints, name=robot.name + "_nofriction", description_hash="")
+
+
+def casadi_inverse_dynamics(robot: rd.Robot):
+    """CasADi C of robodyn's PUMA inverse-dynamics program, compiled with robodyn's flags.
+
+    Returns ``run(q, qd, qdd, tau)``: a C loop calling CasADi's one-state function per state.
+    """
+    import casadi as ca
+
+    kernel = _kernels_cached(robot, robot.parameters)["inverse_dynamics"]
+    n = robot.dof
+    q, qd, qdd = (ca.SX.sym(s, n) for s in ("q", "qd", "qdd"))
+    env: dict[sp.Symbol, object] = {}
+    for arg, sym in zip(kernel.inputs, (q, qd, qdd), strict=True):
+        env.update({e: sym[k] for k, e in enumerate(arg.entries)})
+    modules = [{"sin": ca.sin, "cos": ca.cos, "sqrt": ca.sqrt, "ifelse": ca.if_else}, "math"]
+    ifelse = sp.Function("ifelse")
+
+    def value(expr):
+        # Coulomb friction's steps: CasADi's if_else (a select in the generated C)
+        expr = expr.replace(lambda e: isinstance(e, sp.Piecewise),
+                            lambda e: ifelse(e.args[0].cond, e.args[0].expr, e.args[1].expr))
+        free = sorted(expr.free_symbols, key=lambda s: s.name)
+        return sp.lambdify(free, expr, modules=modules)(*(env[s] for s in free))
+
+    for sym, expr in kernel.body:
+        env[sym] = value(expr)
+    tau = ca.vertcat(*[value(sp.sympify(e)) for e in kernel.outputs[0].entries])
+    f = ca.Function("cs_id", [q, qd, qdd], [tau])
+    gen = ca.CodeGenerator("cs_id.c", {"with_header": False})
+    gen.add(f)
+    driver = f"""
+void cs_id_batch(long count, const double *q, const double *qd, const double *qdd, double *tau) {{
+    casadi_int iw[1]; casadi_real w[{f.sz_w()}];
+    for (long k = 0; k < count; ++k) {{
+        const casadi_real *arg[3] = {{q + {n} * k, qd + {n} * k, qdd + {n} * k}};
+        casadi_real *res[1] = {{tau + {n} * k}};
+        cs_id(arg, res, iw, w, 0);
+    }}
+}}
+"""
+    lib = compile_library(gen.dump() + driver,
+                          "void cs_id_batch(long, const double *, const double *, const double *, double *);",
+                          flags=CFLAGS)
+    ffi = lib.ffi
+
+    def run(qa, qda, qdda, out):
+        lib.lib.cs_id_batch(len(qa), *(ffi.from_buffer("double[]", a) for a in (qa, qda, qdda, out)))
+
+    return run, f.n_instructions()
+
+
+def bench_kernels(quick: bool) -> None:
+    import pinocchio as pin
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = rd.load("puma560")
+    model = rd.compile_model(robot)
+    rigid = rd.compile_model(without_friction(robot))
+    count = 10_000 if quick else 100_000
+    rng = np.random.default_rng(0)
+    q, qd, qdd = rng.uniform(-np.pi, np.pi, (3, count, 6))
+    tau = model.inverse_dynamics(q, qd, qdd)
+    ns = 1e9 / count
+    print(f"== PUMA 560, {count:,} states, ns per state (robodyn C: {' '.join(CFLAGS)}) ==")
+    t = {
+        "id": best_of(lambda: model.inverse_dynamics(q, qd, qdd), 7),
+        "id_rigid": best_of(lambda: rigid.inverse_dynamics(q, qd, qdd), 7),
+        "fd": best_of(lambda: model.forward_dynamics(q, qd, tau), 7),
+        "fd_rigid": best_of(lambda: rigid.forward_dynamics(q, qd, tau), 7),
+        "m": best_of(lambda: model.mass_matrix(q), 7),
+        "id2": best_of(lambda: model.inverse_dynamics(q, qd, qdd, threads=2), 7),
+        "fd2": best_of(lambda: model.forward_dynamics(q, qd, tau, threads=2), 7),
+        "m2": best_of(lambda: model.mass_matrix(q, threads=2), 7),
+    }
+    pmodel, source = pinocchio_puma(robot)
+    pdata = pmodel.createData()
+    tau_rigid = rigid.inverse_dynamics(q, qd, qdd)
+    d_id = max(np.max(np.abs(pin.rnea(pmodel, pdata, q[k], qd[k], qdd[k]) - tau_rigid[k])) for k in range(50))
+    qt, qdt, qddt, taut = (np.asfortranarray(a.T) for a in (q, qd, qdd, tau_rigid))
+    out = np.empty((6, count), order="F")
+    for k in (1, 2):
+        pool = pin.ModelPool(pmodel, k)
+        t[f"pin_rnea{k}"] = best_of(lambda k=k, pool=pool: pin.rneaInParallel(k, pool, qt, qdt, qddt, out), 5)
+        t[f"pin_aba{k}"] = best_of(lambda k=k, pool=pool: pin.abaInParallel(k, pool, qt, qdt, taut, out), 5)
+    loops = min(count, 20_000)
+
+    def crba_loop():
+        for k in range(loops):
+            pin.crba(pmodel, pdata, q[k])
+
+    def noop_loop():
+        for k in range(loops):
+            _ = q[k]
+
+    t["pin_crba"] = best_of(crba_loop, 3) * count / loops
+    t["noop"] = best_of(noop_loop, 3) * count / loops
+    run_cs, ops = casadi_inverse_dynamics(robot)
+    run_cs_rigid, _ = casadi_inverse_dynamics(without_friction(robot))
+    out_cs = np.empty((count, 6))
+    run_cs(q, qd, qdd, out_cs)
+    d_cs = np.max(np.abs(out_cs - model.inverse_dynamics(q, qd, qdd))) / np.max(np.abs(out_cs))
+    t["cs"] = best_of(lambda: run_cs(q, qd, qdd, out_cs), 7)
+    t["cs_rigid"] = best_of(lambda: run_cs_rigid(q, qd, qdd, out_cs), 7)
+    print(f"Pinocchio {pin.__version__} ({source}) vs robodyn without friction: max |tau diff| = {d_id:.1e}")
+    print(f"CasADi C of the same program: {ops} SX instructions, max rel. diff vs robodyn = {d_cs:.1e}")
+    print(f"{'single thread':34s}{'robodyn':>9s}{'peer':>9s}{'ratio':>8s}  (target)")
+
+    def row(label, ours, theirs, target=""):
+        print(f"{label:34s}{ours * ns:9.1f}{theirs * ns:9.1f}{theirs / ours:7.1f}x  {target}")
+
+    row("ID (friction) / rneaInParallel(1)", t["id"], t["pin_rnea1"], ">= 20x")
+    row("ID (no friction) / rneaInParallel(1)", t["id_rigid"], t["pin_rnea1"], "like for like")
+    row("ID (friction) / CasADi C", t["id"], t["cs"], ">= 3x")
+    row("ID (no friction) / CasADi C", t["id_rigid"], t["cs_rigid"], "")
+    row("FD (friction) / abaInParallel(1)", t["fd"], t["pin_aba1"], ">= 15x")
+    row("FD (no friction) / abaInParallel(1)", t["fd_rigid"], t["pin_aba1"], "like for like")
+    row("M / crba from a Python loop", t["m"], t["pin_crba"],
+        f"(the loop alone: {t['noop'] * ns:.0f} ns/state)")
+    row("M / crba minus the loop", t["m"], t["pin_crba"] - t["noop"], "")
+    print("two threads (machine shared: efficiency = t1 / (2 t2))")
+    for name, pin_name in (("id", "pin_rnea"), ("fd", "pin_aba"), ("m", None)):
+        eff = t[name] / (2 * t[name + "2"])
+        line = f"  {name.upper():3s} robodyn {t[name + '2'] * ns:7.1f} ns/state, efficiency {eff:5.2f}"
+        if pin_name:
+            line += (f"; Pinocchio 2 threads {t[pin_name + '2'] * ns:7.1f} ns/state "
+                     f"(efficiency {t[pin_name + '1'] / (2 * t[pin_name + '2']):.2f}), "
+                     f"ratio {t[pin_name + '2'] / t[name + '2']:.1f}x")
+        print(line)
+    print()
+
+
+def bench_ensemble(quick: bool) -> None:
+    import mujoco
+    from mujoco import rollout
+
+    robot = rd.load("trolley_double_pendulum")
+    model = rd.compile_model(robot)
+    count = 100 if quick else 1000
+    steps, dt = 5000, 1e-3
+    rng = np.random.default_rng(1)
+    x0 = np.hstack([rng.uniform(-0.3, 0.3, (count, 3)), np.zeros((count, 3))])
+    print(f"== Ensemble RK4: {count} trolley double-pendulum trajectories, 5 s at 1 ms ==")
+    t_ens = best_of(lambda: model.integrate(x0, steps, dt), 3)
+    t_ens2 = best_of(lambda: model.integrate(x0, steps, dt, threads=2), 3)
+
+    def one_at_a_time():
+        for x in x0:
+            model.integrate(x, steps, dt)
+
+    t_one = best_of(one_at_a_time, 2)
+    xml, source = trolley_mjcf(robot)
+    mj = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(mj)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    states = np.zeros((count, mujoco.mj_stateSize(mj, spec)))
+    for i in range(count):
+        mujoco.mj_resetData(mj, data)
+        data.qpos[:] = x0[i, :3]
+        mujoco.mj_getState(mj, data, states[i], spec)
+    rollout.rollout(mj, data, states[:2], nstep=10)
+    t_mj = best_of(lambda: rollout.rollout(mj, data, states, nstep=steps), 2)
+    per = 1e3 / count
+    print(f"robodyn ensemble, one call, 1 thread   {t_ens * per:8.3f} ms per trajectory")
+    print(f"robodyn ensemble, one call, 2 threads  {t_ens2 * per:8.3f} ms per trajectory "
+          f"(efficiency {t_ens / (2 * t_ens2):.2f})")
+    print(f"robodyn one integrate call each        {t_one * per:8.3f} ms per trajectory "
+          f"({t_one / t_ens:.1f}x the ensemble)")
+    print(f"MuJoCo {mujoco.__version__} rollout, {count} initial states {t_mj * per:8.3f} ms per trajectory "
+          f"({t_mj / t_ens:.1f}x the ensemble; model: {source})")
+    print()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="fewer states and trajectories")
+    args = parser.parse_args()
+    bench_kernels(args.quick)
+    bench_ensemble(args.quick)
+
+
+if __name__ == "__main__":
+    main()
