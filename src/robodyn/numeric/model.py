@@ -11,6 +11,7 @@ import functools
 import hashlib
 import importlib.util
 import os
+import subprocess
 import sys
 import tempfile
 from collections.abc import Mapping
@@ -23,7 +24,14 @@ from typing import Literal
 import numpy as np
 import sympy as sp
 
-from robodyn.codegen.build import CFLAGS, CompiledLibrary, cache_dir, compile_library
+from robodyn.codegen.build import (
+    CFLAGS,
+    CompiledLibrary,
+    CompilerNotFoundError,
+    cache_dir,
+    compile_library,
+    find_compiler,
+)
 from robodyn.codegen.c import CPrinter
 from robodyn.codegen.kernels import DERIVATIVE_KERNEL_NAMES, KernelSet, build_kernels, kernel_signature
 from robodyn.codegen.python import PythonPrinter
@@ -529,12 +537,17 @@ def openmp_flags() -> tuple[str, ...]:
     Without OpenMP the ``*_batch_threads`` functions run on one thread (same results).
     """
     flags = (*CFLAGS, "-fopenmp")
-    probe = "int rd_openmp_probe(void) {\n#ifdef _OPENMP\n    return 1;\n#else\n    return 0;\n#endif\n}\n"
+    # a throwaway compilation outside the cache (which holds models only)
     try:
-        lib = compile_library(probe, "int rd_openmp_probe(void);", flags=flags)
-    except (RuntimeError, OSError):  # no compiler (CompilerNotFoundError) or no -fopenmp
+        compiler = find_compiler()
+    except CompilerNotFoundError:
         return CFLAGS
-    return flags if lib.lib.rd_openmp_probe() == 1 else CFLAGS
+    with tempfile.TemporaryDirectory() as tmp:
+        src = Path(tmp) / "probe.c"
+        src.write_text("#ifndef _OPENMP\n#error no OpenMP\n#endif\nint rd_openmp_probe(void) { return 1; }\n")
+        proc = subprocess.run([compiler, *flags, str(src), "-o", str(Path(tmp) / "probe.so")],
+                              capture_output=True, check=False)
+    return flags if proc.returncode == 0 else CFLAGS
 
 
 def _touch(*paths: Path) -> None:
