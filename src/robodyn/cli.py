@@ -38,7 +38,6 @@ from robodyn.report.agreement import (
     derive_all,
     verdict,
 )
-from robodyn.report.demo import run_demo
 from robodyn.report.text import err as _err
 from robodyn.report.text import progress as _progress
 from robodyn.report.text import steps as _steps
@@ -194,6 +193,8 @@ def _cmd_export(args: argparse.Namespace) -> int:
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
+    from robodyn.report.demo import run_demo
+
     return run_demo(args.output, args.samples, args.seed)
 
 

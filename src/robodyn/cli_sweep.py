@@ -11,11 +11,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from robodyn.report.html import page
-from robodyn.report.study_report import study_figures, study_section
-from robodyn.study.study_file import read_study
-from robodyn.study.sweep import SweepInterrupted, sweep, write_table
-
 __all__ = ["add_sweep_parser"]
 
 
@@ -27,6 +22,11 @@ def _positive(text: str) -> int:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
+    from robodyn.report.html import page
+    from robodyn.report.study_report import study_figures, study_section
+    from robodyn.study.study_file import read_study
+    from robodyn.study.sweep import SweepInterrupted, sweep, write_table
+
     study = read_study(args.study)
     out = Path(args.output)
     try:

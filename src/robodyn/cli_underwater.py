@@ -11,8 +11,7 @@ from __future__ import annotations
 import argparse
 
 import robodyn as rd
-from robodyn.hydro.study import DEFAULT_CURRENT, EFFECTS, effect_series
-from robodyn.hydro.study_plots import write_study
+from robodyn.hydro.effects import DEFAULT_CURRENT, EFFECTS
 
 __all__ = ["add_underwater_parser"]
 
@@ -35,6 +34,9 @@ def _assignment(text: str) -> tuple[str, float]:
 
 
 def _cmd_underwater(args: argparse.Namespace) -> int:
+    from robodyn.hydro.study import effect_series
+    from robodyn.hydro.study_plots import write_study
+
     robot = rd.load(args.robot)
     series = effect_series(
         robot, start=args.start, end=args.end, move_time=args.move_time,

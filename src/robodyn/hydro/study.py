@@ -49,6 +49,7 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
+from robodyn.hydro.effects import DEFAULT_CURRENT, EFFECTS, LABELS
 from robodyn.hydro.schema import fluid_of
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import StudyError
@@ -68,15 +69,6 @@ __all__ = [
     "effect_variant",
 ]
 
-#: The series, in order: each variant adds one effect to the one before.
-EFFECTS: tuple[str, ...] = ("dry", "buoyancy", "added_mass", "drag", "lift", "current")
-LABELS: Mapping[str, str] = {
-    "dry": "dry (in air)", "buoyancy": "+ buoyancy", "added_mass": "+ added mass",
-    "drag": "+ drag", "lift": "+ lift", "current": "+ current",
-}
-#: Current of the ``current`` variant when neither the call nor the description gives one:
-#: 0.5 m/s along base x (a moderate tidal current), ASSUMED.
-DEFAULT_CURRENT: tuple[float, float, float] = (0.5, 0.0, 0.0)
 #: Coefficients each effect switches on (the others are set to zero before it).
 _COEFFICIENTS: Mapping[str, tuple[str, ...]] = {
     "added_mass": ("added_mass", "axial_added_mass"), "drag": ("drag", "skin_friction"),
