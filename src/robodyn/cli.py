@@ -212,7 +212,10 @@ def _parser() -> argparse.ArgumentParser:
         description="Equations of motion of serial robot manipulators: derive them by "
                     "Newton-Euler, Lagrange or Kane and check the formulations against each "
                     "other; generate simulation code, simulate with controllers, export to "
-                    "URDF/MJCF; calibrate the kinematics from measured end-effector positions.",
+                    "URDF/MJCF; read measured recordings (CSV, ROS 2 bags), design excitation, "
+                    "identify and validate the model against measurements; calibrate the "
+                    "kinematics from measured end-effector positions; model arms under water; "
+                    "run parameter studies on Dask.",
         epilog="examples:\n"
                "  robodyn list\n"
                "  robodyn show puma560\n"
