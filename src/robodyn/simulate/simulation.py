@@ -17,13 +17,14 @@ Methods
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from robodyn.numeric.model import Model
+from robodyn.numeric.model import MAX_INTEGRATE_BYTES, Model
 from robodyn.robot.errors import SimulationError
 from robodyn.simulate.controllers import Controller
 from robodyn.simulate.energy import potential_energy
@@ -45,17 +46,20 @@ ControllerLike = Controller | Callable[[float, np.ndarray, np.ndarray], np.ndarr
 class Trajectory:
     """A simulated motion, sampled every ``dt`` (all arrays read-only).
 
+    ``S`` samples; a run from a batch of ``N`` initial states (``q0`` of shape (N, n)) carries
+    the batch axis first on every array but ``t``.
+
     Attributes
     ----------
-    t : (N,) ndarray
+    t : (S,) ndarray
         Time, s.
-    q, qd, qdd : (N, n) ndarray
+    q, qd, qdd : (S, n) or (N, S, n) ndarray
         Joint positions (rad, m), velocities and accelerations.
-    tau : (N, n) ndarray
+    tau : (S, n) or (N, S, n) ndarray
         Joint torques/forces (N m, N): with a fixed-step method, ``tau[k]`` is the torque held
         over ``[t_k, t_k+1)``; the last row is the law at the final state. ``qdd[k]`` is the
         acceleration at ``(q[k], qd[k], tau[k])``.
-    kinetic, potential, energy : (N,) ndarray
+    kinetic, potential, energy : (S,) or (N, S) ndarray
         ``0.5 qd^T M(q) qd`` (rotor inertia included), gravitational ``V(q)`` (see
         :func:`robodyn.simulate.energy.potential_energy`) and their sum, J.
     method : str
@@ -66,7 +70,7 @@ class Trajectory:
     robot : str
     backend : str
     evaluations : int
-        Right-hand-side evaluations (``state_derivative`` calls).
+        Right-hand-side evaluations (``state_derivative`` calls), per trajectory.
     decimate : int
         Every ``decimate``-th step was kept.
     """
@@ -89,31 +93,56 @@ class Trajectory:
 
     @property
     def x(self) -> np.ndarray:
-        """States ``[q, qd]``, (N, 2 n)."""
-        return np.hstack([self.q, self.qd])
+        """States ``[q, qd]``, (S, 2 n) or (N, S, 2 n)."""
+        return np.concatenate([self.q, self.qd], axis=-1)
 
     @property
-    def energy_drift(self) -> float:
-        """``max |E(t) - E(0)| / max(|E(0)|, max K)``: the relative energy error of a passive run."""
-        scale = max(abs(float(self.energy[0])), float(np.max(self.kinetic)), 1e-300)
-        return float(np.max(np.abs(self.energy - self.energy[0])) / scale)
+    def batch(self) -> int | None:
+        """Number of trajectories of a batch run, None for a single run."""
+        return self.q.shape[0] if self.q.ndim == 3 else None
+
+    @property
+    def energy_drift(self) -> float | np.ndarray:
+        """``max |E(t) - E(0)| / max(|E(0)|, max K)``: the relative energy error of a passive run
+        (a float, or (N,) for a batch)."""
+        e0 = self.energy[..., 0]
+        scale = np.maximum(np.maximum(np.abs(e0), np.max(self.kinetic, axis=-1)), 1e-300)
+        drift = np.max(np.abs(self.energy - e0[..., None]), axis=-1) / scale
+        return float(drift) if drift.ndim == 0 else drift
+
+    def member(self, i: int) -> Trajectory:
+        """Trajectory ``i`` of a batch run, as a single-run :class:`Trajectory` (views)."""
+        if self.batch is None:
+            raise ValueError("member: this trajectory is a single run, not a batch")
+        if not -self.batch <= i < self.batch:
+            raise IndexError(f"member: index {i} out of range for a batch of {self.batch}")
+        return dataclasses.replace(
+            self, q=self.q[i], qd=self.qd[i], qdd=self.qdd[i], tau=self.tau[i],
+            kinetic=self.kinetic[i], potential=self.potential[i], energy=self.energy[i])
 
 
 def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: float, dt: float,
              method: str = "rk4", controller: ControllerLike = None, *,
              tau_limit: float | np.ndarray | None = None, rtol: float = 1e-9,
              atol: float = 1e-12, control: str = "sampled", decimate: int = 1,
-             max_samples: int | None = MAX_SAMPLES, substeps: int = 1) -> Trajectory:
+             max_samples: int | None = MAX_SAMPLES, substeps: int = 1,
+             threads: int = 1) -> Trajectory:
     """Simulate ``model`` from ``(q0, qd0)`` for ``duration`` seconds.
+
+    A batch of ``N`` initial states (``q0`` of shape (N, n)) is integrated in one call into the
+    generated C per piece of the run (:meth:`Model.integrate` on an ensemble, SIMD across
+    trajectories), under the same controller: a fixed-step method with ``control="sampled"``,
+    ``substeps=1`` and no controller or a built-in one using the plant's model. Each trajectory
+    equals its own single run (to 1e-12); the result's arrays gain a leading N.
 
     Parameters
     ----------
     model : Model
         From :func:`robodyn.compile_model` (either backend).
-    q0 : (n,) array_like
-        Initial joint positions (rad, m).
-    qd0 : (n,) array_like or None
-        Initial velocities (None: at rest).
+    q0 : (n,) or (N, n) array_like
+        Initial joint positions (rad, m), or a batch of N of them.
+    qd0 : (n,) or (N, n) array_like or None
+        Initial velocities, the shape of ``q0`` (None: at rest).
     duration : float
         s, a whole number of steps ``dt``.
     dt : float
@@ -147,16 +176,21 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         loop over the control steps then runs in Python). For a plant stiffer than the control
         rate: RK4 is stable only while ``|lambda| dt < 2.79`` for every mode ``lambda`` of the
         held-torque dynamics (e.g. viscous friction over a small wrist inertia, ``-b / m``).
+    threads : int
+        Threads of a batch run (C backend with OpenMP); the result does not depend on it.
 
     Returns
     -------
     Trajectory
+        Arrays of shape (S, ...) for one initial state, (N, S, ...) for a batch.
 
     Raises
     ------
     ValueError
         Wrong shapes, non-finite values, non-positive ``dt`` or ``duration``, unknown method,
-        more samples than ``max_samples``, a controller model with another number of joints.
+        more samples than ``max_samples`` (counted over all trajectories of a batch), a
+        controller model with another number of joints, a batch with a method, control,
+        ``substeps`` or controller that the ensemble integrator does not run.
     TypeError
         A controller that is neither built-in nor callable.
     SimulationError
@@ -164,8 +198,14 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         :class:`~robodyn.robot.errors.SingularMassMatrixError` when the mass matrix is singular.
     """
     n = model.dof
-    q0 = _vector(q0, n, "q0")
-    qd0 = np.zeros(n) if qd0 is None else _vector(qd0, n, "qd0")
+    batch = np.ndim(q0) == 2
+    if batch:
+        q0 = _states(q0, n, "q0")
+        qd0 = np.zeros_like(q0) if qd0 is None else _states(qd0, n, "qd0", len(q0))
+    else:
+        q0 = _vector(q0, n, "q0")
+        qd0 = np.zeros(n) if qd0 is None else _vector(qd0, n, "qd0")
+    count = len(q0) if batch else 1
     dt = _positive(dt, "dt")
     duration = _positive(duration, "duration")
     steps = round(duration / dt)
@@ -178,13 +218,16 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         raise ValueError(f"simulate: duration {duration:g} s is {steps} steps of {dt:g} s, not a "
                          f"whole number of decimate = {decimate} steps")
     samples = steps // decimate + 1
-    if max_samples is not None and samples > max_samples:
+    if max_samples is not None and count * samples > max_samples:
+        # a batch keeps its samples for every trajectory
+        per_run = max_samples // count
+        each = f"{count} x {samples:,}" if batch else f"{samples:,}"
+        k_min = -(-steps // (per_run - 1)) if per_run > 1 else steps
         raise ValueError(
-            f"simulate: {duration:g} s at dt = {dt:g} s keeps {samples:,} samples (about "
-            f"{output_bytes(samples, n) / 1e6:,.0f} MB of arrays), above max_samples = "
-            f"{max_samples:,}; keep every k-th step with decimate=k (k >= "
-            f"{-(-steps // (max_samples - 1)) if max_samples > 1 else steps}), shorten the run, "
-            "or raise max_samples")
+            f"simulate: {duration:g} s at dt = {dt:g} s keeps {each} samples (about "
+            f"{output_bytes(count * samples, n) / 1e6:,.0f} MB of arrays), above max_samples = "
+            f"{max_samples:,}; keep every k-th step with decimate=k (k >= {k_min}), shorten the "
+            f"run{', split the batch' if batch else ''}, or raise max_samples")
     if isinstance(substeps, bool) or not isinstance(substeps, int | np.integer) or substeps < 1:
         raise ValueError(f"simulate: substeps must be a positive integer, got {substeps!r}")
     if substeps > 1 and (control != "sampled" or method not in FIXED_STEP):
@@ -205,6 +248,8 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
     if limit is None and isinstance(controller, Controller) and controller.tau_limit is not None:
         limit = _tau_limit(controller.tau_limit, n)
     own = _controller_model(controller, model)
+    if batch:
+        _check_batch(method, control, substeps, controller, own)
     if own is not None:
         # the law with the controller's own model, stepped in Python
         ctrl = controller
@@ -217,6 +262,15 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
     t = dt * np.arange(0, steps + 1, decimate)
     x0 = np.concatenate([q0, qd0])
     continuous = control == "continuous"
+    if batch:
+        x0 = np.concatenate([q0, qd0], axis=1)
+        try:
+            x, tau, evals = _fixed_step_batch(model, x0, steps, dt, decimate, method, controller,
+                                              limit, threads)
+        except SimulationError as exc:
+            i = getattr(exc, "trajectory", 0)
+            raise _diagnosed(exc, model, x0[i], dt, method, control) from None
+        return _result(model, t, x, tau, method, dt, controller, evals, decimate)
     try:
         if method in FIXED_STEP and substeps == 1 and (controller is None
                                                        or isinstance(controller, Controller)):
@@ -305,6 +359,79 @@ def _fixed_step_c(model: Model, x0: np.ndarray, steps: int, dt: float, decimate:
             z = z + dt * controller.position_error(t_end, x[:n])
         last = controller.law(model, t_end, x, z if integral else None)
     tau_out[-1] = _clip(last, limit)
+    return x_out, tau_out, steps * (4 if method == "rk4" else 1)
+
+
+def _check_batch(method: str, control: str, substeps: int, controller: ControllerLike,
+                 own: Model | None) -> None:
+    """Refuse a batch run that the ensemble integrator cannot do in C."""
+    why = None
+    if method not in FIXED_STEP:
+        why = f"method={method!r} (solve_ivp, adaptive steps per trajectory)"
+    elif control != "sampled":
+        why = f"control={control!r} (the law at every RK4 stage)"
+    elif substeps != 1:
+        why = f"substeps={substeps} (a Python loop over the control steps)"
+    elif controller is not None and not isinstance(controller, Controller):
+        why = f"a Python callable controller ({_name(controller)})"
+    elif own is not None:
+        why = f"a {controller.name} with its own model (its law steps in Python)"
+    if why is not None:
+        raise ValueError(
+            "simulate: a batch of initial states (q0 of shape (N, n)) runs in one generated-C "
+            "call per piece, with method 'rk4' or 'semi_implicit', control='sampled', "
+            f"substeps=1 and no controller or a built-in one on the plant's model; {why} is not "
+            "supported there: simulate each row of q0 on its own")
+
+
+def _fixed_step_batch(model: Model, x0: np.ndarray, steps: int, dt: float, decimate: int,
+                      method: str, controller: Controller | None, limit: np.ndarray | None,
+                      threads: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """N trajectories from ``x0`` (N, 2 n) under one sampled law: the ensemble integrator.
+
+    Returns ``x`` (N, S, 2 n), ``tau`` (N, S, n) and the evaluations per trajectory. The run is
+    split in pieces of about CHUNK_STEPS states in all (the steps of one piece times N); each
+    piece continues from the last states, so the pieces do not change the result. A PID runs as
+    one piece (its integral restarts in each call, and the earlier pieces' integral, different
+    for every trajectory, cannot enter as the shared feedforward).
+    """
+    count, n = x0.shape[0], model.dof
+    integral = controller is not None and controller.has_integral
+    chunk = steps if integral else max(1, CHUNK_STEPS // count)
+    size = 8 * (steps + 1) * 3 * n * count
+    if integral and size > MAX_INTEGRATE_BYTES:
+        raise ValueError(f"simulate: a batch under a PID runs in one call, and {count} x {steps:,} "
+                         f"steps need {size / 2**20:,.0f} MiB, above {MAX_INTEGRATE_BYTES / 2**20:,.0f} "
+                         "MiB; split the batch or shorten the run")
+    keep = steps // decimate + 1
+    x_out, tau_out = np.empty((count, keep, 2 * n)), np.empty((count, keep, n))
+    x_out[:, 0] = x0
+    x = x0
+    for k0 in range(0, steps, chunk):
+        m = min(chunk, steps - k0)
+        times = dt * np.arange(k0, k0 + m)
+        kwargs = {} if controller is None else controller.sampled(model, times)
+        xs, taus = model.integrate(x, m, dt, method, tau_limit=limit, threads=threads, **kwargs)
+        # global step k is kept when k % decimate == 0
+        first = -k0 % decimate
+        x_out[:, (k0 + first) // decimate: (k0 + m) // decimate + 1] = xs[:, first::decimate]
+        tau_rows = taus[:, first::decimate]
+        start = (k0 + first) // decimate
+        tau_out[:, start: start + tau_rows.shape[1]] = tau_rows
+        x = xs[:, -1]
+    t_end = steps * dt
+    for i in range(count):
+        # the last row: the law at the final state, as a single run computes it
+        if controller is None:
+            last = np.zeros(n)
+        elif integral:
+            # z = dt sum_k (q_ref(t_k) - q_k) over the steps and the final sample
+            z = dt * np.sum(kwargs["reference"][:, :n] - xs[i, :-1, :n], axis=0)
+            z = z + dt * controller.position_error(t_end, x[i, :n])
+            last = controller.law(model, t_end, x[i], z)
+        else:
+            last = controller.law(model, t_end, x[i], None)
+        tau_out[i, -1] = _clip(last, limit)
     return x_out, tau_out, steps * (4 if method == "rk4" else 1)
 
 
@@ -442,15 +569,19 @@ def _adaptive(model: Model, x0: np.ndarray, t: np.ndarray, method: str, controll
 def _result(model: Model, t: np.ndarray, x: np.ndarray, tau: np.ndarray, method: str, dt: float,
             controller: ControllerLike, evals: int, decimate: int) -> Trajectory:
     n = model.dof
-    q, qd = np.ascontiguousarray(x[:, :n]), np.ascontiguousarray(x[:, n:])
-    qdd = model.forward_dynamics(q, qd, tau)
-    kinetic = np.empty(t.size)
-    for k0 in range(0, t.size, CHUNK_STEPS):
-        # K = 0.5 qd^T M qd (M in pieces: (N, n, n) would dwarf the trajectory)
+    lead = x.shape[:-1]  # (S,) or (N, S) for a batch
+    q, qd = np.ascontiguousarray(x[..., :n]), np.ascontiguousarray(x[..., n:])
+    # the kernels on the samples of all trajectories as one (N S, n) batch
+    qf, qdf = q.reshape(-1, n), qd.reshape(-1, n)
+    qdd = model.forward_dynamics(qf, qdf, tau.reshape(-1, n)).reshape(q.shape)
+    kinetic = np.empty(qf.shape[0])
+    for k0 in range(0, qf.shape[0], CHUNK_STEPS):
+        # K = 0.5 qd^T M qd (M in pieces: (S, n, n) would dwarf the trajectory)
         part = slice(k0, k0 + CHUNK_STEPS)
-        kinetic[part] = 0.5 * np.einsum("ki,kij,kj->k", qd[part], model.mass_matrix(q[part]),
-                                        qd[part])
-    potential = potential_energy(model, q)
+        kinetic[part] = 0.5 * np.einsum("ki,kij,kj->k", qdf[part], model.mass_matrix(qf[part]),
+                                        qdf[part])
+    kinetic = kinetic.reshape(lead)
+    potential = potential_energy(model, qf).reshape(lead)
     arrays = [t, q, qd, qdd, tau, kinetic, potential, kinetic + potential]
     for a in arrays:
         a.flags.writeable = False
@@ -486,6 +617,19 @@ def _vector(v: np.ndarray, n: int, name: str) -> np.ndarray:
         raise ValueError(f"simulate: {name} must have shape ({n},), got {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"simulate: {name} contains non-finite values")
+    return arr
+
+
+def _states(v: np.ndarray, n: int, name: str, count: int | None = None) -> np.ndarray:
+    """A batch of states (N, n), checked (``count``: the required N)."""
+    arr = np.asarray(v, dtype=float)
+    if arr.ndim != 2 or arr.shape[1] != n or arr.shape[0] < 1 or (count is not None
+                                                                   and arr.shape[0] != count):
+        want = f"({count}, {n})" if count is not None else f"(N, {n}) with N >= 1"
+        raise ValueError(f"simulate: {name} must have shape {want}, got {arr.shape}")
+    bad = np.flatnonzero(~np.all(np.isfinite(arr), axis=1))
+    if bad.size:
+        raise ValueError(f"simulate: {name} contains non-finite values (row {int(bad[0])})")
     return arr
 
 
