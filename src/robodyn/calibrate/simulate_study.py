@@ -9,15 +9,15 @@ checked on ``n_test`` other poses: "before" is the nominal kinematics with the t
 and target offset fitted, "after" the calibrated model; held-out errors are against the noisy
 measurements (what a user sees) and against the noise-free truth.
 
-The errors are not drawn in the parameters of any one error model, but they are purely
-geometric: a rigid error of each joint placement and a joint zero offset. Such a "true" robot
-lies inside the span of every *complete* model (Hayati, S-model, POE), which can therefore
-represent it exactly and is only limited by the noise here: this study does not show how a
-model copes with errors outside its span (see ``tests/calibrate/test_nongeometric.py`` for a
-truth with joint compliance and transmission errors, which no geometric model spans). Only standard DH, which is not complete, shows a model error: it has no
-rotation about the common normal's perpendicular at the parallel joints 2 and 3 of the PUMA, and
-its ``d2`` and ``d3`` only enter as their sum. Non-geometric errors (joint compliance,
-transmission errors) are not simulated in this function.
+The errors are not drawn in the parameters of any one error model, but they are purely geometric:
+a rigid error of each joint placement and a joint zero offset. Such a "true" robot lies inside the
+span of every *complete* model (Hayati, S-model, POE), which can therefore represent it exactly
+and is only limited by the noise here: this study does not show how a model copes with errors
+outside its span (see ``tests/calibrate/test_nongeometric.py`` for a truth with joint compliance
+and transmission errors, which no geometric model spans). Only standard DH, which is not complete,
+shows a model error: it has no rotation about the common normal's perpendicular at the parallel
+joints 2 and 3 of the PUMA, and its ``d2`` and ``d3`` only enter as their sum. Non-geometric
+errors (joint compliance, transmission errors) are not simulated in this function.
 """
 
 from __future__ import annotations
