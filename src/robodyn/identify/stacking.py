@@ -1,7 +1,9 @@
 """The stacked identification matrix ``W`` (N n, p): the batched compiled regressor, chunked.
 
 ``W[k n + i, :] = Y(q_k, qd_k, qdd_k)[i, columns]``: one row per joint ``i`` per sample ``k``
-(sample-major). The regressor is evaluated in chunks of ``CHUNK`` samples written into one
+(sample-major). With all columns the batched kernel writes ``W`` itself in one call: its
+(N, n, 15 n) output is ``W`` in memory, reshaped without a copy. With a column selection the
+regressor is evaluated in chunks of ``CHUNK`` samples, each chunk's kept columns copied into one
 preallocated matrix, so that stacking 100,000 samples of a 7-joint arm does not first build a
 second full-size temporary.
 """
@@ -20,7 +22,7 @@ CHUNK = 4096
 
 
 def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
-                          columns: Sequence[int] | None = None) -> np.ndarray:
+                          columns: Sequence[int] | None = None, *, threads: int = 1) -> np.ndarray:
     """Stacked regressor.
 
     Parameters
@@ -31,6 +33,8 @@ def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.n
         rad, rad/s, rad/s^2 (m, m/s, m/s^2 for prismatic joints).
     columns : sequence of int, optional
         Regressor columns to keep (default all ``15 n``).
+    threads : int
+        Threads of the batched kernel (C backend with OpenMP; the result does not depend on it).
 
     Returns
     -------
@@ -38,12 +42,13 @@ def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.n
     """
     q, qd, qdd = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (q, qd, qdd))
     count, n = q.shape
-    cols = None if columns is None else np.asarray(columns, dtype=int)
-    width = 15 * n if cols is None else cols.size
-    out = np.empty((count * n, width))
+    if columns is None:
+        # (N, n, 15 n) C-order is (N n, 15 n): a view, not a copy
+        return model.regressor(q, qd, qdd, threads=threads).reshape(count * n, -1)
+    cols = np.asarray(columns, dtype=int)
+    out = np.empty((count * n, cols.size))
     for start in range(0, count, CHUNK):
         stop = min(start + CHUNK, count)
-        y = model.regressor(q[start:stop], qd[start:stop], qdd[start:stop])
-        block = y.reshape((stop - start) * n, -1)
-        out[start * n:stop * n] = block if cols is None else block[:, cols]
+        y = model.regressor(q[start:stop], qd[start:stop], qdd[start:stop], threads=threads)
+        out[start * n:stop * n] = y.reshape((stop - start) * n, -1)[:, cols]
     return out
