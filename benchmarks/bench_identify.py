@@ -11,7 +11,7 @@ Prints, in one run:
   2. whole identifications of the Kinova whole-arm runs (all three, motor current) with
      ``rd.identify`` for OLS, WLS and the physically consistent SDP, in seconds each.
 
-Run: ``.venv/bin/python benchmarks/bench_identify.py [--samples N] [--repeat N]``.
+Run: ``.venv/bin/python benchmarks/bench_identify.py [--samples N] [--repeat N] [--stacking-only]``.
 """
 
 from __future__ import annotations
@@ -51,6 +51,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=100_000)
     parser.add_argument("--repeat", type=int, default=3, help="timing repeats (best is kept)")
+    parser.add_argument("--stacking-only", action="store_true", help="skip the whole identifications")
     args = parser.parse_args()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -61,9 +62,18 @@ def main() -> None:
     q, qd, qdd = rng.uniform(-2, 2, (3, count, n))
 
     t_rd, y = best_of(lambda: identification_matrix(model, q, qd, qdd), args.repeat)
+    t_rd2, y2 = best_of(lambda: identification_matrix(model, q, qd, qdd, threads=2), args.repeat)
+    assert np.array_equal(y, y2), "threads changed the identification matrix"
+    y2 = None
     print(f"stacking {count} Gen3 samples ({count * n} x {y.shape[1]}):")
     print(f"  robodyn identification_matrix (batched C)  {t_rd:8.3f} s  "
           f"{1e9 * t_rd / count:8.0f} ns/sample")
+    print(f"  the same on 2 threads                       {t_rd2:8.3f} s  "
+          f"{1e9 * t_rd2 / count:8.0f} ns/sample")
+    # the floor: writing a fresh matrix of the same size with NumPy (page faults + stores)
+    t_fill, _ = best_of(lambda: np.full(y.shape, 1.0), args.repeat)
+    print(f"  NumPy np.full of the same shape (memory)    {t_fill:8.3f} s  "
+          f"{1e9 * t_fill / count:8.0f} ns/sample")
     try:
         import pinocchio as pin
     except ImportError:
@@ -83,11 +93,14 @@ def main() -> None:
         t_pin, w = best_of(loop, 1)
         print(f"  Pinocchio computeJointTorqueRegressor loop    {t_pin:8.3f} s  "
               f"{1e9 * t_pin / count:8.0f} ns/sample")
-        print(f"  ratio Pinocchio / robodyn: {t_pin / t_rd:.1f}x (target >= 10x)")
+        print(f"  ratio Pinocchio / robodyn: {t_pin / t_rd:.1f}x on 1 thread, {t_pin / t_rd2:.1f}x on 2 "
+              "(target >= 10x)")
         cols = [PER_JOINT * j + k for j in range(n) for k in PIN_ORDER]
         dev = np.abs(y[:, cols] - w).max() / np.abs(w).max()
         print(f"  rigid-body columns agree to {dev:.1e} (relative to the largest entry)")
 
+    if args.stacking_only:
+        return
     runs = [read(p) for p in WHOLE_ARM_FILES]
     print(f"whole identification, Kinova whole-arm runs ({sum(r.n_samples for r in runs)} samples, "
           f"target current, defaults):")
