@@ -13,14 +13,13 @@ each, the 2-worker scaling ratio, and the Dask per-case overhead against a case'
 from __future__ import annotations
 
 import argparse
-import logging
 import time
 from concurrent.futures import ProcessPoolExecutor
 
 from robodyn.study import LatinHypercube, expand_cases, run_batch, sweep
 from robodyn.study.models import RobotSource
 from robodyn.study.sizing import ActuatorSizing
-from robodyn.study.sweep import batches
+from robodyn.study.sweep import batches, local_cluster
 
 
 def _task() -> ActuatorSizing:
@@ -37,7 +36,7 @@ def main() -> None:
     ap.add_argument("--cases", type=int, default=600)
     ap.add_argument("--batch", type=int, default=50)
     args = ap.parse_args()
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     task = _task()
     # one payload: the model is compiled once per worker; the bandwidth changes every case
@@ -63,9 +62,7 @@ def main() -> None:
           f"speed-up {t_serial / t_pool:.2f}x")
     walls = {}
     for n in (1, 2):
-        with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                          dashboard_address=None, silence_logs=logging.ERROR) as cluster, \
-                Client(cluster, set_as_default=False) as client:
+        with local_cluster(n) as cluster, Client(cluster, set_as_default=False) as client:
             client.run(_warm, 0)
             t0 = time.perf_counter()
             table = sweep(task, cases, client=client, batch=args.batch, seed=None)
