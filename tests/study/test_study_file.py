@@ -92,3 +92,22 @@ parameters:
     html = (out / "study.html").read_text()
     assert "4 cases" in html and "0 failed" in html and "data:image/png" in html
     assert (out / "study_map.png").is_file() and (out / "study_histogram.png").is_file()
+
+
+def test_identification_and_underwater_tasks_run_from_study_files(tmp_path):
+    from robodyn.study import run_serial
+    from robodyn.study.identification_mc import IdentificationMonteCarlo
+    from robodyn.study.underwater_task import UnderwaterEffects
+
+    ident = read_study(_write(tmp_path, "task: identification_monte_carlo\nrobot: planar_2r\n"
+                              "parameters:\n  torque_noise: [0.0, 0.5]\nseed: 1\n", "ident.yaml"))
+    assert isinstance(ident.task, IdentificationMonteCarlo)
+    table = run_serial(ident.task, ident.cases, seed=ident.seed)
+    assert list(table["torque_noise"]) == [0.0, 0.5] and table["error"].isna().all()
+    # more torque noise, larger parameter error
+    assert table["inertial_error"].iloc[1] > table["inertial_error"].iloc[0]
+    uw = read_study(_write(tmp_path, "task: underwater_effects\nparameters:\n  Cd: [0.5, 4.0]\n",
+                           "uw.yaml"))
+    assert isinstance(uw.task, UnderwaterEffects)
+    with pytest.raises(StudyError, match="task: expected one of .*identification_monte_carlo"):
+        read_study(_write(tmp_path, "task: nonesuch\nparameters:\n  a: [1]\n", "bad.yaml"))

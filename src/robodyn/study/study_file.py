@@ -33,14 +33,18 @@ import yaml
 from robodyn.robot.errors import StudyError
 from robodyn.study.calibration_mc import CalibrationMonteCarlo
 from robodyn.study.cases import Grid, LatinHypercube, RandomSampler, Range
+from robodyn.study.identification_mc import IdentificationMonteCarlo
 from robodyn.study.models import RobotSource
 from robodyn.study.sizing import ActuatorSizing
+from robodyn.study.underwater_task import UnderwaterEffects
 
 __all__ = ["TASKS", "Study", "read_study"]
 
 #: Study-file task names and the task classes they build.
 TASKS: Mapping[str, type] = {"actuator_sizing": ActuatorSizing,
-                             "calibration_monte_carlo": CalibrationMonteCarlo}
+                             "calibration_monte_carlo": CalibrationMonteCarlo,
+                             "identification_monte_carlo": IdentificationMonteCarlo,
+                             "underwater_effects": UnderwaterEffects}
 _KEYS = ("task", "robot", "tool", "settings", "parameters", "sampler", "repeat", "seed", "batch", "plot")
 _SAMPLERS: Mapping[str, Callable[..., Any]] = {"latin_hypercube": LatinHypercube, "random": RandomSampler}
 
