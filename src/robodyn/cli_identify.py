@@ -17,17 +17,10 @@ import numpy as np
 from tqdm import tqdm
 
 import robodyn as rd
+from robodyn.cli_workflows import floats
 from robodyn.report.text import err, progress
 
 __all__ = ["add_parsers"]
-
-
-def _floats(text: str) -> np.ndarray:
-    """A comma-separated list of numbers (``9.13,9.13,5.85``); an argparse type."""
-    try:
-        return np.array([float(v) for v in text.replace(" ", "").split(",") if v], dtype=float)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
 
 
 def _gains(value: np.ndarray | None, n: int) -> np.ndarray | None:
@@ -240,7 +233,7 @@ def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
     p.add_argument("--method", choices=("ols", "wls", "consistent"), default="wls",
                    help="estimator: ordinary or weighted least squares, or physically consistent "
                         "(pseudo-inertia LMIs) (default: %(default)s)")
-    p.add_argument("--gains", type=_floats, metavar="K",
+    p.add_argument("--gains", type=floats, metavar="K",
                    help="drive gains, joint torque per motor ampere (N m/A), one or one per joint, "
                         "for --target current: fixed instead of absorbed per joint")
     p.add_argument("--friction", default="linear", choices=FRICTION_MODELS,
@@ -270,7 +263,7 @@ def _validate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
     p.add_argument("robot", metavar="ROBOT", help=robot_help)
     p.add_argument("--data", required=True, nargs="+", metavar="FILE",
                    help="recordings (CSV, CSV.gz or MCAP)")
-    p.add_argument("--gains", type=_floats, metavar="K",
+    p.add_argument("--gains", type=floats, metavar="K",
                    help="joint torque per motor ampere, N m/A, one or one per joint (default: the "
                         "description's gear ratio x torque constant)")
     p.add_argument("--noise-cutoff", type=float, default=10.0, metavar="HZ",

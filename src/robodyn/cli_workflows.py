@@ -20,7 +20,7 @@ from robodyn.report.text import err, progress, table
 __all__ = ["add_parsers"]
 
 
-def _floats(text: str) -> np.ndarray:
+def floats(text: str) -> np.ndarray:
     """A comma-separated list of numbers (``0,0.5,-1``); an argparse type."""
     try:
         return np.array([float(v) for v in text.replace(" ", "").split(",") if v], dtype=float)
@@ -276,8 +276,8 @@ def _simulate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
                "--target 0.8,-0.6,0.9,0.5,-0.7,1 --duration 3 -o sim/\n"
                "  robodyn simulate planar_2r --method DOP853 --q0 1,0 -o sim/")
     p.add_argument("robot", metavar="ROBOT", help=robot_help)
-    p.add_argument("--q0", type=_floats, metavar="Q", help="initial positions, rad/m (default 0)")
-    p.add_argument("--qd0", type=_floats, metavar="QD", help="initial velocities (default 0)")
+    p.add_argument("--q0", type=floats, metavar="Q", help="initial positions, rad/m (default 0)")
+    p.add_argument("--qd0", type=floats, metavar="QD", help="initial velocities (default 0)")
     p.add_argument("--duration", type=float, default=2.0, metavar="S",
                    help="simulated time, s (default: %(default)s)")
     p.add_argument("--dt", type=float, default=1e-3, metavar="S",
@@ -288,20 +288,20 @@ def _simulate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
     p.add_argument("--controller", default="none",
                    choices=("none", "pd", "pid", "gravity", "computed-torque"),
                    help="control law (default: %(default)s, i.e. no actuator torque)")
-    p.add_argument("--target", type=_floats, metavar="Q",
+    p.add_argument("--target", type=floats, metavar="Q",
                    help="final joint positions of a quintic move from q0 (default: hold q0)")
     p.add_argument("--move-time", type=float, metavar="S",
                    help="duration of the move, s (default: half of --duration)")
-    p.add_argument("--kp", type=_floats, metavar="K",
+    p.add_argument("--kp", type=floats, metavar="K",
                    help="stiffness per joint (default 100; 400 1/s^2 for computed torque)")
-    p.add_argument("--kd", type=_floats, metavar="K",
+    p.add_argument("--kd", type=floats, metavar="K",
                    help="damping per joint (default 20; 40 1/s for computed torque)")
-    p.add_argument("--ki", type=_floats, metavar="K", help="integral gain (pid; default 0)")
+    p.add_argument("--ki", type=floats, metavar="K", help="integral gain (pid; default 0)")
     p.add_argument("--control", choices=("sampled", "continuous"), default="sampled",
                    help="fixed-step methods: evaluate the law once per step and hold it (a "
                         "digital controller at 1/dt), or at every RK4 stage (continuous-time) "
                         "(default: %(default)s)")
-    p.add_argument("--tau-limit", type=_floats, metavar="T", help="actuator limits, N m or N")
+    p.add_argument("--tau-limit", type=floats, metavar="T", help="actuator limits, N m or N")
     p.add_argument("--backend", choices=("c", "numpy"), default="c",
                    help="compiled C (needs a C compiler) or pure NumPy (no compiler; slower) "
                         "(default: %(default)s)")
@@ -384,6 +384,6 @@ def _iso9283_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--approach", metavar="FILE.csv", help="measured approach trajectory")
     p.add_argument("--band", type=float, default=0.1, metavar="MM",
                    help="stabilisation band, mm (default: %(default)s)")
-    p.add_argument("--attained", type=_floats, metavar="X,Y,Z",
+    p.add_argument("--attained", type=floats, metavar="X,Y,Z",
                    help="the attained pose, m (default: the mean of the last 10 %% of samples)")
     p.set_defaults(func=_cmd_iso9283)
