@@ -16,9 +16,12 @@ from types import MappingProxyType
 from robodyn.robot.errors import DescriptionError, DescriptionWarning
 from robodyn.robot.model import Robot
 
-__all__ = ["KNOWN_PROPERTIES", "builtin_names", "load"]
+__all__ = ["ALIASES", "KNOWN_PROPERTIES", "builtin_names", "load"]
 
 _LIBRARY = "robodyn.robot.library"
+
+#: Other names of built-in robots (the name a publication uses -> the built-in's file name).
+ALIASES: Mapping[str, str] = MappingProxyType({"underwater_2link": "underwater_2r"})
 
 #: Documented properties of the built-ins' published inertial data, by built-in and link name:
 #: the failed plausibility condition (as worded in the warning). puma560 and puma560_akb: link
@@ -45,8 +48,8 @@ def load(source: str | Path, *, strict: bool = False, tool: str | None = None) -
     Parameters
     ----------
     source : str or Path
-        A built-in name (see :func:`builtin_names`), or a path to a ``.yaml``/``.yml`` robodyn
-        description or a ``.urdf`` file.
+        A built-in name (see :func:`builtin_names`; or one of :data:`ALIASES`), or a path to a
+        ``.yaml``/``.yml`` robodyn description or a ``.urdf`` file.
     strict : bool
         Turn physical-plausibility warnings (inertia not positive definite, triangle inequality,
         singular mass matrix) into errors. The documented properties of the built-ins
@@ -71,6 +74,8 @@ def load(source: str | Path, *, strict: bool = False, tool: str | None = None) -
     from robodyn.robot import urdf, validation, yaml_loader
 
     text = str(source)
+    if text in ALIASES:
+        source = text = ALIASES[text]
     path = Path(source)
     suffix = path.suffix.lower()
     if tool is not None and (text in builtin_names() or suffix != ".urdf"):

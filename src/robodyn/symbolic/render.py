@@ -24,9 +24,10 @@ import html
 import json
 import re
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import sympy as sp
+from sympy.core.function import AppliedUndef
 from sympy.printing.latex import LatexPrinter
 from sympy.printing.mathml import MathMLPresentationPrinter
 
@@ -71,6 +72,8 @@ class _Layout:
     form: str
     sections: list[tuple[str, list[_Row]]]
     variables: list[tuple[sp.Symbol, sp.Expr]]
+    #: LaTeX of left-hand sides that are neither indexed nor variables (``v_n2(s)``)
+    tex: dict[str, str] = field(default_factory=dict)
 
 
 def _version() -> str:
@@ -186,6 +189,8 @@ def _cse(exprs: Sequence[sp.Expr], used: set[str]
 def _layout(eom: EquationsOfMotion) -> _Layout:
     """What to print: the textbook form (small arms) or the recursive/CSE form."""
     n = eom.dof
+    if n <= SMALL_DOF and eom.hydro is not None:
+        return _underwater_layout(eom)
     if n <= SMALL_DOF:
         parts = _textbook(eom)
         sections = [
@@ -222,6 +227,19 @@ def _layout(eom: EquationsOfMotion) -> _Layout:
          "elimination", mg_rows),
     ]
     return _Layout(form, sections, program + subs)
+
+
+def _underwater_layout(eom: EquationsOfMotion) -> _Layout:
+    """Textbook form of a small underwater arm, each hydrodynamic term on its own
+    (:mod:`robodyn.hydro.textbook`)."""
+    from robodyn.hydro.textbook import underwater_textbook
+
+    book = underwater_textbook(eom)
+    sections = [(sec.title, [_Row(ln.name, ln.index, list(ln.terms), ln.mirror)
+                             for ln in sec.lines]) for sec in book.sections]
+    tex = {f"{f.func.__name__}(s)": sp.latex(f) for f in book.functions}
+    return _Layout("textbook, under water: (M + M_A) qdd + (C + C_A) qd + g + g_B + tau_D + tau_F "
+                   "+ tau_L (+ friction) = tau, each hydrodynamic term separately", sections, [], tex)
 
 
 def _continued(text: str) -> str:
@@ -303,6 +321,23 @@ class _Latex(LatexPrinter):
         tex = rf"\operatorname{{H}}\left({self._print(expr.args[0])}\right)"
         return f"{tex}^{{{exp}}}" if exp else tex
 
+    def _print_Function(self, expr: sp.Function, exp: str | None = None) -> str:  # noqa: N802
+        if not isinstance(expr, AppliedUndef):
+            return super()._print_Function(expr, exp)
+        # v_n2(s) (hydro textbook): keep the brackets that fold_func_brackets would drop
+        fold = self._settings["fold_func_brackets"]
+        self._settings["fold_func_brackets"] = False
+        try:
+            return super()._print_Function(expr, exp)
+        finally:
+            self._settings["fold_func_brackets"] = fold
+
+
+#: Left-hand sides of the hydrodynamic terms (:mod:`robodyn.hydro.textbook`).
+_HYDRO_TEX = {"M_A": r"\mathbf{M}^{\mathrm{A}}", "C_A": r"\mathbf{C}^{\mathrm{A}}",
+              "g_B": r"\mathbf{g}^{\mathrm{B}}", "tau_D": r"\tau^{\mathrm{D}}",
+              "tau_F": r"\tau^{\mathrm{F}}", "tau_L": r"\tau^{\mathrm{L}}",
+              "friction": r"\tau^{\mathrm{f}}"}
 
 _NAME = re.compile(r"^([A-Za-z]+)(\d*)((?:_[A-Za-z0-9]+)*)$")
 
@@ -361,7 +396,8 @@ def _tex_lines(texts: Sequence[str]) -> list[str]:
 def _tex_lhs(row: _Row, n: int, names: dict[sp.Symbol, str]) -> str:
     if not row.index:
         return names.get(sp.Symbol(row.lhs, real=True), row.lhs)
-    macro = {"M": r"\mathbf{M}", "C": r"\mathbf{C}", "g": r"\mathbf{g}", "tau": r"\tau"}[row.lhs]
+    macro = {"M": r"\mathbf{M}", "C": r"\mathbf{C}", "g": r"\mathbf{g}", "tau": r"\tau",
+             **_HYDRO_TEX}[row.lhs]
     lhs = f"{macro}_{{{_index(n, row.index)}}}"
     if row.mirror:
         lhs += f" = {macro}_{{{_index(n, row.index[::-1])}}}"
@@ -400,6 +436,7 @@ def render_latex(eom: EquationsOfMotion) -> str:
     layout = _layout(eom)
     robot = eom.robot
     names = _symbol_names(eom, layout.variables)
+    names.update({sp.Symbol(lhs, real=True): tex for lhs, tex in layout.tex.items()})
     printer = _Latex({"symbol_names": names, "fold_func_brackets": True})
     joints = ", ".join(f"$q_{{{k + 1}}}$: joint \\texttt{{{_tex_escape(j.name)}}} ({j.type})"
                        for k, j in enumerate(robot.joints))
@@ -490,7 +527,8 @@ def _mathml_lhs(row: _Row, n: int) -> str:
     if not row.index:
         return f"<mi>{html.escape(row.lhs)}</mi>"
     base = {"M": '<mi mathvariant="bold">M</mi>', "C": '<mi mathvariant="bold">C</mi>',
-            "g": '<mi mathvariant="bold">g</mi>', "tau": "<mi>&#x03C4;</mi>"}[row.lhs]
+            "g": '<mi mathvariant="bold">g</mi>', "tau": "<mi>&#x03C4;</mi>"
+            }.get(row.lhs, f"<mi>{html.escape(row.lhs)}</mi>")
     lhs = f"<msub>{base}<mn>{_index(n, row.index)}</mn></msub>"
     if row.mirror:
         lhs += f"<mo>=</mo><msub>{base}<mn>{_index(n, row.index[::-1])}</mn></msub>"
