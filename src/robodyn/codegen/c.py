@@ -301,8 +301,9 @@ class CPrinter(Printer):
             lines.append(self.signature(kernel, batch=True).replace("restrict ", "") + ";")
             lines.append(self.signature(kernel, batch=True, threads=True).replace("restrict ", "") + ";")
         if with_simulation and "state_derivative" in kset.names:
-            lines.append(simulate_signature(self.prefix) + ";")
-            lines.append(ensemble_signature(self.prefix) + ";")
+            runtime = len(kset.runtime_parameters)
+            lines.append(simulate_signature(self.prefix, runtime) + ";")
+            lines.append(ensemble_signature(self.prefix, runtime) + ";")
         return "\n".join(lines) + "\n"
 
     def source(self, kset: KernelSet, with_simulation: bool = True) -> str:
@@ -316,9 +317,10 @@ class CPrinter(Printer):
                          f"#define {macro}\n#endif\n")
         parts.extend(self.kernel_source(kernel) for kernel in kset.kernels)
         if with_simulation and "state_derivative" in kset.names:
+            runtime = len(kset.runtime_parameters)
             parts.append(simulation_source(kset.dof, self.prefix, "gravity" in kset.names,
-                                           "mass_matrix" in kset.names))
-            parts.append(ensemble_source(kset.dof, self.prefix))
+                                           "mass_matrix" in kset.names, runtime))
+            parts.append(ensemble_source(kset.dof, self.prefix, runtime))
         return "\n".join(parts)
 
 
@@ -365,23 +367,34 @@ def _names(kernel: Kernel) -> list[str]:
     return [a.name for a in (*kernel.inputs, *kernel.outputs)]
 
 
-def simulate_signature(prefix: str) -> str:
-    """Prototype of the in-C trajectory integrator."""
+def _params_decl(runtime: int) -> str:
+    """The parameter argument of the integrators when the kernels take runtime parameters."""
+    return "const double *params, " if runtime else ""
+
+
+def simulate_signature(prefix: str, runtime: int = 0) -> str:
+    """Prototype of the in-C trajectory integrator.
+
+    With ``runtime`` > 0 parameters left as kernel inputs it takes ``params`` (runtime,).
+    """
     return (f"int {prefix}simulate(long steps, double dt, int method, const double *x0, "
             "const double *feedforward, const double *reference, const double *gain, "
-            "const double *integral_gain, int mode, const double *tau_limit, int continuous, "
-            "double *x_out, double *tau_out)")
+            "const double *integral_gain, int mode, const double *tau_limit, "
+            f"{_params_decl(runtime)}int continuous, double *x_out, double *tau_out)")
 
 
-def ensemble_signature(prefix: str) -> str:
-    """Prototype of the in-C integrator of many trajectories."""
+def ensemble_signature(prefix: str, runtime: int = 0) -> str:
+    """Prototype of the in-C integrator of many trajectories.
+
+    With ``runtime`` > 0 parameters it takes ``params`` (count, runtime): one set per trajectory.
+    """
     return (f"int {prefix}simulate_ensemble(long count, long steps, double dt, int method, "
             "const double *x0, const double *feedforward, const double *reference, "
             "const double *gain, const double *integral_gain, int mode, const double *tau_limit, "
-            "int threads, double *x_out, double *tau_out, long *status)")
+            f"{_params_decl(runtime)}int threads, double *x_out, double *tau_out, long *status)")
 
 
-def ensemble_source(n: int, prefix: str) -> str:
+def ensemble_source(n: int, prefix: str, runtime: int = 0) -> str:
     """C source of ``PREFIXsimulate_ensemble``: ``count`` trajectories of ``PREFIXsimulate``.
 
     Trajectory i starts at ``x0[i]`` (2 n) and follows the sampled law of
@@ -392,18 +405,23 @@ def ensemble_source(n: int, prefix: str) -> str:
     across trajectories) and the updates are loops over the block's states. Every trajectory
     gets the same bits as ``PREFIXsimulate`` alone. ``status[i]`` is 0, or k + 1 when trajectory i
     stopped being finite at step k (its later rows are not written). Blocks go to ``threads``
-    OpenMP threads. Returns the number of trajectories that failed.
+    OpenMP threads. Returns the number of trajectories that failed. With ``runtime`` > 0
+    parameters left as kernel inputs, trajectory i uses ``params[i]`` (runtime values) in its
+    dynamics and in the law's model terms.
     """
     sd = f"{prefix}state_derivative_range"
     law = f"{prefix}control_law"
     args = "feedforward, reference, gain, integral_gain, mode, tau_limit"
+    # the block's parameter rows (the kernels index them like the states), one row per law
+    blk = f", params + first * {runtime}" if runtime else ""
+    own = f", params + (first + j) * {runtime}" if runtime else ""
     stage = "        for (int i = 0; i < m * NX; ++i) xt[i] = x[i] + {h} * {k}[i];"
     lines = [
         f"/* trajectories first .. first + m - 1 (m <= {BLOCK}) of simulate_ensemble. */",
         f"static void {prefix}ensemble_block(long first, int m, long steps, double dt, int method, "
         "const double *x0, const double *feedforward, const double *reference, const double *gain, "
-        "const double *integral_gain, int mode, const double *tau_limit, double *x_out, "
-        "double *tau_out, long *status) {",
+        f"const double *integral_gain, int mode, const double *tau_limit, {_params_decl(runtime)}"
+        "double *x_out, double *tau_out, long *status) {",
         f"    enum {{ N = {n}, NX = {2 * n}, B = {BLOCK} }};",
         "    double x[B * NX], xt[B * NX], k1[B * NX], k2[B * NX], k3[B * NX], k4[B * NX];",
         "    double tau[B * N], integ[B * N], r[N];",
@@ -418,22 +436,22 @@ def ensemble_source(n: int, prefix: str) -> str:
         "        for (int j = 0; j < m; ++j) {",
         f"            {prefix}error_rate(k, x + j * NX, reference, r);",
         "            for (int i = 0; i < N; ++i) integ[j * N + i] += r[i] * dt;",
-        f"            {law}(k, x + j * NX, integ + j * N, {args}, tau + j * N);",
+        f"            {law}(k, x + j * NX, integ + j * N, {args}{own}, tau + j * N);",
         "        }",
         "        if (method == 0) {",
         "            /* RK4 over the block: x += dt/6 (k1 + 2 k2 + 2 k3 + k4) */",
-        f"            {sd}(0, m, x, tau, k1);",
+        f"            {sd}(0, m, x, tau{blk}, k1);",
         stage.format(h="0.5 * dt", k="k1"),
-        f"            {sd}(0, m, xt, tau, k2);",
+        f"            {sd}(0, m, xt, tau{blk}, k2);",
         stage.format(h="0.5 * dt", k="k2"),
-        f"            {sd}(0, m, xt, tau, k3);",
+        f"            {sd}(0, m, xt, tau{blk}, k3);",
         stage.format(h="dt", k="k3"),
-        f"            {sd}(0, m, xt, tau, k4);",
+        f"            {sd}(0, m, xt, tau{blk}, k4);",
         "            for (int i = 0; i < m * NX; ++i)",
         "                x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);",
         "        } else {",
         "            /* semi-implicit Euler: qd += dt qdd(q, qd); q += dt qd (new qd) */",
-        f"            {sd}(0, m, x, tau, k1);",
+        f"            {sd}(0, m, x, tau{blk}, k1);",
         "            for (int j = 0; j < m; ++j) {",
         "                for (int i = 0; i < N; ++i) x[j * NX + N + i] += dt * k1[j * NX + N + i];",
         "                for (int i = 0; i < N; ++i) x[j * NX + i] += dt * x[j * NX + N + i];",
@@ -459,7 +477,7 @@ def ensemble_source(n: int, prefix: str) -> str:
         "}",
         "",
         f"/* count trajectories of {n}-joint dynamics, {BLOCK} per block, blocks on `threads` threads. */",
-        ensemble_signature(prefix) + " {",
+        ensemble_signature(prefix, runtime) + " {",
         f"    const long blocks = (count + {BLOCK - 1}) / {BLOCK};",
         "    long failed = 0;",
         "#ifdef _OPENMP",
@@ -467,8 +485,8 @@ def ensemble_source(n: int, prefix: str) -> str:
         "#endif",
         "    for (long b = 0; b < blocks; ++b) {",
         f"        const int m = count - {BLOCK} * b < {BLOCK} ? (int)(count - {BLOCK} * b) : {BLOCK};",
-        f"        {prefix}ensemble_block({BLOCK} * b, m, steps, dt, method, x0, {args}, x_out, tau_out, "
-        "status);",
+        f"        {prefix}ensemble_block({BLOCK} * b, m, steps, dt, method, x0, {args}, "
+        f"{'params, ' if runtime else ''}x_out, tau_out, status);",
         "    }",
         "    (void)threads;",
         "    for (long i = 0; i < count; ++i) failed += status[i] != 0;",
@@ -478,13 +496,16 @@ def ensemble_source(n: int, prefix: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _law_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) -> list[str]:
+def _law_source(n: int, prefix: str, has_gravity: bool, has_mass: bool,
+                runtime: int = 0) -> list[str]:
     """``PREFIXcontrol_law``: the torque at one state from row ``row`` of the sampled inputs."""
+    p = ", params" if runtime else ""
     lines = [
         "/* tau = the control law at state x with the inputs of sample `row` (see simulate). */",
         f"static void {prefix}control_law(long row, const double *x, const double *integ, "
         "const double *feedforward, const double *reference, const double *gain, "
-        "const double *integral_gain, int mode, const double *tau_limit, double *tau) {",
+        f"const double *integral_gain, int mode, const double *tau_limit, {_params_decl(runtime)}"
+        "double *tau) {",
         f"    enum {{ N = {n}, NX = {2 * n} }};",
         "    double e[NX], v[N];",
         "    /* e = reference_row - x */",
@@ -503,8 +524,8 @@ def _law_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) -> list[
             "        /* computed torque: tau = M(q) v + (C qd + g + friction) */",
             "        double m[N * N], h[N], zero[N];",
             "        for (int i = 0; i < N; ++i) zero[i] = 0.0;",
-            f"        {prefix}mass_matrix(x, m);",
-            f"        {prefix}inverse_dynamics(x, x + N, zero, h);",
+            f"        {prefix}mass_matrix(x{p}, m);",
+            f"        {prefix}inverse_dynamics(x, x + N, zero{p}, h);",
             "        for (int i = 0; i < N; ++i) {",
             "            double s = h[i];",
             "            for (int j = 0; j < N; ++j) s += m[i * N + j] * v[j];",
@@ -521,7 +542,7 @@ def _law_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) -> list[
             "    if (mode == 1) {",
             "        /* gravity compensation: tau += g(q) */",
             "        double gq[N];",
-            f"        {prefix}gravity(x, gq);",
+            f"        {prefix}gravity(x{p}, gq);",
             "        for (int i = 0; i < N; ++i) tau[i] += gq[i];",
             "    }",
         ]
@@ -536,12 +557,15 @@ def _law_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) -> list[
     return lines
 
 
-def _staged_rk4(prefix: str, args: str) -> list[str]:
-    """The body of one RK4 step with the control law evaluated at every stage (C lines)."""
+def _staged_rk4(prefix: str, args: str, p: str = "") -> list[str]:
+    """The body of one RK4 step with the control law evaluated at every stage (C lines).
+
+    ``p``: ``", params"`` when the kernels take runtime parameters (``args`` then ends with it).
+    """
     sd, law = f"{prefix}state_derivative", f"{prefix}control_law"
     ind = "            "
     lines = [f"{ind}{law}(2 * k, x, integ, {args}, tau);",
-             f"{ind}{sd}(x, tau, k1);",
+             f"{ind}{sd}(x, tau{p}, k1);",
              f"{ind}{prefix}error_rate(2 * k, x, reference, r1);"]
     # stages 2-4: state and integral advanced by (dt/2, dt/2, dt) times the previous slopes
     for (frac, row), (kp, rp), (kn, rn) in zip((("0.5 * dt", "2 * k + 1"), ("0.5 * dt", "2 * k + 1"),
@@ -551,7 +575,7 @@ def _staged_rk4(prefix: str, args: str) -> list[str]:
         lines += [f"{ind}for (int i = 0; i < NX; ++i) xt[i] = x[i] + {frac} * {kp}[i];",
                   f"{ind}for (int i = 0; i < N; ++i) zt[i] = integ[i] + {frac} * {rp}[i];",
                   f"{ind}{law}({row}, xt, zt, {args}, ts);",
-                  f"{ind}{sd}(xt, ts, {kn});",
+                  f"{ind}{sd}(xt, ts{p}, {kn});",
                   f"{ind}{prefix}error_rate({row}, xt, reference, {rn});"]
     lines += [f"{ind}/* x += dt/6 (k1 + 2 k2 + 2 k3 + k4), the same for z */",
               f"{ind}for (int i = 0; i < NX; ++i)",
@@ -561,7 +585,8 @@ def _staged_rk4(prefix: str, args: str) -> list[str]:
     return lines
 
 
-def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) -> str:
+def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool,
+                      runtime: int = 0) -> str:
     """C source of ``PREFIXsimulate``: fixed-step integration under a state-feedback law.
 
     The law, with ``e = reference_row - x`` (2 n) and ``e_q`` its first n entries::
@@ -579,12 +604,14 @@ def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) ->
     by the same RK4; this is a continuous-time controller, tracked to the integrator's order.
     Null pointers mean zero (no feedforward, no reference, no gain, no limit). ``tau_out[k]`` is
     the law at the start of step k. Returns 0, or k + 1 when the state stopped being finite at
-    step k.
+    step k. With ``runtime`` > 0 parameters left as kernel inputs it takes their values
+    ``params`` (runtime,).
     """
     sd = f"{prefix}state_derivative"
     law = f"{prefix}control_law"
-    args = "feedforward, reference, gain, integral_gain, mode, tau_limit"
-    lines = _law_source(n, prefix, has_gravity, has_mass) + [
+    p = ", params" if runtime else ""
+    args = "feedforward, reference, gain, integral_gain, mode, tau_limit" + p
+    lines = _law_source(n, prefix, has_gravity, has_mass, runtime) + [
         "/* e_q = q_ref - q at sample `row`: the rate of the error integral. */",
         f"static void {prefix}error_rate(long row, const double *x, const double *reference, "
         "double *out) {",
@@ -593,7 +620,7 @@ def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) ->
         "}",
         "",
         f"/* Integrate {n}-joint dynamics for `steps` steps of `dt` s (see robodyn.codegen.c). */",
-        simulate_signature(prefix) + " {",
+        simulate_signature(prefix, runtime) + " {",
         f"    enum {{ N = {n}, NX = {2 * n} }};",
         "    double x[NX], xt[NX], k1[NX], k2[NX], k3[NX], k4[NX], tau[N], ts[N], integ[N], zt[N];",
         "    double r1[N], r2[N], r3[N], r4[N];",
@@ -604,7 +631,7 @@ def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) ->
         "        if (staged) {",
         "            /* RK4 with the law at every stage (rows 2k, 2k+1, 2k+1, 2k+2 at t, t+dt/2, t+dt)",
         "               and the error integral z as extra state: z' = e_q */",
-        *_staged_rk4(prefix, args),
+        *_staged_rk4(prefix, args, p),
         "        } else {",
         "            /* sampled law, held over the step; integral += e_q dt first */",
         "            const long row = continuous ? 2 * k : k;",
@@ -613,18 +640,18 @@ def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool) ->
         f"            {law}(row, x, integ, {args}, tau);",
         "            if (method == 0) {",
         "                /* RK4: x += dt/6 (k1 + 2 k2 + 2 k3 + k4) */",
-        f"                {sd}(x, tau, k1);",
+        f"                {sd}(x, tau{p}, k1);",
         "                for (int i = 0; i < NX; ++i) xt[i] = x[i] + 0.5 * dt * k1[i];",
-        f"                {sd}(xt, tau, k2);",
+        f"                {sd}(xt, tau{p}, k2);",
         "                for (int i = 0; i < NX; ++i) xt[i] = x[i] + 0.5 * dt * k2[i];",
-        f"                {sd}(xt, tau, k3);",
+        f"                {sd}(xt, tau{p}, k3);",
         "                for (int i = 0; i < NX; ++i) xt[i] = x[i] + dt * k3[i];",
-        f"                {sd}(xt, tau, k4);",
+        f"                {sd}(xt, tau{p}, k4);",
         "                for (int i = 0; i < NX; ++i)",
         "                    x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);",
         "            } else {",
         "                /* semi-implicit Euler: qd += dt qdd(q, qd); q += dt qd (new qd) */",
-        f"                {sd}(x, tau, k1);",
+        f"                {sd}(x, tau{p}, k1);",
         "                for (int i = 0; i < N; ++i) x[N + i] += dt * k1[N + i];",
         "                for (int i = 0; i < N; ++i) x[i] += dt * x[N + i];",
         "            }",

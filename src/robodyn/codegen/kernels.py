@@ -117,6 +117,9 @@ class KernelSet:
     parameters : tuple of (str, float)
         The parameter values folded into the code.
     kernels : tuple of Kernel
+    runtime_parameters : tuple of str
+        Named parameters left as runtime inputs: every kernel then takes a last input ``p``
+        holding their values in this order (empty: all parameters folded).
     """
 
     robot_name: str
@@ -124,6 +127,7 @@ class KernelSet:
     dof: int
     parameters: tuple[tuple[str, float], ...]
     kernels: tuple[Kernel, ...]
+    runtime_parameters: tuple[str, ...] = ()
 
     def __getitem__(self, name: str) -> Kernel:
         for k in self.kernels:
@@ -167,7 +171,8 @@ def kernel_signature(name: str, n: int) -> tuple[tuple[tuple[str, int], ...], tu
 
 
 def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
-                  names: Sequence[str] = KERNEL_NAMES) -> KernelSet:
+                  names: Sequence[str] = KERNEL_NAMES,
+                  runtime: Sequence[str] = ()) -> KernelSet:
     """Straight-line programs of every generated function for ``robot``.
 
     Parameters
@@ -177,24 +182,33 @@ def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
         Overrides of the robot's parameter defaults (every named parameter must end up numeric).
     names : sequence of str
         Which kernels to build (default: all of :data:`KERNEL_NAMES`).
+    runtime : sequence of str
+        Named parameters kept symbolic: every kernel gains a last input ``p`` (P,) holding
+        their values in this order (their symbols are renamed ``prm1_``, ``prm2_``, ...).
 
     Returns
     -------
     KernelSet
     """
-    unknown = [k for k in (parameters or {}) if k not in robot.parameters]
+    unknown = [k for k in (*(parameters or {}), *runtime) if k not in robot.parameters]
     if unknown:
         raise ValueError(f"robot {robot.name!r} has no parameter(s) {', '.join(unknown)}; "
                          f"it has {', '.join(robot.parameters) or 'none'}")
+    runtime = tuple(runtime)
+    if len(set(runtime)) != len(runtime):
+        raise ValueError(f"runtime parameters named twice: {', '.join(runtime)}")
     merged = {**robot.parameters, **(parameters or {})}
-    values = {sp.Symbol(k, real=True): float(v) for k, v in merged.items()}
+    values = {sp.Symbol(k, real=True): float(v) for k, v in merged.items() if k not in runtime}
+    # runtime parameters: renamed (a parameter may share a name with an output array, e.g. g)
+    prm = [sp.Symbol(f"prm{i + 1}_", real=True) for i in range(len(runtime))]
+    rename_prm = {sp.Symbol(k, real=True): s for k, s in zip(runtime, prm, strict=True)}
     n = robot.dof
     q, qd, qdd = joint_symbols(n)
     u = sp.symbols(f"u1:{n + 1}", real=True)
     inputs = {"q": _arg("q", q), "qd": _arg("qd", qd), "qdd": _arg("qdd", qdd), "tau": _arg("tau", u)}
     reserved = {s.name for s in (*q, *qd, *qdd, *u)} | set(merged) | set(KERNEL_NAMES)
     reserved |= {"q", "qd", "qdd", "tau", "M", "g", "c", "T", "J", "Y", "xd", "u", "qdd_out"}
-    reserved |= {"dtau", "dqdd", *DERIVATIVE_KERNEL_NAMES}
+    reserved |= {"dtau", "dqdd", "p", *DERIVATIVE_KERNEL_NAMES, *(s.name for s in prm)}
 
     hyd = _pi_as_number(hydro_terms(robot, q, qd, qdd))
 
@@ -256,7 +270,12 @@ def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
         summary, ins, out_name, shape, build = builders[name]
         rec = Recorder(reserved)
         outs = build(rec)
-        body, outs = opt.fold_parameters(rec.assignments, outs, values)
+        assignments = rec.assignments
+        if prm:
+            ins = (*ins, _arg("p", prm))
+            assignments = [(s, e.xreplace(rename_prm)) for s, e in assignments]
+            outs = [sp.sympify(o).xreplace(rename_prm) for o in outs]
+        body, outs = opt.fold_parameters(assignments, outs, values)
         body, outs = opt.eliminate_common_subexpressions(body, outs)
         rename = opt.safe_names(body, reserved)
         if rename:
@@ -264,8 +283,8 @@ def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
             outs = [sp.sympify(o).xreplace(rename) for o in outs]
         kernels.append(Kernel(name, summary, ins, (Argument(out_name, shape, tuple(outs)),),
                               tuple(body)))
-    params = tuple((k, float(v)) for k, v in sorted(merged.items()))
-    return KernelSet(robot.name, robot.description_hash, n, params, tuple(kernels))
+    params = tuple((k, float(v)) for k, v in sorted(merged.items()) if k not in runtime)
+    return KernelSet(robot.name, robot.description_hash, n, params, tuple(kernels), runtime)
 
 
 def _arg(name: str, symbols: Sequence[sp.Symbol]) -> Argument:

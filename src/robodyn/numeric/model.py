@@ -14,7 +14,7 @@ import os
 import subprocess
 import sys
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -35,11 +35,16 @@ from robodyn.codegen.build import (
 from robodyn.codegen.c import CPrinter
 from robodyn.codegen.kernels import DERIVATIVE_KERNEL_NAMES, KernelSet, build_kernels, kernel_signature
 from robodyn.codegen.python import PythonPrinter
+from robodyn.numeric.integrate_numpy import integrate_numpy as _integrate_numpy
+from robodyn.numeric.runtime_parameters import check_physics, parameter_array, runtime_names
 from robodyn.robot.errors import SimulationError, SingularMassMatrixError
 from robodyn.robot.model import Robot
 from robodyn.robot.overrides import checked_parameter_values
 
 Backend = Literal["c", "numpy"]
+#: Runtime parameter values: a mapping (name -> value), a sequence of N mappings, or an array
+#: (P,) / (N, P) in the order of :attr:`Model.runtime_parameters`.
+ParameterValues = Mapping[str, float] | Sequence[Mapping[str, float]] | np.ndarray | None
 _PREFIX = "rd_"
 
 #: Largest output of one :meth:`Model.integrate` call (states and torques), bytes: longer runs
@@ -58,13 +63,20 @@ class Model:
     robot : Robot
     backend : {"c", "numpy"}
     parameter_values : tuple of (str, float)
-        The parameter values compiled in.
+        The parameter values compiled in (for runtime parameters: the values used when a call
+        gives none).
+    runtime_parameters : tuple of str
+        Named parameters that are kernel inputs rather than compiled constants
+        (``compile_model(robot, runtime_parameters=...)``): every method then takes
+        ``parameters=`` (one set, or one per state of a batch; see :data:`ParameterValues`), and
+        :meth:`integrate` one set per trajectory of an ensemble. Empty: all folded.
     """
 
     robot: Robot
     backend: str
     parameter_values: tuple[tuple[str, float], ...]
     _impl: CompiledLibrary | ModuleType = field(repr=False, compare=False)
+    runtime_parameters: tuple[str, ...] = ()
 
     @property
     def dof(self) -> int:
@@ -79,32 +91,60 @@ class Model:
     @cached_property
     def kernels(self) -> KernelSet:
         """The generated programs (printable in any language by :mod:`robodyn.codegen`)."""
-        return _kernels_cached(self.robot, self.parameters)
+        return _kernels_cached(self.robot, self.parameters, self.runtime_parameters)
+
+    def with_parameters(self, values: Mapping[str, float]) -> Model:
+        """The same compiled code with other default values of its runtime parameters.
+
+        No compilation: the new model shares the loaded library. Values are checked like
+        ``compile_model(parameters=...)`` (finite, physically possible).
+
+        Parameters
+        ----------
+        values : mapping of str to float
+            New values of some of :attr:`runtime_parameters`.
+
+        Returns
+        -------
+        Model
+        """
+        names = self.runtime_parameters
+        row = parameter_array(names, self.parameters, dict(values), (), "with_parameters")
+        check_physics(self.robot, names, self.parameters, row, "with_parameters")
+        merged = {**self.parameters, **dict(zip(names, row.tolist(), strict=True))}
+        return Model(self.robot, self.backend, tuple(sorted(merged.items())), self._impl, names)
 
     # --- public kernels ------------------------------------------------------------------------
     def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, *,
-                         threads: int = 1) -> np.ndarray:
+                         threads: int = 1,
+                         parameters: ParameterValues = None) -> np.ndarray:
         """Joint torques ``tau = M qdd + C qd + g + friction``, shape like ``q`` (N m or N).
 
         ``threads``: threads of a batch call (every method takes it; the result bits do not
-        depend on it; the NumPy backend uses one).
+        depend on it; the NumPy backend uses one). ``parameters``: values of the
+        :attr:`runtime_parameters` (every method takes it): a mapping, a sequence of N
+        mappings or an array (P,) / (N, P) (one set, or one per state); None: the defaults.
         """
-        return self._call("inverse_dynamics", q, qd, qdd, threads=threads)
+        return self._call("inverse_dynamics", q, qd, qdd, threads=threads, parameters=parameters)
 
-    def mass_matrix(self, q: np.ndarray, *, threads: int = 1) -> np.ndarray:
+    def mass_matrix(self, q: np.ndarray, *, threads: int = 1,
+                    parameters: ParameterValues = None) -> np.ndarray:
         """Joint-space inertia (rotor inertia included), (n, n) or (N, n, n)."""
-        return self._call("mass_matrix", q, threads=threads)
+        return self._call("mass_matrix", q, threads=threads, parameters=parameters)
 
-    def gravity(self, q: np.ndarray, *, threads: int = 1) -> np.ndarray:
+    def gravity(self, q: np.ndarray, *, threads: int = 1,
+                parameters: ParameterValues = None) -> np.ndarray:
         """Gravity load ``g(q)``: the torques that hold the arm still, shape like ``q``."""
-        return self._call("gravity", q, threads=threads)
+        return self._call("gravity", q, threads=threads, parameters=parameters)
 
-    def coriolis(self, q: np.ndarray, qd: np.ndarray, *, threads: int = 1) -> np.ndarray:
+    def coriolis(self, q: np.ndarray, qd: np.ndarray, *, threads: int = 1,
+                 parameters: ParameterValues = None) -> np.ndarray:
         """Coriolis and centrifugal torques ``C(q, qd) qd``, shape like ``q``."""
-        return self._call("coriolis", q, qd, threads=threads)
+        return self._call("coriolis", q, qd, threads=threads, parameters=parameters)
 
     def forward_dynamics(self, q: np.ndarray, qd: np.ndarray, tau: np.ndarray, *,
-                         threads: int = 1) -> np.ndarray:
+                         threads: int = 1,
+                         parameters: ParameterValues = None) -> np.ndarray:
         """Joint accelerations ``qdd = M^-1 (tau - C qd - g - friction)``, shape like ``q``.
 
         Raises
@@ -112,9 +152,11 @@ class Model:
         SingularMassMatrixError
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
-        return self._nonsingular(self._call("forward_dynamics", q, qd, tau, threads=threads), q)
+        qdd = self._call("forward_dynamics", q, qd, tau, threads=threads, parameters=parameters)
+        return self._nonsingular(qdd, q, parameters)
 
-    def state_derivative(self, x: np.ndarray, tau: np.ndarray, *, threads: int = 1) -> np.ndarray:
+    def state_derivative(self, x: np.ndarray, tau: np.ndarray, *, threads: int = 1,
+                         parameters: ParameterValues = None) -> np.ndarray:
         """``[qd, qdd]`` of the state ``x = [q, qd]``, (2 n,) or (N, 2 n).
 
         Raises
@@ -122,21 +164,22 @@ class Model:
         SingularMassMatrixError
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
-        xd = self._call("state_derivative", x, tau, threads=threads)
-        return self._nonsingular(xd, np.asarray(x, dtype=float)[..., : self.dof])
+        xd = self._call("state_derivative", x, tau, threads=threads, parameters=parameters)
+        return self._nonsingular(xd, np.asarray(x, dtype=float)[..., : self.dof], parameters)
 
-    def check_mass_matrix(self, q: np.ndarray) -> None:
+    def check_mass_matrix(self, q: np.ndarray, parameters: ParameterValues = None) -> None:
         """Raise :class:`SingularMassMatrixError` when ``M(q)`` is not positive definite.
 
         Parameters
         ----------
         q : (n,)
             Joint positions (rad, m); non-finite positions are not checked.
+        parameters : one set of runtime parameter values, optional
         """
         q = np.asarray(q, dtype=float)
         if not np.all(np.isfinite(q)):
             return
-        m = self.mass_matrix(q)
+        m = self.mass_matrix(q, parameters=parameters)
         if not np.all(np.isfinite(m)):
             raise SingularMassMatrixError(f"{self.robot.name}: the mass matrix is not finite at "
                                           f"q = {np.array2string(q, precision=4)}")
@@ -154,31 +197,41 @@ class Model:
             "link, a point mass on a joint axis), so the forward dynamics has no solution; give "
             "the links mass and inertia, or the joints rotor inertia")
 
-    def _nonsingular(self, out: np.ndarray, q: np.ndarray) -> np.ndarray:
+    def _nonsingular(self, out: np.ndarray, q: np.ndarray,
+                     parameters: ParameterValues = None) -> np.ndarray:
         """``out`` unchanged when finite; otherwise check ``M`` at the first non-finite row."""
         if np.all(np.isfinite(out)):
             return out
         rows = np.atleast_2d(np.asarray(q, dtype=float))
         bad = ~np.all(np.isfinite(out.reshape(rows.shape[0], -1)), axis=1)
-        self.check_mass_matrix(rows[int(np.argmax(bad))])
+        i = int(np.argmax(bad))
+        p = None
+        if self.runtime_parameters:
+            p = self.parameter_input(parameters, np.shape(q)[:-1], "check_mass_matrix")
+            p = p[i] if p.ndim == 2 else p
+        self.check_mass_matrix(rows[i], p)
         return out
 
-    def forward_kinematics(self, q: np.ndarray, *, threads: int = 1) -> np.ndarray:
+    def forward_kinematics(self, q: np.ndarray, *, threads: int = 1,
+                           parameters: ParameterValues = None) -> np.ndarray:
         """End-effector pose in the base frame, (4, 4) or (N, 4, 4)."""
-        return self._call("forward_kinematics", q, threads=threads)
+        return self._call("forward_kinematics", q, threads=threads, parameters=parameters)
 
-    def jacobian(self, q: np.ndarray, *, threads: int = 1) -> np.ndarray:
+    def jacobian(self, q: np.ndarray, *, threads: int = 1,
+                 parameters: ParameterValues = None) -> np.ndarray:
         """Geometric Jacobian ``[v; omega]`` of the tool origin, base frame, (6, n) or (N, 6, n)."""
-        return self._call("jacobian", q, threads=threads)
+        return self._call("jacobian", q, threads=threads, parameters=parameters)
 
     def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, *,
-                  threads: int = 1) -> np.ndarray:
+                  threads: int = 1,
+                  parameters: ParameterValues = None) -> np.ndarray:
         """Regressor ``Y`` with ``Y @ params == tau``, (n, 15 n) or (N, n, 15 n)."""
-        return self._call("regressor", q, qd, qdd, threads=threads)
+        return self._call("regressor", q, qd, qdd, threads=threads, parameters=parameters)
 
     def inverse_dynamics_derivatives(self, q: np.ndarray, qd: np.ndarray,
-                                     qdd: np.ndarray, *,
-                                     threads: int = 1) -> tuple[np.ndarray, np.ndarray]:
+                                     qdd: np.ndarray, *, threads: int = 1,
+                                     parameters: ParameterValues = None,
+                                     ) -> tuple[np.ndarray, np.ndarray]:
         """Partial derivatives of the full inverse dynamics ``tau(q, qd, qdd)``.
 
         Generated by forward-mode differentiation of the recorded Newton-Euler program (see
@@ -199,13 +252,15 @@ class Model:
             ``[..., i, j] = d tau_i / d q_j`` (N m/rad, N/m) and ``d tau_i / d qd_j``; views into
             one array.
         """
-        d = self._derivative_model._call("inverse_dynamics_derivatives", q, qd, qdd, threads=threads)
+        d = self._derivative_model._call("inverse_dynamics_derivatives", q, qd, qdd, threads=threads,
+                                         parameters=parameters)
         n = self.dof
         return d[..., :n], d[..., n:]
 
     def forward_dynamics_derivatives(self, q: np.ndarray, qd: np.ndarray,
-                                     tau: np.ndarray, *,
-                                     threads: int = 1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                                     tau: np.ndarray, *, threads: int = 1,
+                                     parameters: ParameterValues = None,
+                                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Partial derivatives of the forward dynamics ``qdd = FD(q, qd, tau)``.
 
         Differentiating ``tau(q, qd, qdd) = u``: ``d qdd/dx = -M^-1 d tau/dx`` (x = q or qd)
@@ -229,8 +284,9 @@ class Model:
         SingularMassMatrixError
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
-        d = self._derivative_model._call("forward_dynamics_derivatives", q, qd, tau, threads=threads)
-        d = self._nonsingular(d, q)
+        d = self._derivative_model._call("forward_dynamics_derivatives", q, qd, tau, threads=threads,
+                                         parameters=parameters)
+        d = self._nonsingular(d, q, parameters)
         n = self.dof
         return d[..., :n], d[..., n:2 * n], d[..., 2 * n:]
 
@@ -243,7 +299,8 @@ class Model:
                   feedforward: np.ndarray | None = None, reference: np.ndarray | None = None,
                   gain: np.ndarray | None = None, integral_gain: np.ndarray | None = None,
                   mode: str = "feedback", tau_limit: np.ndarray | None = None,
-                  control: str = "sampled", threads: int = 1) -> tuple[np.ndarray, np.ndarray]:
+                  control: str = "sampled", threads: int = 1,
+                  parameters: ParameterValues = None) -> tuple[np.ndarray, np.ndarray]:
         """Fixed-step trajectory under a state-feedback law, in one call.
 
         With ``e = reference[row] - x``::
@@ -287,6 +344,10 @@ class Model:
         control : {"sampled", "continuous"}
         threads : int
             Threads of an ensemble (C backend with OpenMP; results do not depend on it).
+        parameters : mapping, sequence of N mappings, or (P,) / (N, P), optional
+            Values of the :attr:`runtime_parameters`: one set, or one per trajectory of an
+            ensemble (each integrated with its own dynamics and model-based law, in the same
+            one C call); checked like compile-time values (finite, physically possible).
 
         Returns
         -------
@@ -342,6 +403,11 @@ class Model:
             if arr.shape != shape:
                 raise ValueError(f"integrate: {key} must have shape {shape}, got {arr.shape}")
             checked[key] = arr
+        checked["params"] = None
+        if self.runtime_parameters or parameters is not None:
+            checked["params"] = self.parameter_input(parameters, (count,) if ensemble else (), "integrate")
+            check_physics(self.robot, self.runtime_parameters, self.parameters, checked["params"],
+                          "integrate(parameters=...)")
         if ensemble:
             return self._integrate_ensemble(checked, steps, dt, methods[method], modes[mode], threads)
         x_out = np.empty((steps + 1, nx))
@@ -353,13 +419,15 @@ class Model:
             ffi = self._impl.ffi
             ptr = {k: (ffi.NULL if v is None else ffi.from_buffer("double[]", v))
                    for k, v in checked.items()}
+            params = (ptr["params"],) if self.runtime_parameters else ()
             status = self._impl.lib.rd_simulate(
                 steps, float(dt), methods[method], ptr["x0"], ptr["feedforward"], ptr["reference"],
-                ptr["gain"], ptr["integral_gain"], modes[mode], ptr["tau_limit"], int(continuous),
-                ffi.from_buffer("double[]", x_out), ffi.from_buffer("double[]", tau_out))
+                ptr["gain"], ptr["integral_gain"], modes[mode], ptr["tau_limit"], *params,
+                int(continuous), ffi.from_buffer("double[]", x_out),
+                ffi.from_buffer("double[]", tau_out))
         if status:
             # the last finite state: a singular mass matrix there is the explanation
-            self.check_mass_matrix(x_out[status - 1, :n])
+            self.check_mass_matrix(x_out[status - 1, :n], checked["params"])
             exc = SimulationError(f"the simulated state stopped being finite at step {status - 1} "
                                   f"(t = {(status - 1) * dt:g} s); reduce dt or check the inputs")
             # the last finite state, for a caller's diagnosis
@@ -375,22 +443,25 @@ class Model:
         x_out = np.empty((count, steps + 1, nx))
         tau_out = np.empty((count, steps, n))
         status = np.zeros(count, dtype=np.int64)
+        params = a["params"]
         if isinstance(self._impl, ModuleType):
             for i in range(count):
-                status[i] = _integrate_numpy(self, steps, dt, method, mode, {**a, "x0": a["x0"][i]},
+                row = {"x0": a["x0"][i], "params": None if params is None else params[i]}
+                status[i] = _integrate_numpy(self, steps, dt, method, mode, {**a, **row},
                                              x_out[i], tau_out[i])
         elif count:
             ffi = self._impl.ffi
             ptr = {k: (ffi.NULL if v is None else ffi.from_buffer("double[]", v)) for k, v in a.items()}
+            extra = (ptr["params"],) if self.runtime_parameters else ()
             self._impl.lib.rd_simulate_ensemble(
                 count, steps, float(dt), method, ptr["x0"], ptr["feedforward"], ptr["reference"],
-                ptr["gain"], ptr["integral_gain"], mode, ptr["tau_limit"], threads,
+                ptr["gain"], ptr["integral_gain"], mode, ptr["tau_limit"], *extra, threads,
                 ffi.from_buffer("double[]", x_out), ffi.from_buffer("double[]", tau_out),
                 ffi.from_buffer("long[]", status))
         failed = np.flatnonzero(status)
         if failed.size:
             i, k = int(failed[0]), int(status[failed[0]])
-            self.check_mass_matrix(x_out[i, k - 1, :n])
+            self.check_mass_matrix(x_out[i, k - 1, :n], None if params is None else params[i])
             exc = SimulationError(
                 f"{failed.size} of {count} trajectories stopped being finite; the first, "
                 f"trajectory {i}, at step {k - 1} (t = {(k - 1) * dt:g} s); reduce dt or check "
@@ -401,7 +472,31 @@ class Model:
         return x_out, tau_out
 
     # --- plumbing ------------------------------------------------------------------------------
-    def _call(self, name: str, *arrays: np.ndarray, threads: int = 1) -> np.ndarray:
+    def parameter_input(self, value: ParameterValues, batch: tuple[int, ...] = (),
+                        where: str = "parameters") -> np.ndarray:
+        """The kernels' runtime-parameter input for ``batch`` states, checked.
+
+        Parameters
+        ----------
+        value : mapping, sequence of N mappings, (P,) or (N, P) array, or None
+            See :data:`ParameterValues` (None: the defaults).
+        batch : () or (N,)
+        where : str
+            The caller, for messages.
+
+        Returns
+        -------
+        (P,) or (N, P) array, columns in the order of :attr:`runtime_parameters`.
+        """
+        if not self.runtime_parameters:
+            raise ValueError(f"{where}: parameters=... needs a model compiled with runtime "
+                             "parameters (compile_model(robot, runtime_parameters=True or names)); "
+                             f"this {self.robot.name} model has its parameter values compiled in")
+        return parameter_array(self.runtime_parameters, self.parameters, value, batch,
+                               f"{where}(parameters=...)")
+
+    def _call(self, name: str, *arrays: np.ndarray, threads: int = 1,
+              parameters: ParameterValues = None) -> np.ndarray:
         threads = _thread_count(threads)
         inputs, result_shape = kernel_signature(name, self.dof)
         batch_shape: tuple[int, ...] | None = None
@@ -418,6 +513,8 @@ class Model:
                                  f"argument's batch shape is {batch_shape}")
             args.append(arr)
         assert batch_shape is not None
+        if self.runtime_parameters or parameters is not None:
+            args.append(self.parameter_input(parameters, batch_shape, name))
         out_shape = batch_shape + result_shape
         if isinstance(self._impl, ModuleType):
             # a singular M divides by zero: the callers check the result, not NumPy's warnings
@@ -439,7 +536,8 @@ class Model:
 
 
 def compile_model(robot: Robot, backend: Backend = "c", *,
-                  parameters: Mapping[str, float] | None = None) -> Model:
+                  parameters: Mapping[str, float] | None = None,
+                  runtime_parameters: bool | Sequence[str] = False) -> Model:
     """Generate, compile (cached) and load the numeric model of ``robot``.
 
     Parameters
@@ -451,6 +549,15 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
         NumPy module, no compiler needed.
     parameters : mapping of str to float, optional
         Values overriding the robot's parameter defaults.
+    runtime_parameters : bool or sequence of str
+        Named parameters (``robot.parameters``) that stay inputs of the generated kernels
+        instead of being folded in as constants: True for all of them, or their names. Every
+        method of the model then takes ``parameters=`` (one set, or one per state), and
+        :meth:`Model.integrate` / :func:`robodyn.simulate` one set per trajectory of an
+        ensemble, all in one C call. ``parameters`` gives their default values. The code is
+        slower than with folded constants (no constant folding), and a state's bits may
+        differ from a model compiled with the same values in the last places (other rounding
+        order; the tests hold them to 1e-12 relative).
 
     Returns
     -------
@@ -468,15 +575,17 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
         raise ValueError(f"unknown backend {backend!r}; choose 'c' (compiled) or 'numpy'")
     # unknown names, non-finite values and impossible physics at the new values are refused
     values = checked_parameter_values(robot, parameters, where="compile_model(parameters=...)")
-    # generated sources are cached by (description, parameter values, generator source)
-    key = hashlib.sha256(repr((robot.description_hash, sorted(values.items()), backend,
-                               _generator_hash())).encode()).hexdigest()[:24]
+    runtime = runtime_names(robot, runtime_parameters)
+    # generated sources are cached by (description, folded values, runtime names, generator)
+    folded = sorted((k, v) for k, v in values.items() if k not in runtime)
+    key = hashlib.sha256(repr((robot.description_hash, folded, backend, _generator_hash())
+                              + ((runtime,) if runtime else ())).encode()).hexdigest()[:24]
     directory = cache_dir()
     if backend == "c":
         src, decl = directory / f"rd_model_{key}.c", directory / f"rd_model_{key}.cdef"
         if not (src.exists() and decl.exists()):
-            kset = _kernels_cached(robot, values)
-            _check_structure(robot, kset)
+            kset = _kernels_cached(robot, values, runtime)
+            _check_structure(robot, kset, values)
             printer = CPrinter(_PREFIX)
             _write_atomic(decl, printer.declarations(kset))
             _write_atomic(src, printer.source(kset))
@@ -487,25 +596,28 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
     else:
         path = directory / f"rd_model_{key}.py"
         if not path.exists():
-            kset = _kernels_cached(robot, values)
-            _check_structure(robot, kset)
+            kset = _kernels_cached(robot, values, runtime)
+            _check_structure(robot, kset, values)
             _write_atomic(path, PythonPrinter().module(kset))
         else:
             _touch(path)
         impl = _import_file(path, f"robodyn_generated_{key}")
-    return Model(robot, backend, tuple(sorted(values.items())), impl)
+    return Model(robot, backend, tuple(sorted(values.items())), impl, runtime)
 
 
 def _compile_derivatives(model: Model) -> Model:
     """A :class:`Model` over :data:`DERIVATIVE_KERNEL_NAMES` only, same robot and parameters."""
     robot, values, backend = model.robot, model.parameters, model.backend
-    key = hashlib.sha256(repr((robot.description_hash, sorted(values.items()), backend,
-                               "derivatives", _generator_hash())).encode()).hexdigest()[:24]
+    runtime = model.runtime_parameters
+    folded = sorted((k, v) for k, v in values.items() if k not in runtime)
+    key = hashlib.sha256(repr((robot.description_hash, folded, backend, "derivatives",
+                               _generator_hash()) + ((runtime,) if runtime else ()))
+                         .encode()).hexdigest()[:24]
     directory = cache_dir()
     if backend == "c":
         src, decl = directory / f"rd_deriv_{key}.c", directory / f"rd_deriv_{key}.cdef"
         if not (src.exists() and decl.exists()):
-            kset = build_kernels(robot, values, names=DERIVATIVE_KERNEL_NAMES)
+            kset = build_kernels(robot, values, names=DERIVATIVE_KERNEL_NAMES, runtime=runtime)
             printer = CPrinter(_PREFIX)
             _write_atomic(decl, printer.declarations(kset, with_simulation=False))
             _write_atomic(src, printer.source(kset, with_simulation=False))
@@ -515,12 +627,12 @@ def _compile_derivatives(model: Model) -> Model:
     else:
         path = directory / f"rd_deriv_{key}.py"
         if not path.exists():
-            kset = build_kernels(robot, values, names=DERIVATIVE_KERNEL_NAMES)
+            kset = build_kernels(robot, values, names=DERIVATIVE_KERNEL_NAMES, runtime=runtime)
             _write_atomic(path, PythonPrinter().module(kset))
         else:
             _touch(path)
         impl = _import_file(path, f"robodyn_generated_deriv_{key}")
-    return Model(robot, backend, model.parameter_values, impl)
+    return Model(robot, backend, model.parameter_values, impl, runtime)
 
 
 def _thread_count(threads: int) -> int:
@@ -557,7 +669,7 @@ def _touch(*paths: Path) -> None:
             os.utime(p)
 
 
-def _check_structure(robot: Robot, kset: KernelSet) -> None:
+def _check_structure(robot: Robot, kset: KernelSet, values: Mapping[str, float]) -> None:
     """Refuse a mass matrix that is singular everywhere: the Cholesky pivot folds to ``1/0``."""
     fd = kset["forward_dynamics"]
     exprs = [e for _, e in fd.body] + list(fd.outputs[0].entries)
@@ -565,6 +677,10 @@ def _check_structure(robot: Robot, kset: KernelSet) -> None:
         return
     mass = kset["mass_matrix"]
     env: dict[sp.Symbol, sp.Expr] = dict.fromkeys(mass.inputs[0].entries, sp.Float(0.3))
+    if kset.runtime_parameters:
+        # runtime parameters at their default values
+        env.update({s: sp.Float(values[k]) for s, k in zip(mass.inputs[-1].entries,
+                                                            kset.runtime_parameters, strict=True)})
     for sym, expr in mass.body:
         env[sym] = expr.xreplace(env).evalf()
     m = np.array([float(sp.sympify(e).xreplace(env).evalf()) for e in mass.outputs[0].entries])
@@ -610,11 +726,13 @@ def _write_atomic(path: Path, text: str) -> None:
 _KERNEL_MEMO: dict[tuple[str, tuple], KernelSet] = {}
 
 
-def _kernels_cached(robot: Robot, parameters: Mapping[str, float] | None) -> KernelSet:
+def _kernels_cached(robot: Robot, parameters: Mapping[str, float] | None,
+                    runtime: tuple[str, ...] = ()) -> KernelSet:
     """Kernels are deterministic in (description, parameters): derive them once per process."""
-    key = (robot.description_hash, tuple(sorted((parameters or {}).items())))
+    folded = tuple(sorted((k, v) for k, v in (parameters or {}).items() if k not in runtime))
+    key = (robot.description_hash, folded, runtime)
     if key not in _KERNEL_MEMO:
-        _KERNEL_MEMO[key] = build_kernels(robot, parameters)
+        _KERNEL_MEMO[key] = build_kernels(robot, parameters, runtime=runtime)
     return _KERNEL_MEMO[key]
 
 
@@ -631,66 +749,3 @@ def _import_file(path: Path, name: str) -> ModuleType:
 
 
 __all__ = ["Model", "compile_model"]
-
-
-def _integrate_numpy(model: Model, steps: int, dt: float, method: int, mode: int,
-                     a: dict[str, np.ndarray | None], x_out: np.ndarray, tau_out: np.ndarray,
-                     continuous: bool = False) -> int:
-    """The NumPy twin of the generated C ``simulate`` (same law, same steps); returns its status."""
-    n = model.dof
-    x = a["x0"].copy()
-    x_out[0] = x
-    integ = np.zeros(n)
-    zero = np.zeros(n)
-    f = model.state_derivative
-
-    def rate(row: int, xs: np.ndarray) -> np.ndarray:
-        # e_q = q_ref - q
-        return (a["reference"][row, :n] if a["reference"] is not None else 0.0) - xs[:n]
-
-    def law(row: int, xs: np.ndarray, z: np.ndarray) -> np.ndarray:
-        # e = reference_row - x
-        e = np.broadcast_to((a["reference"][row] if a["reference"] is not None else 0.0) - xs, (2 * n,))
-        v = a["feedforward"][row].copy() if a["feedforward"] is not None else np.zeros(n)
-        if a["gain"] is not None:
-            v += a["gain"] @ e
-        if a["integral_gain"] is not None:
-            v += a["integral_gain"] * z
-        # tau = M(q) v + (C qd + g + friction) under computed torque
-        tau = model.mass_matrix(xs[:n]) @ v + model.inverse_dynamics(xs[:n], xs[n:], zero) if mode == 2 else v
-        if mode == 1:
-            tau = tau + model.gravity(xs[:n])
-        if a["tau_limit"] is not None:
-            tau = np.clip(tau, -a["tau_limit"], a["tau_limit"])
-        return tau
-
-    for k in range(steps):
-        if continuous:
-            # RK4 with the law at every stage; the error integral z is extra state, z' = e_q
-            tau = law(2 * k, x, integ)
-            k1, r1 = f(x, tau), rate(2 * k, x)
-            xs, zs = x + 0.5 * dt * k1, integ + 0.5 * dt * r1
-            k2, r2 = f(xs, law(2 * k + 1, xs, zs)), rate(2 * k + 1, xs)
-            xs, zs = x + 0.5 * dt * k2, integ + 0.5 * dt * r2
-            k3, r3 = f(xs, law(2 * k + 1, xs, zs)), rate(2 * k + 1, xs)
-            xs, zs = x + dt * k3, integ + dt * r3
-            k4, r4 = f(xs, law(2 * k + 2, xs, zs)), rate(2 * k + 2, xs)
-            x = x + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-            integ = integ + dt / 6.0 * (r1 + 2.0 * r2 + 2.0 * r3 + r4)
-        else:
-            integ = integ + rate(k, x) * dt
-            tau = law(k, x, integ)
-            if method == 0:
-                k1 = f(x, tau)
-                k2 = f(x + 0.5 * dt * k1, tau)
-                k3 = f(x + 0.5 * dt * k2, tau)
-                k4 = f(x + dt * k3, tau)
-                x = x + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-            else:
-                qd = x[n:] + dt * f(x, tau)[n:]
-                x = np.concatenate([x[:n] + dt * qd, qd])
-        if not np.all(np.isfinite(x)):
-            return k + 1
-        x_out[k + 1] = x
-        tau_out[k] = tau
-    return 0

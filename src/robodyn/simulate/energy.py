@@ -32,18 +32,23 @@ _MEMO: dict[tuple, Callable[..., object]] = {}
 
 
 def _key(model: Model, what: str) -> tuple:
-    return (what, model.robot.description_hash, tuple(sorted(model.parameters.items())))
+    runtime = model.runtime_parameters
+    folded = tuple(sorted((k, v) for k, v in model.parameters.items() if k not in runtime))
+    return (what, model.robot.description_hash, folded, runtime)
 
 
 def _values(model: Model) -> dict[sp.Symbol, float]:
-    return {sp.Symbol(k, real=True): float(v) for k, v in model.parameters.items()}
+    """The folded parameter values (runtime parameters stay symbols, arguments of the function)."""
+    return {sp.Symbol(k, real=True): float(v) for k, v in model.parameters.items()
+            if k not in model.runtime_parameters}
 
 
-def potential_energy(model: Model, q: np.ndarray) -> np.ndarray:
+def potential_energy(model: Model, q: np.ndarray, parameters: object = None) -> np.ndarray:
     """Potential energy ``V(q) = -sum_i m_i g . p_ci`` (J), plus the buoyancy potential
     ``sum_i rho V_i g . p_Bi`` under water; () for (n,), (N,) for (N, n).
 
-    The zero of ``V`` is at the world origin's height.
+    The zero of ``V`` is at the world origin's height. ``parameters``: values of the model's
+    runtime parameters, one set or one per state (as every :class:`Model` method takes them).
     """
     key = _key(model, "V")
     if key not in _MEMO:
@@ -62,9 +67,12 @@ def potential_energy(model: Model, q: np.ndarray) -> np.ndarray:
                     # V += rho V_B g . p_B (buoyancy: a mass -rho V_B at the centre of buoyancy)
                     p_b = S.rotation(t) * h.center_of_buoyancy + S.translation(t)
                     v += fluid.density * h.volume * (model.robot.gravity.T * p_b)[0, 0]
-        _MEMO[key] = sp.lambdify(qs, v.xreplace(_values(model)), modules="numpy", cse=True)
+        prm = [sp.Symbol(k, real=True) for k in model.runtime_parameters]
+        _MEMO[key] = sp.lambdify([*qs, *prm], v.xreplace(_values(model)), modules="numpy", cse=True)
     q = _states(model, q)
-    out = np.asarray(_MEMO[key](*q.T), dtype=float)
+    p = (model.parameter_input(parameters, q.shape[:-1], "potential_energy")
+         if model.runtime_parameters else np.empty(q.shape[:-1] + (0,)))
+    out = np.asarray(_MEMO[key](*q.T, *p.T), dtype=float)
     return np.broadcast_to(out, q.shape[:-1]).copy()
 
 
@@ -75,12 +83,14 @@ def frame_origins(model: Model, q: np.ndarray) -> np.ndarray:
     -------
     (n + 2, 3) for one state, (N, n + 2, 3) for a batch: a stick figure of the arm.
     """
-    key = _key(model, "points")
+    # (runtime parameters at the model's values)
+    key = ("points", model.robot.description_hash, tuple(sorted(model.parameters.items())))
     if key not in _MEMO:
         qs, _, _ = joint_symbols(model.dof)
         kin = forward_kinematics(model.robot, qs)
         frames = (sp.ImmutableMatrix(model.robot.base),) + kin.links + (kin.end_effector,)
-        pts = sp.Matrix([list(S.translation(f)) for f in frames]).xreplace(_values(model))
+        every = {sp.Symbol(k, real=True): float(v) for k, v in model.parameters.items()}
+        pts = sp.Matrix([list(S.translation(f)) for f in frames]).xreplace(every)
         _MEMO[key] = sp.lambdify(qs, pts, modules="numpy", cse=True)
     q = _states(model, q)
     fn = _MEMO[key]

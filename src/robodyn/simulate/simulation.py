@@ -24,7 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from robodyn.numeric.model import MAX_INTEGRATE_BYTES, Model
+from robodyn.numeric.model import MAX_INTEGRATE_BYTES, Model, ParameterValues
+from robodyn.numeric.runtime_parameters import check_physics
 from robodyn.robot.errors import SimulationError
 from robodyn.simulate.controllers import Controller
 from robodyn.simulate.energy import potential_energy
@@ -126,7 +127,7 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
              tau_limit: float | np.ndarray | None = None, rtol: float = 1e-9,
              atol: float = 1e-12, control: str = "sampled", decimate: int = 1,
              max_samples: int | None = MAX_SAMPLES, substeps: int = 1,
-             threads: int = 1) -> Trajectory:
+             threads: int = 1, parameters: ParameterValues = None) -> Trajectory:
     """Simulate ``model`` from ``(q0, qd0)`` for ``duration`` seconds.
 
     A batch of ``N`` initial states (``q0`` of shape (N, n)) is integrated in one call into the
@@ -178,6 +179,12 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         held-torque dynamics (e.g. viscous friction over a small wrist inertia, ``-b / m``).
     threads : int
         Threads of a batch run (C backend with OpenMP); the result does not depend on it.
+    parameters : mapping, sequence of N mappings, or (P,) / (N, P), optional
+        Values of the model's runtime parameters (a model from ``compile_model(robot,
+        runtime_parameters=...)``; columns in the order of ``model.runtime_parameters``): one
+        set for the run, or for a batch one set per trajectory, every trajectory integrated
+        with its own parameters (plant and built-in model-based law) in the same C call.
+        Checked like compile-time values. None: the model's defaults.
 
     Returns
     -------
@@ -248,6 +255,16 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
     if limit is None and isinstance(controller, Controller) and controller.tau_limit is not None:
         limit = _tau_limit(controller.tau_limit, n)
     own = _controller_model(controller, model)
+    rows = None
+    if parameters is not None:
+        rows = model.parameter_input(parameters, (count,) if batch else (), "simulate")
+        check_physics(model.robot, model.runtime_parameters, model.parameters, rows,
+                      "simulate(parameters=...)")
+        if not batch:
+            # one set: the model with those defaults (no compilation)
+            model = model.with_parameters(dict(zip(model.runtime_parameters, rows.tolist(),
+                                                   strict=True)))
+            rows = None
     if batch:
         _check_batch(method, control, substeps, controller, own)
     if own is not None:
@@ -266,11 +283,12 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         x0 = np.concatenate([q0, qd0], axis=1)
         try:
             x, tau, evals = _fixed_step_batch(model, x0, steps, dt, decimate, method, controller,
-                                              limit, threads)
+                                              limit, threads, rows)
         except SimulationError as exc:
             i = getattr(exc, "trajectory", 0)
-            raise _diagnosed(exc, model, x0[i], dt, method, control) from None
-        return _result(model, t, x, tau, method, dt, controller, evals, decimate)
+            raise _diagnosed(exc, _member_model(model, rows, i), x0[i], dt, method,
+                             control) from None
+        return _result(model, t, x, tau, method, dt, controller, evals, decimate, rows)
     try:
         if method in FIXED_STEP and substeps == 1 and (controller is None
                                                        or isinstance(controller, Controller)):
@@ -384,9 +402,17 @@ def _check_batch(method: str, control: str, substeps: int, controller: Controlle
             "supported there: simulate each row of q0 on its own")
 
 
+def _member_model(model: Model, rows: np.ndarray | None, i: int) -> Model:
+    """The model of trajectory ``i`` of a batch: its own runtime parameter values, if any."""
+    if rows is None:
+        return model
+    return model.with_parameters(dict(zip(model.runtime_parameters, rows[i].tolist(), strict=True)))
+
+
 def _fixed_step_batch(model: Model, x0: np.ndarray, steps: int, dt: float, decimate: int,
                       method: str, controller: Controller | None, limit: np.ndarray | None,
-                      threads: int) -> tuple[np.ndarray, np.ndarray, int]:
+                      threads: int, rows: np.ndarray | None = None,
+                      ) -> tuple[np.ndarray, np.ndarray, int]:
     """N trajectories from ``x0`` (N, 2 n) under one sampled law: the ensemble integrator.
 
     Returns ``x`` (N, S, 2 n), ``tau`` (N, S, n) and the evaluations per trajectory. The run is
@@ -411,7 +437,8 @@ def _fixed_step_batch(model: Model, x0: np.ndarray, steps: int, dt: float, decim
         m = min(chunk, steps - k0)
         times = dt * np.arange(k0, k0 + m)
         kwargs = {} if controller is None else controller.sampled(model, times)
-        xs, taus = model.integrate(x, m, dt, method, tau_limit=limit, threads=threads, **kwargs)
+        xs, taus = model.integrate(x, m, dt, method, tau_limit=limit, threads=threads,
+                                   parameters=rows, **kwargs)
         # global step k is kept when k % decimate == 0
         first = -k0 % decimate
         x_out[:, (k0 + first) // decimate: (k0 + m) // decimate + 1] = xs[:, first::decimate]
@@ -428,9 +455,9 @@ def _fixed_step_batch(model: Model, x0: np.ndarray, steps: int, dt: float, decim
             # z = dt sum_k (q_ref(t_k) - q_k) over the steps and the final sample
             z = dt * np.sum(kwargs["reference"][:, :n] - xs[i, :-1, :n], axis=0)
             z = z + dt * controller.position_error(t_end, x[i, :n])
-            last = controller.law(model, t_end, x[i], z)
+            last = controller.law(_member_model(model, rows, i), t_end, x[i], z)
         else:
-            last = controller.law(model, t_end, x[i], None)
+            last = controller.law(_member_model(model, rows, i), t_end, x[i], None)
         tau_out[i, -1] = _clip(last, limit)
     return x_out, tau_out, steps * (4 if method == "rk4" else 1)
 
@@ -567,21 +594,24 @@ def _adaptive(model: Model, x0: np.ndarray, t: np.ndarray, method: str, controll
 
 
 def _result(model: Model, t: np.ndarray, x: np.ndarray, tau: np.ndarray, method: str, dt: float,
-            controller: ControllerLike, evals: int, decimate: int) -> Trajectory:
+            controller: ControllerLike, evals: int, decimate: int,
+            rows: np.ndarray | None = None) -> Trajectory:
     n = model.dof
     lead = x.shape[:-1]  # (S,) or (N, S) for a batch
     q, qd = np.ascontiguousarray(x[..., :n]), np.ascontiguousarray(x[..., n:])
     # the kernels on the samples of all trajectories as one (N S, n) batch
     qf, qdf = q.reshape(-1, n), qd.reshape(-1, n)
-    qdd = model.forward_dynamics(qf, qdf, tau.reshape(-1, n)).reshape(q.shape)
+    # each sample with its trajectory's runtime parameters (None: the model's own)
+    pf = None if rows is None else np.repeat(rows, lead[-1], axis=0)
+    qdd = model.forward_dynamics(qf, qdf, tau.reshape(-1, n), parameters=pf).reshape(q.shape)
     kinetic = np.empty(qf.shape[0])
     for k0 in range(0, qf.shape[0], CHUNK_STEPS):
         # K = 0.5 qd^T M qd (M in pieces: (S, n, n) would dwarf the trajectory)
         part = slice(k0, k0 + CHUNK_STEPS)
-        kinetic[part] = 0.5 * np.einsum("ki,kij,kj->k", qdf[part], model.mass_matrix(qf[part]),
-                                        qdf[part])
+        mass = model.mass_matrix(qf[part], parameters=None if pf is None else pf[part])
+        kinetic[part] = 0.5 * np.einsum("ki,kij,kj->k", qdf[part], mass, qdf[part])
     kinetic = kinetic.reshape(lead)
-    potential = potential_energy(model, qf).reshape(lead)
+    potential = potential_energy(model, qf, parameters=pf).reshape(lead)
     arrays = [t, q, qd, qdd, tau, kinetic, potential, kinetic + potential]
     for a in arrays:
         a.flags.writeable = False
