@@ -2,11 +2,13 @@
 
 Data: ../shared/data/kinova-gen3 (README: motor current ``Cur`` is the dependable target; the
 ``Torque`` columns are a model output and are never used here). Fit on the first 70 % of each
-whole-arm run, predict the last 30 % and every jointwise run (the moving joint).
+whole-arm run, predict the last 30 % and every jointwise run (the moving joint); and across runs.
 
 README baseline on the same split: 0.32 relative error against the raw current, 0.22 against
-the zero-phase-filtered current; noise floor (raw minus filtered) about 0.26. Figures measured
-by these tests are quoted in docs/identification.md.
+the zero-phase-filtered current; noise floor (raw minus filtered) about 0.26. "Filtered" is
+robodyn's reference filter (``robodyn.validate.heldout``: zero-phase Butterworth, order 4, at
+2.5 Hz, the cut-off that reproduces the README's noise floor), the one ``rd.validate`` and the
+CLI use. Figures measured by these tests are quoted in docs/identification.md.
 """
 
 from __future__ import annotations
@@ -16,13 +18,16 @@ import pytest
 
 import robodyn as rd
 from robodyn.identify.consistent import pseudo_inertia
-from robodyn.measure.filtering import lowpass
+from robodyn.identify.preprocess import preprocess
 from robodyn.robot.yaml_writer import dump_yaml
+from robodyn.validate.heldout import held_out_error, moving_joints
 from tests.identify.helpers import load_quiet
-from tests.identify.kinova import JOINTWISE_FILES, WHOLE_ARM_FILES, read, relative_error, split
+from tests.identify.kinova import JOINTWISE_FILES, WHOLE_ARM, WHOLE_ARM_FILES, read, split
 
 BASELINE_RAW = 0.32
 BASELINE_FILTERED = 0.22
+#: the controller's current-to-torque constants (data README), N m/A
+CONTROLLER_GAINS = np.array([9.13, 9.13, 9.13, 9.13, 5.852, 5.852, 5.852])
 data = pytest.mark.data(*WHOLE_ARM_FILES, *JOINTWISE_FILES)
 
 
@@ -36,12 +41,17 @@ def gen3():
     return robot, model, train, test
 
 
+@pytest.fixture(scope="module")
+def default_fit(gen3):
+    robot, model, train, _ = gen3
+    return rd.identify(robot, train, target="current", model=model)
+
+
 def _errors(ident, recs, joint=None):
-    cols = slice(None) if joint is None else [joint]
-    pred = np.vstack([ident.predict(r)[:, cols] for r in recs])
-    y = np.vstack([r.current[:, cols] for r in recs])
-    y_f = np.vstack([lowpass(r.t, r.current, ident.preprocess.cutoff)[:, cols] for r in recs])
-    return relative_error(pred - y, y), relative_error(pred - y_f, y_f), relative_error(y - y_f, y)
+    """(raw, filtered, noise floor) of ``ident`` pooled over ``recs`` (reference filter)."""
+    fig = held_out_error([r.t for r in recs], [r.current for r in recs], [ident.predict(r) for r in recs],
+                         ident.robot.joint_names, None if joint is None else [joint])
+    return fig.raw, fig.filtered, fig.noise_floor
 
 
 @data
@@ -55,25 +65,68 @@ def test_held_out_current_error_beats_the_readme_baseline(gen3):
               f"noise floor {figures[friction][2]:.3f}  (cut-off {ident.preprocess.cutoff:g} Hz, "
               f"decimate {ident.preprocess.decimate}, lambda {ident.regularization:.3g}, "
               f"cond {ident.condition:.3g})")
-    for friction in ("linear", "load"):  # measured: linear 0.318 / 0.206, load 0.304 / 0.185
+    for friction in ("linear", "load"):  # measured: linear 0.318 / 0.206, load: see the docs
         raw, filtered, floor = figures[friction]
         assert raw < BASELINE_RAW, friction
         assert filtered < BASELINE_FILTERED, friction
-        assert 0.2 < floor < 0.3
+        assert 0.25 < floor < 0.27  # the README's "about 0.26" (measured 0.261)
     # friction is the decisive term: without it the error nearly doubles
     assert figures["none"][0] > 1.5 * figures["linear"][0]
 
 
+# Each whole-arm run's last 30 % alone, default fit. The two short runs are NOT below the README's
+# pooled baseline on their own (measured 0.353 / 0.269 and 0.351 / 0.283, noise floors 0.246 /
+# 0.243); the long run is (0.285 / 0.110) and carries the pooled figure.
+SHORT_RUN_GAP = pytest.mark.xfail(strict=True, reason="measured above the pooled README baseline")
+
+
 @data
-def test_each_jointwise_run_for_its_moving_joint(gen3):
-    robot, model, train, _ = gen3
-    ident = rd.identify(robot, train, target="current", friction="load", model=model)
-    for k, path in enumerate(JOINTWISE_FILES):
+@pytest.mark.parametrize("run", [pytest.param(0, marks=SHORT_RUN_GAP),
+                                 pytest.param(1, marks=SHORT_RUN_GAP), 2], ids=WHOLE_ARM)
+def test_each_whole_arm_run_held_out(gen3, default_fit, run):
+    _, _, _, test = gen3
+    raw, filtered, floor = _errors(default_fit, [test[run]])
+    print(f"{WHOLE_ARM[run]}: raw {raw:.3f}  filtered {filtered:.3f}  noise floor {floor:.3f}")
+    assert raw < BASELINE_RAW
+    assert filtered < BASELINE_FILTERED
+
+
+@data
+def test_each_jointwise_run_for_its_moving_joint(default_fit):
+    """Never used in fitting; the moving joint's current. Raw: below the baseline, or, where the
+    run's noise floor alone exceeds it (joint 7: 0.498), within 0.01 of that floor."""
+    for path in JOINTWISE_FILES:
         rec = read(path)
-        raw, filtered, floor = _errors(ident, [rec], joint=k)
+        (k,) = moving_joints(rec.q)
+        assert path.name == f"joint_{k + 1}_trapez.csv.gz"
+        raw, filtered, floor = _errors(default_fit, [rec], joint=int(k))
         print(f"{path.name}: joint {k + 1}: raw {raw:.3f}  filtered {filtered:.3f}  noise floor {floor:.3f}")
-        assert raw < max(BASELINE_RAW, floor + 0.06), path.name
+        assert raw < max(BASELINE_RAW, floor + 0.01), path.name
         assert filtered < BASELINE_FILTERED, path.name
+
+
+@data
+def test_cross_run_fit_on_the_short_runs_predicts_the_long_run(gen3):
+    """Fit on the whole of RunTrajectory1 and Trajectory1, predict the whole of
+    RecordTrajectory_quadratic (a different motion, recorded about 10 deg C colder): worse than
+    the held-out split (measured 0.415 / 0.332, noise floor 0.266), yet better than the
+    manufacturer's URDF with the controller's constants on the same run (an independent model)."""
+    robot, model, _, _ = gen3
+    runs = [read(p) for p in WHOLE_ARM_FILES]
+    from robodyn.identify.prior import IdentificationWarning
+
+    with pytest.warns(IdentificationWarning, match=r"'joint_7' cannot be absorbed"):
+        ident = rd.identify(robot, runs[:2], target="current", model=model)
+    raw, filtered, floor = _errors(ident, [runs[2]])
+    s = preprocess(runs[2], ident.preprocess, None)
+    urdf = held_out_error(runs[2].t, runs[2].current, model.inverse_dynamics(s.q, s.qd, s.qdd)
+                          / CONTROLLER_GAINS, robot.joint_names)
+    print(f"cross-run: raw {raw:.3f}  filtered {filtered:.3f}  noise floor {floor:.3f}; "
+          f"manufacturer URDF raw {urdf.raw:.3f} filtered {urdf.filtered:.3f}")
+    assert raw < urdf.raw and filtered < urdf.filtered  # noqa: PT018
+    held = _errors(rd.identify(robot, [split(r)[0] for r in runs], target="current", model=model),
+                   [split(runs[2])[1]])
+    assert raw > held[0]  # a different excitation: worse than the same run's last 30 %
 
 
 @data

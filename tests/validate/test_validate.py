@@ -69,7 +69,8 @@ def test_noise_floor_matches_added_noise_and_errors_against_filtered_are_smaller
     noisy = sim.tau + rng.normal(size=sim.tau.shape) * sigma
     rec = recording(t=sim.t, q=sim.q, qd=sim.qd, qdd=sim.qdd, tau=noisy,
                     joint_names=robot.joint_names)
-    val = validate(robot, rec, model=model, window=None)
+    val = validate(robot, rec, model=model, window=None, noise_cutoff=10.0)
+    assert val.noise.cutoff == 10.0
     # the filter removes the white noise above 10 Hz (98 % of its variance in a 500 Hz band) and
     # the clean torque's own content above 10 Hz (Coulomb friction steps at velocity reversals)
     clean_hf = sim.tau - lowpass(sim.t, sim.tau, val.noise.cutoff)

@@ -184,26 +184,24 @@ def friction_table(robot: Any, train: Any, test: Sequence[Any], models: Sequence
     pandas.DataFrame
         One row per model: ``relative_error`` (``||e|| / ||y||`` against the raw target over all
         test samples and joints), ``relative_error_filtered`` (against the target low-passed with
-        the identification's filter), ``noise_floor`` (``||y - y_f|| / ||y||``) and
+        the reference filter of :mod:`robodyn.validate.heldout`), ``noise_floor``
+        (``||y - y_f|| / ||y||``) and
         ``relative_error_<joint>`` per joint (raw).
     """
     import pandas as pd
 
     from robodyn.identify.pipeline import identify
-    from robodyn.measure.filtering import lowpass
+    from robodyn.validate.heldout import held_out_error
 
     rows = []
     for model in models:
         ident = identify(robot, train, friction=model, **options)
-        pred = np.vstack([ident.predict(r) for r in test])
-        y = np.vstack([np.asarray(getattr(r, ident.target), float) for r in test])
-        cut = ident.preprocess.cutoff
-        y_f = y if cut is None else np.vstack(
-            [lowpass(r.t, np.asarray(getattr(r, ident.target), float), cut) for r in test])
-        row = {"model": model,
-               "relative_error": float(np.linalg.norm(pred - y) / np.linalg.norm(y)),
-               "relative_error_filtered": float(np.linalg.norm(pred - y_f) / np.linalg.norm(y_f)),
-               "noise_floor": float(np.linalg.norm(y - y_f) / np.linalg.norm(y))}
+        preds = [ident.predict(r) for r in test]
+        ys = [np.asarray(getattr(r, ident.target), float) for r in test]
+        fig = held_out_error([np.asarray(r.t, float) for r in test], ys, preds, robot.joint_names)
+        pred, y = np.vstack(preds), np.vstack(ys)
+        row = {"model": model, "relative_error": fig.raw, "relative_error_filtered": fig.filtered,
+               "noise_floor": fig.noise_floor}
         for j, name in enumerate(robot.joint_names):
             row[f"relative_error_{name}"] = float(np.linalg.norm(pred[:, j] - y[:, j])
                                                   / np.linalg.norm(y[:, j]))

@@ -6,10 +6,18 @@ measured state under the measured torque (drift per window), and estimates the t
 floor and the residual spectra. :mod:`robodyn.validate.figures` draws the result.
 """
 
+from robodyn.validate.heldout import (
+    REFERENCE_CUTOFF_HZ,
+    HeldOutError,
+    format_held_out,
+    held_out_error,
+    reference_filter,
+)
 from robodyn.validate.metrics import ErrorMetrics, error_metrics
 from robodyn.validate.spectra import NoiseFloor, ResidualSpectra, noise_floor, residual_spectra
 from robodyn.validate.validation import Validation, validate
 from robodyn.validate.windows import WindowDrift, simulate_windows
 
-__all__ = ["ErrorMetrics", "NoiseFloor", "ResidualSpectra", "Validation", "WindowDrift",
-           "error_metrics", "noise_floor", "residual_spectra", "simulate_windows", "validate"]
+__all__ = ["REFERENCE_CUTOFF_HZ", "ErrorMetrics", "HeldOutError", "NoiseFloor", "ResidualSpectra",
+           "Validation", "WindowDrift", "error_metrics", "format_held_out", "held_out_error",
+           "noise_floor", "reference_filter", "residual_spectra", "simulate_windows", "validate"]

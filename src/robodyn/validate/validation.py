@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from robodyn.measure.filtering import differentiate, lowpass
+from robodyn.measure.filtering import differentiate
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import ValidationError
 from robodyn.robot.model import Robot
@@ -34,6 +34,7 @@ from robodyn.validate.effort import (
     resolve_target,
     target_unit,
 )
+from robodyn.validate.heldout import REFERENCE_CUTOFF_HZ, reference_filter
 from robodyn.validate.metrics import ErrorMetrics, error_metrics
 from robodyn.validate.spectra import NoiseFloor, ResidualSpectra, noise_floor, residual_spectra
 from robodyn.validate.windows import WindowDrift, simulate_windows
@@ -166,7 +167,7 @@ class Validation:
 
 def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: Any = None,
              model: Model | None = None, gains: np.ndarray | None = None, window: float | None = 0.2,
-             noise_cutoff: float = 10.0, cutoff: float | None = None,
+             noise_cutoff: float = REFERENCE_CUTOFF_HZ, cutoff: float | None = None,
              backend: str = "c") -> Validation:
     """Validate ``robot``'s dynamic model against a measured recording.
 
@@ -201,7 +202,9 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
         states are those of the prediction.
     noise_cutoff : float
         Cut-off of the zero-phase Butterworth low-pass (order 4) that separates the target
-        from its noise, Hz (limited to 0.4 x the sample rate).
+        from its noise, Hz (limited to 0.4 x the sample rate); default: the reference filter of
+        :mod:`robodyn.validate.heldout` (2.5 Hz, the cut-off that reproduces the Kinova data
+        README's noise floor), used for every "against filtered" figure robodyn reports.
     backend : {"c", "numpy"}
         For ``compile_model`` when ``model`` is not given.
 
@@ -273,7 +276,7 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
     dt = float(np.median(np.diff(t)))
     cutoff = min(float(noise_cutoff), 0.4 / dt)
     filtered = np.full_like(y, np.nan)
-    filtered[:, has] = lowpass(t, y[:, has], cutoff)
+    filtered[:, has] = reference_filter(t, y[:, has], cutoff)
     # tau_measured = N K_t current
     tau_meas = y * scale
     friction_model_at_data = friction_torque(robot, qd, model.parameters)
