@@ -17,8 +17,7 @@ import textwrap
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
-
-import sympy as sp
+from typing import TYPE_CHECKING
 
 import robodyn as rd
 from robodyn.cli_cache import add_cache_parser
@@ -28,25 +27,22 @@ from robodyn.cli_record import add_record_parser
 from robodyn.cli_sweep import add_sweep_parser
 from robodyn.cli_underwater import add_underwater_parser
 from robodyn.cli_workflows import add_parsers
-from robodyn.report.agreement import (
-    AGREEMENT_HEADERS,
-    COUNT_HEADERS,
-    TOLERANCE,
-    agreement,
-    agreement_rows,
-    count_rows,
-    derive_all,
-    verdict,
-)
 from robodyn.report.text import err as _err
 from robodyn.report.text import progress as _progress
 from robodyn.report.text import steps as _steps
 from robodyn.report.text import table as _table
 from robodyn.robot.errors import DescriptionError
-from robodyn.symbolic.eom import METHODS
-from robodyn.symbolic.render import render_json, render_latex, render_text
 
-_RENDERERS = {"text": render_text, "latex": render_latex, "json": render_json}
+if TYPE_CHECKING:
+    import sympy as sp
+
+# SymPy, the symbolic layer and the agreement report are imported inside the commands that use
+# them, so that ``robodyn --help`` and the numeric commands (calibrate, identify, ...) start
+# without them. The parser only needs these names; tests/calibrate/test_startup.py checks them
+# against robodyn.symbolic.eom.METHODS and robodyn.report.agreement.TOLERANCE.
+METHODS: tuple[str, ...] = ("newton_euler", "lagrange", "kane")
+TOLERANCE = 1e-9
+_RENDERERS = ("text", "latex", "json")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -56,6 +52,8 @@ _RENDERERS = {"text": render_text, "latex": render_latex, "json": render_json}
 
 def _fmt(expr: object) -> str:
     """Short text of a number or SymPy expression."""
+    import sympy as sp
+
     if expr is None:
         return "-"
     return sp.sstr(sp.sympify(expr), full_prec=False)
@@ -70,6 +68,8 @@ def _types(robot: rd.Robot) -> str:
 
 
 def _transform(mat: sp.MatrixBase) -> str:
+    import sympy as sp
+
     if sp.Matrix(mat) == sp.eye(4):
         return "identity"
     return "; ".join(" ".join(_fmt(mat[r, c]) for c in range(4)) for r in range(3))
@@ -143,16 +143,29 @@ def _cmd_show(args: argparse.Namespace) -> int:
 
 
 def _cmd_derive(args: argparse.Namespace) -> int:
+    from robodyn.symbolic.render import render_json, render_latex, render_text
+
+    renderers = {"text": render_text, "latex": render_latex, "json": render_json}
     robot = _load(args)
     with _progress(f"deriving {args.method}"):
         eom = rd.derive(robot, args.method)
     with _progress(f"rendering {args.format}"):
-        text = _RENDERERS[args.format](eom)
+        text = renderers[args.format](eom)
     _write(text, args.output)
     return 0
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
+    from robodyn.report.agreement import (
+        AGREEMENT_HEADERS,
+        COUNT_HEADERS,
+        agreement,
+        agreement_rows,
+        count_rows,
+        derive_all,
+        verdict,
+    )
+
     robot = _load(args)
     print(f"{robot.name}: {robot.dof} joints ({_types(robot)}), {robot.source}")
     symbolic = robot.dof <= 2
@@ -258,7 +271,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("robot", metavar="ROBOT", help=_ROBOT_HELP)
     p.add_argument("--method", choices=METHODS, default="newton_euler",
                    help="formulation (default: %(default)s)")
-    p.add_argument("--format", choices=tuple(_RENDERERS), default="text",
+    p.add_argument("--format", choices=_RENDERERS, default="text",
                    help="output format (default: %(default)s)")
     p.add_argument("-o", "--output", metavar="FILE", help="write to FILE instead of stdout")
     p.set_defaults(func=_cmd_derive)

@@ -8,9 +8,11 @@ from __future__ import annotations
 
 import argparse
 
-from robodyn.codegen.build import DEFAULT_CACHE_MAX_MB, cache_info, clear_cache
-
 __all__ = ["add_cache_parser"]
+
+# robodyn.codegen.build (and cffi) is imported by the command itself, not to build the parser;
+# tests/calibrate/test_startup.py checks this against codegen.build.DEFAULT_CACHE_MAX_MB.
+DEFAULT_CACHE_MAX_MB = 1024
 
 
 def _mb(size: int) -> str:
@@ -18,6 +20,8 @@ def _mb(size: int) -> str:
 
 
 def _cmd_cache(args: argparse.Namespace) -> int:
+    from robodyn.codegen.build import cache_info, clear_cache
+
     info = cache_info()
     if args.action == "info":
         print(f"location  {info.path}" + ("" if info.path.is_dir() else " (not created yet)"))

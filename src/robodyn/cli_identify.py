@@ -14,13 +14,24 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
 
 import robodyn as rd
 from robodyn.cli_workflows import floats
 from robodyn.report.text import err, progress
 
 __all__ = ["add_parsers"]
+
+# The --friction choices, kept here so that building the parser does not import the
+# identification package; tests/calibrate/test_startup.py checks them against
+# robodyn.identify.friction.FRICTION_MODELS.
+FRICTION_MODELS: tuple[str, ...] = ("none", "linear", "stribeck", "load", "polynomial")
+
+
+def tqdm(*args: object, **kwargs: object) -> object:
+    """:class:`tqdm.tqdm`, imported on first use (it is not needed to build the parser)."""
+    from tqdm import tqdm as _tqdm
+
+    return _tqdm(*args, **kwargs)
 
 
 def _gains(value: np.ndarray | None, n: int) -> np.ndarray | None:
@@ -106,6 +117,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     paths["metrics"] = _write_metrics([v for _, v in vals], out / "validation.csv")
     with progress("writing the report and its figures"):
         paths["report"] = identification_html(ident, vals, out, [r.source for r in recs])
+    table = _held_out_table([(kind, v) for (kind, _), (_, v) in zip(jobs, vals, strict=True)])
     print(f"identified {len(ident.base_parameters)} base parameters of {robot.name} "
           f"({args.method}, target {ident.target}); condition number {ident.condition:.3g}, "
           f"Tikhonov weight {ident.regularization:.3g}")
@@ -113,10 +125,18 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     for head, v in vals:
         print(f"\n{head}")
         print(v.summary())
-    print()
+    print(f"\n{table}\n")
     for kind, path in paths.items():
         print(f"wrote {kind:<10} {path}")
     return _check_loadable(paths["yaml"])
+
+
+def _held_out_table(vals: Sequence[tuple[str, rd.Validation]]) -> str:
+    """Relative error of each validation, raw and against the reference-filtered target, beside
+    its noise floor (a jointwise run: its moving joint only)."""
+    from robodyn.validate.heldout import format_held_out, held_out_from_validation
+
+    return format_held_out([held_out_from_validation(v, label) for label, v in vals])
 
 
 def _with_gains(robot: rd.Robot, gains: np.ndarray) -> rd.Robot:
@@ -168,8 +188,9 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     gains = _gains(args.gains, robot.dof)
     vals = []
     for rec in tqdm(recs, desc="validating", unit="recording", leave=False, disable=len(recs) < 2):
+        extra = {} if args.noise_cutoff is None else {"noise_cutoff": args.noise_cutoff}
         vals.append(rd.validate(robot, rec, args.target, model=model, gains=gains,
-                                window=args.window, noise_cutoff=args.noise_cutoff))
+                                window=args.window, **extra))
     paths = {"metrics": _write_metrics(vals, out / "validation.csv")}
     with progress("writing the report and its figures"):
         for i, v in enumerate(vals):
@@ -178,6 +199,8 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     for v in vals:
         print(v.summary())
         print()
+    print(_held_out_table([("validation", v) for v in vals]))
+    print()
     for kind, path in paths.items():
         print(f"wrote {kind:<10} {path}")
     return 0
@@ -207,8 +230,6 @@ def _common(p: argparse.ArgumentParser) -> None:
 
 
 def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
-    from robodyn.identify.friction import FRICTION_MODELS
-
     p = sub.add_parser(
         "identify", help="identify inertial, drive and friction parameters from recordings",
         formatter_class=fmt,
@@ -266,8 +287,9 @@ def _validate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
     p.add_argument("--gains", type=floats, metavar="K",
                    help="joint torque per motor ampere, N m/A, one or one per joint (default: the "
                         "description's gear ratio x torque constant)")
-    p.add_argument("--noise-cutoff", type=float, default=10.0, metavar="HZ",
-                   help="low-pass cut-off separating the target from its noise (default: "
-                        "%(default)s)")
+    p.add_argument("--noise-cutoff", type=float, metavar="HZ",
+                   help="low-pass cut-off separating the target from its noise, Hz (default: the "
+                        "reference filter of robodyn.validate.heldout, zero-phase Butterworth "
+                        "order 4 at 2.5 Hz, which reproduces the Kinova data README's noise floor)")
     _common(p)
     p.set_defaults(func=_cmd_validate)

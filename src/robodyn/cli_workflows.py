@@ -19,6 +19,14 @@ from robodyn.report.text import err, progress, table
 
 __all__ = ["add_parsers"]
 
+# The parsers' choices and defaults, kept here so that building the parser (every command, and
+# --help) imports neither the simulation nor the calibration package; test_startup.py in
+# tests/calibrate checks them against robodyn.simulate.simulation and robodyn.calibrate.models.
+FIXED_STEP: tuple[str, ...] = ("rk4", "semi_implicit")
+ADAPTIVE: tuple[str, ...] = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+MAX_SAMPLES = 1_000_000
+MODELS: tuple[str, ...] = ("dh", "hayati", "s-model", "poe")
+
 
 def floats(text: str) -> np.ndarray:
     """A comma-separated list of numbers (``0,0.5,-1``); an argparse type."""
@@ -260,8 +268,6 @@ def add_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> 
 
 
 def _simulate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
-    from robodyn.simulate.simulation import ADAPTIVE, FIXED_STEP, MAX_SAMPLES
-
     p = sub.add_parser(
         "simulate", help="simulate a robot (passive or under a controller), CSV and plots",
         formatter_class=fmt,
@@ -320,8 +326,6 @@ def _simulate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
 
 
 def _calibrate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
-    from robodyn.calibrate.models import MODELS
-
     p = sub.add_parser(
         "calibrate", help="kinematic calibration from measured end-effector positions",
         formatter_class=fmt,

@@ -71,7 +71,7 @@ def load(source: str | Path, *, strict: bool = False, tool: str | None = None) -
     FileNotFoundError
         ``source`` is neither a built-in name nor an existing file.
     """
-    from robodyn.robot import urdf, validation, yaml_loader
+    from robodyn.robot import validation, yaml_loader
 
     text = str(source)
     if text in ALIASES:
@@ -94,6 +94,8 @@ def load(source: str | Path, *, strict: bool = False, tool: str | None = None) -
         validation.check_mass_matrix(robot, where=str(path), strict=strict)
         return robot
     if suffix == ".urdf":
+        from robodyn.robot import urdf  # yourdfpy and trimesh: only for URDF files
+
         return urdf.load_urdf(path, strict=strict, tool=tool)
     raise ValueError(f"{path}: unknown description format {suffix!r} (expected .yaml, .yml or .urdf)")
 
