@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 
 import robodyn as rd
-from robodyn.hydro.effects import DEFAULT_CURRENT, EFFECTS
+from robodyn.hydro.effects import DEFAULT_CD_VALUES, DEFAULT_CURRENT, DEFAULT_CURRENT_SPEEDS, EFFECTS
 
 __all__ = ["add_underwater_parser"]
 
@@ -34,16 +34,34 @@ def _assignment(text: str) -> tuple[str, float]:
 
 
 def _cmd_underwater(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from robodyn.hydro.model_error import model_error_study
+    from robodyn.hydro.sensitivity import sensitivity
     from robodyn.hydro.study import effect_series
     from robodyn.hydro.study_plots import write_study
 
     robot = rd.load(args.robot)
+    params = dict(args.set or [])
     series = effect_series(
         robot, start=args.start, end=args.end, move_time=args.move_time,
         hold_time=args.hold_time, free_time=args.free_time, dt=args.dt, bandwidth=args.bandwidth,
-        current=args.current, lift=args.lift, parameters=dict(args.set or []),
+        current=args.current, lift=args.lift, parameters=params,
         backend=args.backend, progress=True)
-    for path in write_study(series, args.output):
+    sens = errors = None
+    if not args.series_only:
+        t = series.runs[0].tracked.t
+        speed = float(np.linalg.norm(series.current))
+        sens = sensitivity(robot, series.reference, t, free_time=args.free_time, dt=args.dt,
+                           cd_values=args.cd_values, current_speeds=args.current_speeds,
+                           direction=series.current / speed if speed > 0 else (1.0, 0.0, 0.0),
+                           lift=args.lift, parameters=params, backend=args.backend,
+                           progress=True)
+        errors = model_error_study(robot, series.reference, float(t[-1]), dt=args.dt,
+                                   bandwidth=args.bandwidth, current=series.current,
+                                   lift=args.lift, parameters=params, backend=args.backend,
+                                   progress=True)
+    for path in write_study(series, args.output, sens, errors):
         print(path)
     return 0
 
@@ -58,7 +76,10 @@ def add_underwater_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
                     "PD controller, and a free motion from rest. Writes effects.csv and effects.md "
                     "(peak/RMS torque per joint, tracking error, settling, difference against dry, "
                     "free-motion amplitude), figures, underwater_section.html and underwater.html "
-                    "to DIR. The robot needs hydro blocks (see docs/underwater.md).",
+                    "to DIR; then sweeps C_d and the current speed (sensitivity.csv/.png) and "
+                    "tracks the move by computed torque with a model omitting each effect in turn "
+                    "(model_error.csv/.png). The robot needs hydro blocks (see "
+                    "docs/underwater.md).",
         epilog="example:\n  robodyn underwater underwater_2r -o out/underwater")
     p.add_argument("robot", metavar="ROBOT", help="built-in name or a .yaml description")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder (created)")
@@ -84,6 +105,15 @@ def add_underwater_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
                         "(default: the description's)")
     p.add_argument("--set", type=_assignment, action="append", metavar="NAME=VALUE",
                    help="value of a named parameter of the description (repeatable)")
+    p.add_argument("--cd-values", type=float, nargs="+", metavar="CD",
+                   default=list(DEFAULT_CD_VALUES),
+                   help="drag coefficients of the sensitivity sweep (default: %(default)s)")
+    p.add_argument("--current-speeds", type=float, nargs="+", metavar="V",
+                   default=list(DEFAULT_CURRENT_SPEEDS),
+                   help="current speeds of the sensitivity sweep, m/s, along the current's "
+                        "direction (default: %(default)s)")
+    p.add_argument("--series-only", action="store_true",
+                   help="only the effect series (no sensitivity sweep, no model-error study)")
     p.add_argument("--backend", choices=("c", "numpy"), default="c",
                    help="compiled C or the NumPy fallback (default: %(default)s)")
     p.set_defaults(func=_cmd_underwater)

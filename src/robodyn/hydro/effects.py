@@ -13,3 +13,8 @@ LABELS: Mapping[str, str] = {
 #: Current of the ``current`` variant when neither the call nor the description gives one:
 #: 0.5 m/s along base x (a moderate tidal current), ASSUMED.
 DEFAULT_CURRENT: tuple[float, float, float] = (0.5, 0.0, 0.0)
+#: C_d of the sensitivity sweep: half, about the nominal and twice the subcritical
+#: circular-cylinder value (:mod:`robodyn.hydro.sensitivity`).
+DEFAULT_CD_VALUES: tuple[float, ...] = (0.6, 1.2, 2.4)
+#: Current speeds of the sensitivity sweep, m/s (still water to a strong tidal current).
+DEFAULT_CURRENT_SPEEDS: tuple[float, ...] = (0.0, 0.5, 1.0)
