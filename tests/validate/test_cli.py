@@ -77,6 +77,17 @@ def test_identify_command_writes_a_loadable_robot_and_tables(files, tmp_path, ca
     page = (tmp_path / "report.html").read_text()
     assert "Base parameters" in page and "held-out (--validate): held.csv" in page
     assert "wrote yaml" in captured.out and "condition number" in captured.out
+    # the held-out table: one row per recording, raw / filtered / noise floor beside each other
+    table = {line.split()[-6]: line.split()[-4:-1] for line in captured.out.splitlines()
+             if line.startswith(("identification data", "held-out (--validate)")) and "q1,q2" in line}
+    assert set(table) == {"train.csv", "held.csv"}
+    for source, (raw, filtered, floor) in table.items():
+        v = [float(r["relative"]) for r in rows if r["source"] == source]
+        # noise-free simulation: the floor is only the torque's own content above 2.5 Hz
+        assert float(filtered) < 1.0 and float(floor) < 0.1  # noqa: PT018
+        # the pooled error ||E|| / ||Y|| lies within the per-joint relative errors' range
+        assert min(v) - 1e-3 <= float(raw) <= max(v) + 1e-3
+    assert "at 2.5 Hz" in captured.out
 
 
 def test_validate_command_rejects_joints_that_do_not_match(files, tmp_path, capsys):
