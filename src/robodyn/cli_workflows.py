@@ -167,7 +167,6 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
 
     from robodyn.calibrate.io import read_calibration_csv, read_joint_map, write_calibration
     from robodyn.calibrate.pipeline import LENGTH_UNITS, convert_units, validate
-    from robodyn.report.calibration_report import calibration_html
 
     robot = rd.load(args.robot, tool=args.tool)
     stem = check_stem(args.stem) if args.stem is not None else f"{robot.name}_calibrated"
@@ -204,6 +203,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         # before: the nominal kinematics placed in the instrument frame, first target
         stats_before = ErrorStats.from_residuals(first - robot_positions(cal.before_robot, held_q))
         validation = (Path(args.validate).name, (held_pts - cal.predict(held_q)).reshape(-1, 3))
+    from robodyn.report.calibration_report import calibration_html  # matplotlib: after the solve
+
     paths = write_calibration(cal, args.output, stem=stem)
     if validation is not None:
         report = json.loads(paths["json"].read_text(encoding="utf-8"))
