@@ -7,15 +7,25 @@ and 20 strips per cylinder (midpoint sum of per-strip drag forces, the planar ki
 underwater_2r written out here), vectorised over the states. Both are timed in the same run and
 compared for accuracy against a 4000-strip sum of the same integrand (the reference), with a
 0.3 m/s current so that the normal velocity changes sign inside the links (the hard case).
-Run: ``.venv/bin/python benchmarks/bench_hydro.py``.
+Last, 10 s of the underwater two-link arm (every effect on, 0.3 m/s current) released from rest,
+RK4 at 1 ms: robodyn (``rd.simulate`` and ``Model.integrate``, generated C) against SciPy
+``solve_ivp`` (RK45) on a lambdified model: ``sympy.lambdify`` of robodyn's OWN symbolic M(q) and
+tau(q, qd, 0) (Lagrange form; the rhs solves M qdd = -h), the usual Python route. Accuracy of
+both is measured against a fine reference (robodyn's RK4 at dt / 20, checked against SciPy
+DOP853 at rtol = atol = 1e-12 on the same compiled state derivative), and solve_ivp's rtol is
+chosen from a sweep as the loosest whose error is within 2x of robodyn's (matched accuracy); the
+time ratio is printed.
+Run: ``.venv/bin/python benchmarks/bench_hydro.py [--quick]`` (``--quick``: only the last part).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import sys
 import time
 
 import numpy as np
+import sympy as sp
 
 import robodyn as rd
 
@@ -101,5 +111,82 @@ def strips_benchmark() -> None:
               f"max error {err:.1e}")
 
 
+def lambdified_rhs(robot: rd.Robot, values: dict[str, float]):
+    """SciPy rhs from ``sympy.lambdify`` of robodyn's own M(q) and h(q, qd) = tau(q, qd, 0)."""
+    eom = rd.derive(robot, "lagrange")
+    subs = eom.numeric(values)
+    zero = dict.fromkeys(eom.qdd, 0)
+    m_fn = sp.lambdify([eom.q], eom.M.xreplace(subs), "numpy", cse=True)
+    h_fn = sp.lambdify([eom.q, eom.qd], eom.tau.xreplace(zero).xreplace(subs), "numpy", cse=True)
+    n = robot.dof
+
+    def rhs(t, y):
+        q, qd = y[:n], y[n:]
+        # M qdd = -h
+        qdd = np.linalg.solve(np.asarray(m_fn(q), float), -np.asarray(h_fn(q, qd), float).ravel())
+        return np.concatenate([qd, qdd])
+
+    return rhs
+
+
+def solve_ivp_benchmark() -> None:
+    from scipy.integrate import solve_ivp
+
+    from robodyn.simulate import simulate
+
+    values = {"vc": float(CURRENT[0])}
+    robot = rd.load("underwater_2r")
+    model = rd.compile_model(robot, parameters=values)
+    q0 = np.array([0.3, -0.5])
+    x0 = np.concatenate([q0, np.zeros(2)])
+    steps, dt = 10_000, 1e-3
+    t_eval = dt * np.arange(steps + 1)
+    print("\n== 10 s of underwater_2r (every effect, 0.3 m/s current), from rest, output every 1 ms ==")
+    # reference: RK4 at dt / 20 (4th order: ~1e5 times more accurate than at dt), checked
+    # against SciPy DOP853 at rtol = atol = 1e-12 on the same compiled derivative
+    fine = model.integrate(x0, 20 * steps, dt / 20, "rk4")[0]
+    ref = np.asarray(fine)[::20]
+    dop = solve_ivp(lambda t, y: model.state_derivative(y, np.zeros(2)), (0.0, 10.0), x0,
+                    method="DOP853", t_eval=t_eval, rtol=1e-12, atol=1e-12).y.T
+    t_int = best_of(lambda: model.integrate(x0, steps, dt, "rk4"), 7)
+    t_sim = best_of(lambda: simulate(model, q0, None, 10.0, dt, "rk4"), 5)
+    run = simulate(model, q0, None, 10.0, dt, "rk4")
+    err_rd = np.abs(np.concatenate([run.q, run.qd], 1) - ref).max()
+    print(f"reference: RK4 at {dt / 20:g} s; it differs from SciPy DOP853 (rtol = atol = 1e-12) "
+          f"by {np.abs(dop - ref).max():.1e}; swing q1 in [{ref[:, 0].min():.2f}, "
+          f"{ref[:, 0].max():.2f}] rad")
+    print(f"robodyn  Model.integrate RK4 1 ms (one C call)   {t_int * 1e3:8.2f} ms")
+    print(f"robodyn  rd.simulate RK4 1 ms                    {t_sim * 1e3:8.2f} ms   "
+          f"max |x - x_ref| = {err_rd:.1e}")
+    start = time.perf_counter()
+    rhs = lambdified_rhs(robot, values)
+    print(f"lambdify of robodyn's own M and h (Lagrange): {time.perf_counter() - start:.1f} s "
+          "(not in the times below)")
+    matched = None
+    for rtol in (1e-6, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12):
+        start = time.perf_counter()
+        sol = solve_ivp(rhs, (0.0, 10.0), x0, method="RK45", t_eval=t_eval, rtol=rtol,
+                        atol=rtol * 1e-2)
+        elapsed = time.perf_counter() - start
+        err = np.abs(sol.y.T - ref).max()
+        print(f"SciPy solve_ivp RK45 + lambdify, rtol {rtol:.0e}  {elapsed * 1e3:8.1f} ms   "
+              f"max |x - x_ref| = {err:.1e}  ({sol.nfev} rhs calls)")
+        if err <= 2 * err_rd:
+            matched = (rtol, elapsed, err)
+            break
+    if matched is None:
+        print("solve_ivp did not come within 2x of robodyn's accuracy in the sweep")
+        return
+    rtol, elapsed, err = matched
+    print(f"matched accuracy (first rtol within 2x of robodyn's error: solve_ivp rtol {rtol:.0e}, "
+          f"{err:.1e}; robodyn {err_rd:.1e}): "
+          f"solve_ivp + lambdify / rd.simulate = {elapsed / t_sim:.0f}x, "
+          f"/ Model.integrate = {elapsed / t_int:.0f}x")
+
+
 if __name__ == "__main__":
-    main()
+    if "--quick" in sys.argv[1:]:
+        solve_ivp_benchmark()
+    else:
+        main()
+        solve_ivp_benchmark()
