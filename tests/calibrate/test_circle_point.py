@@ -162,3 +162,54 @@ def test_registration_places_nominal_axes_on_measured_ones():
     est = register_lines(g.points, g.directions, pts, dirs, g.target[:3, 3], x[:3, :3] @ g.target[:3, 3]
                          + x[:3, 3])
     np.testing.assert_allclose(est, x, atol=1e-9)
+
+
+def _sets(true, sweeps, counts, scale=None):
+    """One set per joint: joint j sweeps HOME[j] +- sweeps[j] in counts[j] readings."""
+    out = []
+    for j in range(true.dof):
+        qs = np.tile(HOME, (counts[j], 1))
+        qs[:, j] = HOME[j] + np.linspace(-sweeps[j], sweeps[j], counts[j])
+        pts = robot_positions(true, qs)
+        if scale is not None and j == scale[0]:
+            qs[:, j] *= scale[1]  # readings of another scale than the arc
+        out.append((qs, pts))
+    return out
+
+
+@pytest.mark.parametrize(("sweep6", "count6"), [(np.radians(200), 20),  # 400 deg, 21 deg steps
+                                                (2 * np.pi, 4),  # 720 deg in 240 deg steps
+                                                (np.radians(500), 7)])  # 1000 deg
+def test_multi_turn_sweeps_give_the_axes(sweep6, count6):
+    r = robot("puma560")
+    true = perturbed_robot(r, 3, base=TRACKER, target=TARGET)
+    sweeps, counts = [1.0, 1.0, 1.0, np.radians(200), 1.0, sweep6], [12, 12, 12, 16, 12, count6]
+    cp = circle_point(robot_geometry(r), _sets(true, sweeps, counts))
+    points, dirs = _true_axes(true)
+    assert np.all(np.sum(cp.directions * dirs, axis=1) > 0)
+    assert np.linalg.norm(np.cross(cp.directions, dirs), axis=1).max() < 1e-9
+    assert np.linalg.norm(np.cross(cp.points - points, dirs), axis=1).max() < 1e-9
+    assert all(a.scale == pytest.approx(1.0, abs=1e-9) for a in cp.axes)
+
+
+def test_multi_turn_readings_as_given_and_wrapped_agree():
+    r = robot("puma560")
+    true = perturbed_robot(r, 3, base=TRACKER, target=TARGET)
+    sets = _sets(true, [1.0, 1.0, 1.0, 1.0, 1.0, np.radians(200)], [12] * 5 + [15])
+    wrapped = list(sets)
+    q6 = sets[5][0].copy()
+    q6[:, 5] = np.angle(np.exp(1j * q6[:, 5]))  # a controller that reports (-180, 180] deg
+    wrapped[5] = (q6, sets[5][1])
+    a, b = circle_point(robot_geometry(r), sets), circle_point(robot_geometry(r), wrapped)
+    np.testing.assert_allclose(a.directions, b.directions, atol=1e-12)
+    np.testing.assert_allclose(a.points, b.points, atol=1e-12)
+
+
+def test_sparse_sweep_whose_readings_do_not_follow_says_what_to_do():
+    r = robot("puma560")
+    true = perturbed_robot(r, 3, base=TRACKER, target=TARGET)
+    # q6 turns 720 deg in 240 deg steps but its readings are 1.3 times the arc (a wrong gear ratio)
+    sets = _sets(true, [1.0] * 5 + [2 * np.pi], [12] * 5 + [4], scale=(5, 1.3))
+    with pytest.raises(ValueError, match=r"set 5 \(q6\).*readings are up to 312 deg apart.*"
+                                         r"measure the sweep in steps under 180 deg"):
+        circle_point(robot_geometry(r), sets)

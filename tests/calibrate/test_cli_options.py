@@ -93,3 +93,40 @@ def test_bad_mapping_and_target_count(data, tmp_path, capsys):
                  "--joint-map", str(data / "map.yaml"), "-o", str(tmp_path)])
     assert code == 2
     assert "look like millimetres" in capsys.readouterr().err
+
+
+def test_circle_files_with_multi_turn_joints_as_given_or_wrapped(tmp_path, capsys):
+    """``--circle`` in degrees: q4 sweeps 400 deg in 16 readings, q6 680 deg in 4 (steps of 227
+    deg); the same poses with the readings wrapped to (-180, 180] by the controller give the
+    identical calibration, at the noise level."""
+    from robodyn.calibrate.simulate_study import HOME, robot_positions
+
+    r = robot("puma560")
+    true = perturbed_robot(r, 6, base=TRACKER, target=(0.031, -0.018, 0.076))
+    rng = np.random.default_rng(5)
+    q = poses("puma560", 50, 43)
+    _write(tmp_path / "poses.csv", [*r.joint_names, "x", "y", "z"],
+           np.hstack((np.degrees(q), robot_positions(true, q) + rng.normal(0, 5e-5, (50, 3)))))
+    given, wrapped = [], []
+    for j, (sweep, count) in enumerate(zip(np.radians([60, 60, 60, 200, 60, 340]),
+                                           (16, 16, 16, 16, 16, 4), strict=True)):
+        qs = np.tile(HOME, (count, 1))
+        qs[:, j] = HOME[j] + np.linspace(-sweep, sweep, count)
+        pts = robot_positions(true, qs) + rng.normal(0, 5e-5, (count, 3))
+        for kind, readings, names in (("given", qs, given), ("wrapped", np.angle(np.exp(1j * qs)), wrapped)):
+            path = tmp_path / f"circle{j + 1}_{kind}.csv"
+            _write(path, [*r.joint_names, "x", "y", "z"], np.hstack((np.degrees(readings), pts)))
+            names += ["--circle", str(path)]
+    runs = {}
+    for kind, names in (("given", given), ("wrapped", wrapped)):
+        out = tmp_path / kind
+        assert main(["calibrate", "puma560", "--data", str(tmp_path / "poses.csv"), *names,
+                     "--angle-unit", "deg", "-o", str(out)]) == 0
+        runs[kind] = json.loads((out / "puma560_calibrated_report.json").read_text())
+        assert runs[kind]["initial"] == "circle-point"
+        assert runs[kind]["after_m"]["rms"] < 1.3 * np.sqrt(3) * 5e-5
+    pa = {p["name"]: p["value"] for p in runs["given"]["parameters"]}
+    pb = {p["name"]: p["value"] for p in runs["wrapped"]["parameters"]}
+    assert pa.keys() == pb.keys()
+    for k in pa:
+        assert pb[k] == pytest.approx(pa[k], abs=1e-9), k

@@ -34,6 +34,7 @@ __all__ = [
     "CircleFit",
     "CirclePointResult",
     "JointAxis",
+    "arc_angles",
     "circle_point",
     "fit_circle",
     "fit_line",
@@ -198,21 +199,48 @@ def joint_axis(q: np.ndarray, points: np.ndarray, joint_type: str, name: str = "
     e1 /= np.linalg.norm(e1)
     e2 = np.cross(n, e1)
     d = points - circle.center
-    phi = np.unwrap(np.arctan2(d @ e2, d @ e1))
+    phi = arc_angles(q, np.arctan2(d @ e2, d @ e1))
     slope = np.polyfit(q, phi, 1)[0]
     if slope < 0:
         n, slope = -n, -slope
-    _check_scale(name, slope, "rad of arc per rad of reading")
+    gap = float(np.max(np.diff(q)))
+    _check_scale(name, slope, "rad of arc per rad of reading",
+                 "" if gap < np.pi else
+                 f"; its readings are up to {np.degrees(gap):.0f} deg apart, so the arc between two "
+                 "of them is ambiguous: measure the sweep in steps under 180 deg (readings as "
+                 "given, multi-turn values are fine), or check that the readings are in the "
+                 "declared angle unit")
     return JointAxis(name, joint_type, circle.center, n, circle.radius, circle.rms, float(slope),
                      len(points))
 
 
-def _check_scale(name: str, scale: float, unit: str) -> None:
+def arc_angles(q: np.ndarray, phi: np.ndarray, tol: float = 0.5) -> np.ndarray:
+    """Continuous arc angles (M,) of a target circling a revolute joint, from readings (M,) sorted.
+
+    ``phi`` (M,) are the measured angles wrapped to (-pi, pi]. Multi-turn sweeps (beyond
+    +-180 deg) and sparse sweeps (steps over 180 deg) are unwrapped with the readings as given:
+    the arc angle is ``+-q + c`` up to calibration errors, so ``phi`` minus that line is wrapped
+    and added back. When neither sense fits within ``tol`` rad RMS (readings of another scale),
+    neighbouring samples are unwrapped instead (:func:`numpy.unwrap`), which needs steps under
+    180 deg, and the scale check that follows says what is wrong.
+    """
+    best, best_rms = None, tol
+    for sense in (1.0, -1.0):
+        off = np.angle(np.exp(1j * (phi - sense * q)))  # wrapped phi - sense q
+        c = np.angle(np.mean(np.exp(1j * off)))  # circular mean
+        dev = np.angle(np.exp(1j * (off - c)))
+        rms = float(np.sqrt(np.mean(dev**2)))
+        if rms < best_rms:
+            best, best_rms = sense * q + c + dev, rms
+    return best if best is not None else np.unwrap(phi)
+
+
+def _check_scale(name: str, scale: float, unit: str, hint: str = "") -> None:
     if not 0.8 < scale < 1.25:
         raise ValueError(
             f"{name}: the target moved {scale:.3g} {unit}, not about 1: the data set does not move "
             "this joint alone, the readings have the wrong scale, or the target is too close to "
-            "the axis for its circle to be measured"
+            f"the axis for its circle to be measured{hint}"
         )
 
 
