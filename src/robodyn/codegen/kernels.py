@@ -25,6 +25,8 @@ differentiation of the recorded programs (:mod:`robodyn.symbolic.forward_mode`):
 
     inverse_dynamics_derivatives(q, qd, qdd) -> dtau (n, 2 n)      [d tau/dq, d tau/dqd]
     forward_dynamics_derivatives(q, qd, tau) -> dqdd (n, 3 n)      [d qdd/dq, d qdd/dqd, d qdd/dtau]
+    regressor_derivatives(q, qd, qdd)        -> dY (15 n^2, 3 n)   [dY/dq, dY/dqd, dY/dqdd]
+                                                  (:data:`REGRESSOR_DERIVATIVE_KERNEL_NAMES`)
 
 ``d qdd/dx = -M^-1 d tau/dx`` at ``qdd = FD(q, qd, tau)`` (differentiating ``tau(q, qd, qdd) = u``)
 and ``d qdd/dtau = M^-1``, both by the Cholesky factor of the forward dynamics. Coulomb
@@ -147,6 +149,9 @@ KERNEL_NAMES = ("inverse_dynamics", "mass_matrix", "gravity", "coriolis", "forwa
 #: Kernels built only when asked for by name (larger: 2 n or 3 n directions).
 DERIVATIVE_KERNEL_NAMES = ("inverse_dynamics_derivatives", "forward_dynamics_derivatives")
 
+#: The regressor's derivatives (15 n^2 x 3 n entries: large), built apart from the others.
+REGRESSOR_DERIVATIVE_KERNEL_NAMES = ("regressor_derivatives",)
+
 
 def kernel_signature(name: str, n: int) -> tuple[tuple[tuple[str, int], ...], tuple[int, ...]]:
     """``((input name, width), ...), output shape`` of kernel ``name`` for ``n`` joints."""
@@ -163,10 +168,12 @@ def kernel_signature(name: str, n: int) -> tuple[tuple[tuple[str, int], ...], tu
         "regressor": ((q, qd, qdd), (n, 15 * n)),
         "inverse_dynamics_derivatives": ((q, qd, qdd), (n, 2 * n)),
         "forward_dynamics_derivatives": ((q, qd, tau), (n, 3 * n)),
+        "regressor_derivatives": ((q, qd, qdd), (15 * n * n, 3 * n)),
     }
     if name not in table:
         raise ValueError(f"unknown kernel {name!r}; choose from "
-                         f"{', '.join(KERNEL_NAMES + DERIVATIVE_KERNEL_NAMES)}")
+                         f"{', '.join(KERNEL_NAMES + DERIVATIVE_KERNEL_NAMES)}, "
+                         "regressor_derivatives")
     return table[name]
 
 
@@ -208,7 +215,8 @@ def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
     inputs = {"q": _arg("q", q), "qd": _arg("qd", qd), "qdd": _arg("qdd", qdd), "tau": _arg("tau", u)}
     reserved = {s.name for s in (*q, *qd, *qdd, *u)} | set(merged) | set(KERNEL_NAMES)
     reserved |= {"q", "qd", "qdd", "tau", "M", "g", "c", "T", "J", "Y", "xd", "u", "qdd_out"}
-    reserved |= {"dtau", "dqdd", "p", *DERIVATIVE_KERNEL_NAMES, *(s.name for s in prm)}
+    reserved |= {"dtau", "dqdd", "dY", "p", *DERIVATIVE_KERNEL_NAMES, *(s.name for s in prm)}
+    reserved |= set(REGRESSOR_DERIVATIVE_KERNEL_NAMES)
 
     hyd = _pi_as_number(hydro_terms(robot, q, qd, qdd))
 
@@ -261,12 +269,17 @@ def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
             "Derivatives [d qdd/dq, d qdd/dqd, d qdd/dtau] of the forward dynamics",
             (inputs["q"], inputs["qd"], inputs["tau"]), "dqdd", (n, 3 * n),
             lambda rec: _qdd_derivatives(robot, q, qd, u, rec, hyd)),
+        "regressor_derivatives": (
+            "Derivatives of the regressor: row (i 15 n + c) holds [dY_ic/dq, dY_ic/dqd, dY_ic/dqdd]",
+            (inputs["q"], inputs["qd"], inputs["qdd"]), "dY", (15 * n * n, 3 * n),
+            lambda rec: _regressor_derivatives(robot, q, qd, qdd, rec)),
     }
     kernels = []
     for name in names:
         if name not in builders:
             raise ValueError(f"unknown kernel {name!r}; choose from "
-                             f"{', '.join(KERNEL_NAMES + DERIVATIVE_KERNEL_NAMES)}")
+                             f"{', '.join(KERNEL_NAMES + DERIVATIVE_KERNEL_NAMES)}, "
+                             "regressor_derivatives")
         summary, ins, out_name, shape, build = builders[name]
         rec = Recorder(reserved)
         outs = build(rec)
@@ -404,6 +417,18 @@ def _tau_derivatives(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbo
     """``[d tau/dq, d tau/dqd]`` (n, 2 n) row-major, by forward mode over the tau program."""
     tau = _tau_full(robot, q, qd, qdd, rec, hyd)
     d = forward_mode.jacobian(list(rec.assignments), tau, [*q, *qd], rec)
+    return list(d)
+
+
+def _regressor_derivatives(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
+                           qdd: Sequence[sp.Symbol], rec: Recorder) -> list[sp.Expr]:
+    """``d Y / d [q, qd, qdd]`` (15 n^2, 3 n) row-major, by forward mode over the Y program.
+
+    Row ``i 15 n + c`` is entry ``Y[i, c]``. Friction's step columns (Coulomb, offset) have
+    derivative 0 (exact away from ``qd = 0``).
+    """
+    y = list(regressor(robot, q, qd, qdd, rec))
+    d = forward_mode.jacobian(list(rec.assignments), y, [*q, *qd, *qdd], rec)
     return list(d)
 
 

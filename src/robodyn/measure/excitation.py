@@ -26,10 +26,14 @@ set, found by QR with column pivoting on random states, :func:`base_columns`). T
 condition number ``cond(W) = sigma_max / sigma_min`` (``criterion="cond"``; minimised as
 ``log cond``) or ``-log det(W^T W)`` (``criterion="logdet"``, D-optimality). Both are minimised by
 SciPy's SLSQP under the *linear* joint position, velocity and acceleration limits on the ``K``
-samples, from several random feasible starts; the gradient is analytic in the Fourier
-coefficients and uses finite differences of the regressor only in the joint states (``3 n``
-batched regressor calls per gradient). Coulomb and offset friction columns are steps in ``qd``:
-their derivative is zero wherever it exists, and it is taken as zero.
+samples, from several random feasible starts. The gradient is analytic: in the Fourier
+coefficients by the chain rule, and in the joint states by the compiled regressor derivatives
+(:meth:`robodyn.numeric.model.Model.regressor_derivatives`, forward-mode differentiation of the
+regressor's program, one batched call per gradient; compiled once per robot, cached).
+``gradient="finite_difference"`` uses central differences of the regressor in the joint states
+instead (``5 n`` perturbed copies of the samples in one batched regressor call; no extra
+compilation). Coulomb and offset friction columns are steps in ``qd``: their derivative is zero
+wherever it exists, and it is taken as zero.
 
 Limits are enforced exactly on the returned samples: after optimisation, the oscillating part is
 shrunk about the offset (a scale factor <= 1) until the finely sampled trajectory is within every
@@ -463,7 +467,8 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
                duration: float | None = None, limits: ExcitationLimits | None = None, *,
                criterion: Criterion = "cond", starts: int = 6, seed: int = 0, dt: float = 1e-3,
                design_samples: int | None = None, max_iterations: int = 40,
-               columns: Sequence[int] | None = None) -> Excitation:
+               columns: Sequence[int] | None = None,
+               gradient: Literal["analytic", "finite_difference"] = "analytic") -> Excitation:
     """Design an optimal periodic excitation trajectory (finite Fourier series, Swevers 1997).
 
     Parameters
@@ -493,6 +498,10 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
         SLSQP iterations per start.
     columns : sequence of int, optional
         Regressor columns to use (default :func:`base_columns`).
+    gradient : {"analytic", "finite_difference"}
+        How the criterion's gradient is differentiated in the joint states: the compiled
+        regressor derivatives (default; the first design for a robot compiles them, which
+        takes minutes for a six-joint arm, then cached) or central differences of the regressor.
 
     Returns
     -------
@@ -523,6 +532,9 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
         raise ValueError(f"excitation: unknown criterion {criterion!r}; choose 'cond' or 'logdet'")
     if starts < 1:
         raise ValueError(f"excitation: starts must be >= 1, got {starts!r}")
+    if gradient not in ("analytic", "finite_difference"):
+        raise ValueError(f"excitation: unknown gradient {gradient!r}; choose 'analytic' or "
+                         "'finite_difference'")
     lim = excitation_limits(model.robot) if limits is None else limits
     if lim.dof != n:
         raise ValueError(f"excitation: limits are for {lim.dof} joints, the robot has {n}")
@@ -531,7 +543,7 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
     k = int(design_samples or 20 * harmonics)
     na, nb = _null_bases(harmonics, f)
     layout = _Layout(n, harmonics, na, nb)
-    problem = _Problem(model, layout, f, k, cols, lim, criterion)
+    problem = _Problem(model, layout, f, k, cols, lim, criterion, gradient)
     best: tuple[float, FourierTrajectory] | None = None
     history = []
     for _ in range(starts):
@@ -595,8 +607,9 @@ class _Problem:
     """Objective, gradient and linear limit constraints of one design (x as in :class:`_Layout`)."""
 
     def __init__(self, model: Model, layout: _Layout, f: float, k: int, cols: Sequence[int],
-                 lim: ExcitationLimits, criterion: str) -> None:
+                 lim: ExcitationLimits, criterion: str, gradient: str = "analytic") -> None:
         self.model, self.layout, self.cols, self.criterion = model, layout, list(cols), criterion
+        self.gradient = gradient
         n, m = layout.n, layout.per_joint
         t = np.arange(k) / (k * f)
         sq, sqd, sqdd = _basis(t, layout.harmonics, f)
@@ -657,9 +670,30 @@ class _Problem:
             g = -2.0 * w @ ((v / lam) @ v.T)
         if feasible and value < self.best[0]:
             self.best = (value, x.copy())
-        gk = np.zeros((w.shape[0], y.shape[-1]))
-        gk[:, self.cols] = g
-        gk = gk.reshape(y.shape)  # (K, n, P)
+        gk = g.reshape(y.shape[0], y.shape[1], len(self.cols))  # (K, n, p) over the columns
+        if self.gradient == "analytic":
+            dots = self.state_gradient(states, gk)
+        else:
+            dots = self.state_gradient_fd(states, y, gk)
+        grad = np.zeros((self.n, self.m))
+        n = self.n
+        for i in range(n):
+            # d value / d x_i = sum_k (dV/dq_i dq_i/dx_i + dV/dqd_i dqd_i/dx_i + dV/dqdd_i ...)
+            grad[i] = dots[i] @ self.dq + dots[n + i] @ self.dqd + dots[2 * n + i] @ self.dqdd
+        return value, grad.ravel()
+
+    def state_gradient(self, states: tuple[np.ndarray, ...], gk: np.ndarray) -> np.ndarray:
+        """``d value / d [q, qd, qdd](t_k)``, (3 n, K), by the compiled regressor derivatives.
+
+        ``gk`` (K, n, p): ``d value / d Y`` on the design columns.
+        """
+        d = np.concatenate(self.model.regressor_derivatives(*states), axis=-1)  # (K, n, P, 3 n)
+        # dV/ds_v(t_k) = sum_jc G_kjc dY_kjc/ds_v
+        return np.einsum("kjcv,kjc->vk", d[:, :, self.cols], gk, optimize=True)
+
+    def state_gradient_fd(self, states: tuple[np.ndarray, ...], y: np.ndarray,
+                          gk: np.ndarray) -> np.ndarray:
+        """:meth:`state_gradient` by central differences of the regressor in the states."""
         # central differences in q and qd, a one-sided one in qdd (Y is linear in qdd: exact),
         # all 5 n perturbed copies of the K states in one batched regressor call
         n, h = self.n, 1e-6
@@ -671,18 +705,17 @@ class _Problem:
         yb = self.model.regressor(*(b.reshape(-1, n) for b in batch)).reshape((len(shifts),) + y.shape)
         yb[..., self.step_cols] = 0.0
         # d value / d state(t_k) = sum over the rows of sample k of G . dY
-        dots = np.einsum("skjp,kjp->sk", yb, gk)
-        y0 = y.copy()
-        y0[..., self.step_cols] = 0.0
+        dots = np.einsum("skjp,kjp->sk", yb[..., self.cols], gk)
+        y0 = y[..., self.cols].copy()
+        y0[..., np.isin(self.cols, self.step_cols)] = 0.0
         dots0 = np.einsum("kjp,kjp->k", y0, gk)
-        grad = np.zeros((n, self.m))
-        d_states = (self.dq, self.dqd, self.dqdd)
-        for i in range(n):
-            for which in (0, 1):
+        out = np.empty((3 * n, y.shape[0]))
+        for which in (0, 1):
+            for i in range(n):
                 plus = 2 * (which * n + i)
-                grad[i] += (dots[plus] - dots[plus + 1]) / (2 * h) @ d_states[which]
-            grad[i] += (dots[4 * n + i] - dots0) / h @ self.dqdd
-        return value, grad.ravel()
+                out[which * n + i] = (dots[plus] - dots[plus + 1]) / (2 * h)
+        out[2 * n:] = (dots[4 * n:] - dots0) / h
+        return out
 
 
 # --- helpers -----------------------------------------------------------------------------------
