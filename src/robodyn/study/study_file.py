@@ -110,6 +110,32 @@ def read_study(path: str | Path) -> Study:
     """
     path = Path(path)
     name = str(path)
+    data = _load_mapping(path)
+    task = _task(data, path)
+    params = data.get("parameters") or {}
+    if not isinstance(params, dict) or not params:
+        raise StudyError(f"{name}: parameters: expected a mapping of parameter name -> values or range")
+    grid, ranges, fixed = _split_parameters(params, task, name)
+    seed = _int(data.get("seed", 0), f"{name}: seed")
+    repeat = _int(data.get("repeat", 1), f"{name}: repeat", 1)
+    if repeat > 1:
+        grid["repeat"] = list(range(repeat))
+    cases = _cases(data.get("sampler"), grid, ranges, fixed, seed, name)
+    batch = data.get("batch")
+    if batch is not None:
+        batch = _int(batch, f"{name}: batch", 1)
+    plot = data.get("plot") or {}
+    if not isinstance(plot, dict) or set(plot) - {"x", "y", "result"}:
+        raise StudyError(f"{name}: plot: expected a mapping with x, y and result")
+    varying = tuple(k for k in params if k in ranges or len(grid.get(k, ())) > 1)
+    if "repeat" in grid and "repeat" not in task.parameters():
+        task = _Repeat(task)
+    return Study(path, task, cases, seed, batch, varying, plot)
+
+
+def _load_mapping(path: Path) -> dict[str, Any]:
+    """The study file's top-level mapping, its keys and task name checked."""
+    name = str(path)
     try:
         data = yaml.safe_load(path.read_text(encoding="utf-8"))
     except yaml.YAMLError as exc:
@@ -121,9 +147,15 @@ def read_study(path: str | Path) -> Study:
     unknown = [k for k in data if k not in _KEYS]
     if unknown:
         raise StudyError(f"{name}: unknown key {unknown[0]!r} (known: {', '.join(_KEYS)})")
-    kind = data.get("task")
-    if kind not in TASKS:
-        raise StudyError(f"{name}: task: expected one of {', '.join(TASKS)}, got {kind!r}")
+    if data.get("task") not in TASKS:
+        raise StudyError(f"{name}: task: expected one of {', '.join(TASKS)}, got {data.get('task')!r}")
+    return data
+
+
+def _task(data: Mapping[str, Any], path: Path) -> Any:
+    """The task object built from ``task``, ``robot``, ``tool`` and ``settings``."""
+    name = str(path)
+    kind = data["task"]
     if "robot" not in data and kind == "actuator_sizing":
         raise StudyError(f"{name}: robot: missing (a built-in name or a description file)")
     settings = data.get("settings") or {}
@@ -141,14 +173,16 @@ def read_study(path: str | Path) -> Study:
         except FileNotFoundError as exc:
             raise StudyError(f"{name}: robot: {exc}") from None
     try:
-        task = TASKS[kind](**kwargs)
+        return TASKS[kind](**kwargs)
     except TypeError as exc:
         raise StudyError(f"{name}: settings: {exc} (see the {TASKS[kind].__name__} options)") from None
     except StudyError as exc:
         raise StudyError(f"{name}: settings: {exc}") from None
-    params = data.get("parameters") or {}
-    if not isinstance(params, dict) or not params:
-        raise StudyError(f"{name}: parameters: expected a mapping of parameter name -> values or range")
+
+
+def _split_parameters(params: Mapping[str, Any], task: Any, name: str
+                      ) -> tuple[dict[str, list[Any]], dict[str, Range], dict[str, Any]]:
+    """Parameters split into value lists (grid), ranges to sample and fixed values."""
     grid: dict[str, list[Any]] = {}
     ranges: dict[str, Range] = {}
     fixed: dict[str, Any] = {}
@@ -167,34 +201,24 @@ def read_study(path: str | Path) -> Study:
                 grid[key] = r
         else:
             fixed[key] = value
-    sampler = data.get("sampler")
-    seed = _int(data.get("seed", 0), f"{name}: seed")
-    repeat = _int(data.get("repeat", 1), f"{name}: repeat", 1)
-    if repeat > 1:
-        grid["repeat"] = list(range(repeat))
-    if ranges:
-        if not isinstance(sampler, dict) or "n" not in sampler:
-            raise StudyError(f"{name}: sampler: ranges {sorted(ranges)} need a sampler "
-                             "{kind: latin_hypercube | random, n: N}")
-        skind = sampler.get("kind", "latin_hypercube")
-        if skind not in _SAMPLERS:
-            raise StudyError(f"{name}: sampler.kind: expected latin_hypercube or random, got {skind!r}")
-        n = _int(sampler["n"], f"{name}: sampler.n", 1)
-        cases: Any = _SAMPLERS[skind](ranges, n=n, seed=seed, fixed=fixed, grid=grid)
-    else:
+    return grid, ranges, fixed
+
+
+def _cases(sampler: Any, grid: dict[str, list[Any]], ranges: dict[str, Range],
+           fixed: dict[str, Any], seed: int, name: str) -> Any:
+    """The case set: a sampler over the ranges (crossed with the grid), or the plain grid."""
+    if not ranges:
         if sampler is not None:
             raise StudyError(f"{name}: sampler: given but no parameter is a range to sample")
-        cases = Grid({**{k: [v] for k, v in fixed.items()}, **grid})
-    batch = data.get("batch")
-    if batch is not None:
-        batch = _int(batch, f"{name}: batch", 1)
-    plot = data.get("plot") or {}
-    if not isinstance(plot, dict) or set(plot) - {"x", "y", "result"}:
-        raise StudyError(f"{name}: plot: expected a mapping with x, y and result")
-    varying = tuple(k for k in params if k in ranges or len(grid.get(k, ())) > 1)
-    if "repeat" in grid and "repeat" not in task.parameters():
-        task = _Repeat(task)
-    return Study(path, task, cases, seed, batch, varying, plot)
+        return Grid({**{k: [v] for k, v in fixed.items()}, **grid})
+    if not isinstance(sampler, dict) or "n" not in sampler:
+        raise StudyError(f"{name}: sampler: ranges {sorted(ranges)} need a sampler "
+                         "{kind: latin_hypercube | random, n: N}")
+    skind = sampler.get("kind", "latin_hypercube")
+    if skind not in _SAMPLERS:
+        raise StudyError(f"{name}: sampler.kind: expected latin_hypercube or random, got {skind!r}")
+    n = _int(sampler["n"], f"{name}: sampler.n", 1)
+    return _SAMPLERS[skind](ranges, n=n, seed=seed, fixed=fixed, grid=grid)
 
 
 @dataclass(frozen=True)
