@@ -162,6 +162,16 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 # ----------------------------------------------------------------------------------------------
 
 
+def _payload(values: np.ndarray | None) -> tuple[float, np.ndarray] | None:
+    """``--payload KG,X,Y,Z`` as (mass, centre of mass)."""
+    if values is None:
+        return None
+    if values.size != 4:
+        raise ValueError(f"--payload: expected 4 numbers (mass in kg, then x, y, z of the centre of "
+                         f"mass in the tool frame in m), got {values.size}")
+    return float(values[0]), values[1:]
+
+
 def _cmd_calibrate(args: argparse.Namespace) -> int:
     import json
 
@@ -190,6 +200,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         cal = rd.calibrate(robot, data.q, data.points, args.model, sigma=sigma, loss=args.loss,
                            initial="circle-point" if circle else "nominal", circle_data=circle,
                            orientations=data.orientations, nongeometric=tuple(args.nongeometric or ()),
+                           payload=_payload(args.payload), identify_payload=args.identify_payload,
                            **units)
     validation = None
     if args.validate:
@@ -366,6 +377,12 @@ def _calibrate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: st
                         "coupling: {other column: factor}} (docs/calibration.md)")
     p.add_argument("--targets", type=int, metavar="K",
                    help="targets per pose (x, y, z, x2, y2, z2, ...); checked against the columns")
+    p.add_argument("--payload", type=floats, metavar="KG,X,Y,Z",
+                   help="known payload for the compliance torques: mass in kg and centre of mass in "
+                        "the tool frame in m (the start value with --identify-payload)")
+    p.add_argument("--identify-payload", action="store_true",
+                   help="estimate the payload's mass and centre of mass with the compliances "
+                        "(needs --nongeometric compliance)")
     p.add_argument("--nongeometric", action="append", choices=("compliance", "harmonics"),
                    help="add joint compliance (gravity model) and/or transmission errors (ratio, "
                         "first harmonics); repeat for both")

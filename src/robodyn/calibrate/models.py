@@ -148,13 +148,13 @@ class ErrorModel:
         q = np.asarray(q, dtype=float)
         basis = None
         if self.nongeometric is not None:
-            basis = self.nongeometric.basis(q)
-            # q_link = q + B(q) theta
-            q = q + basis @ params[self.nongeometric_slice]
+            # q_link = q + dq(q, theta), dq = B(q) theta for all but an identified payload
+            dq, basis = self.nongeometric.correction(q, params[self.nongeometric_slice])
+            q = q + dq
         ev = evaluate(self.ops, params, q, self.n_params, derivatives=derivatives)[0]
         jp, jq = ev.jac_param, ev.jac_joint
         if derivatives and basis is not None:
-            # d p / d theta = J_q B
+            # d p / d theta = J_q d dq / d theta
             jp[:, :, self.nongeometric_slice] = jq @ basis
         if self.targets == 1:
             return ChainEval(ev.position, ev.rotation, jp, jq)
@@ -428,7 +428,8 @@ def extend_model(model: ErrorModel, offsets: np.ndarray | None = None,
         ng = list(range(len(names), len(names) + nongeometric.n_params))
         names += nongeometric.names
         units += nongeometric.units
-        values += [0.0] * nongeometric.n_params
+        values += [float(v) for v in nongeometric.initial] if nongeometric.initial is not None \
+            else [0.0] * nongeometric.n_params
     # placement and targets first, then the joints' parameters, then the terms, then the redundant
     priority = placement + targets + core + ng + extra
     return replace(model, names=tuple(names), units=tuple(units), initial=np.array(values),

@@ -15,6 +15,15 @@ is a gravity-shaped basis instead: the holding torque of a 1 kg point mass at th
 joint frame after joint ``j`` and at the tool (then ``c_j`` absorbs the unknown mass scale and its
 unit is rad/(N m) per that unit-mass torque).
 
+Payload: a known payload (mass, centre of mass in the tool frame) adds its holding torque to
+``tau``. An identified payload (``identify_payload``) has four parameters, its mass ``m`` and first
+moments ``m r`` (kg m, tool frame), so ``tau_j = g_j(q) + T_j(q) pi`` with ``pi = (m, m r_x, m r_y,
+m r_z)`` and ``T`` the holding torques of a unit mass at the tool origin and of unit first moments
+along the tool axes; the deflection ``-c_j tau_j`` is then bilinear in ``(c, pi)``
+(:meth:`NonGeometric.correction` gives it with its exact Jacobian). At ``c = 0`` the payload has
+no effect, so it is identified after the compliances (:func:`robodyn.calibrate.calibrate` fits in
+two stages).
+
 Harmonics (transmission errors): ``dq_j = k_j q_j + a_j cos(q_j) + b_j sin(q_j)``: a
 transmission ratio error ``k_j`` (the reading's scale) and the first harmonic of the joint angle
 (eccentricity of the output gear), and, when the description gives a gear ratio ``G_j`` other than 1, also
@@ -25,7 +34,7 @@ Only revolute joints get harmonics.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -51,15 +60,22 @@ class NonGeometric:
     units : tuple of str, length M
         ``"rad/(N m)"``, ``"m/N"``, ``"rad"`` or ``"1"`` (ratio error).
     joints : tuple of int, length M
-        The joint each parameter corrects.
+        The joint each parameter corrects (-1 for the payload's).
     kinds : tuple of str, length M
-        ``"compliance"``, ``"ratio"``, ``"cos"``, ``"sin"``, ``"motor_cos"``, ``"motor_sin"``.
+        ``"compliance"``, ``"ratio"``, ``"cos"``, ``"sin"``, ``"motor_cos"``, ``"motor_sin"``,
+        ``"payload_mass"``, ``"payload_moment"``.
     gear_ratio : numpy.ndarray, shape (n,)
         Gear ratios (NaN where the description gives none).
     torque : callable or None
         ``torque(q)``: holding torques (N, n) for readings (N, n), N m; None without compliance.
     torque_source : str
-        ``"gravity model"``, ``"gravity model + payload"`` or ``"gravity-shaped basis"`` (or ``""``).
+        ``"gravity model"``, ``"gravity model + payload"`` or ``"gravity-shaped basis"`` (or ``""``),
+        with ``" + identified payload"`` when the payload is estimated.
+    initial : numpy.ndarray, shape (M,)
+        Starting values (zero, or the given payload for an identified one).
+    payload_torque : callable or None
+        ``payload_torque(q)``: ``T`` (N, n, 4), the holding torques per unit payload parameter
+        ``(m, m r_x, m r_y, m r_z)``, N m per kg (per kg m); None unless the payload is identified.
     """
 
     terms: tuple[str, ...]
@@ -70,15 +86,54 @@ class NonGeometric:
     gear_ratio: np.ndarray
     torque: Callable[[np.ndarray], np.ndarray] | None
     torque_source: str
+    initial: np.ndarray | None = None
+    payload_torque: Callable[[np.ndarray], np.ndarray] | None = None
+    _cache: dict = field(default_factory=dict, repr=False)
 
     @property
     def n_params(self) -> int:
         """Number of parameters M."""
         return len(self.names)
 
+    def _of_readings(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """``B(q)`` and ``T(q)`` for readings ``q``, kept for the last ``q`` (they depend on the
+        readings only, not on the parameters: one gravity evaluation per data set, not per
+        iteration)."""
+        last = self._cache.get("q")
+        if last is None or last.shape != q.shape or not np.array_equal(last, q):
+            b = self._basis(q)
+            t = self.payload_torque(q) if self.payload_torque is not None else None
+            self._cache.update(q=q.copy(), basis=b, payload=t)
+        return self._cache["basis"], self._cache["payload"]
+
     def basis(self, q: np.ndarray) -> np.ndarray:
-        """``B(q)``, shape (N, n, M): ``q_link = q + B(q) theta`` for readings ``q`` (N, n)."""
+        """``B(q)``, shape (N, n, M): the linear part, ``q_link = q + B(q) theta`` without an
+        identified payload, for readings ``q`` (N, n)."""
+        return self._of_readings(np.asarray(q, dtype=float))[0].copy()
+
+    def correction(self, q: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Joint corrections ``dq`` (N, n) for readings ``q`` (N, n) and parameters ``theta``
+        (M,), and their Jacobian ``d dq / d theta`` (N, n, M): ``q_link = q + dq``."""
         q = np.asarray(q, dtype=float)
+        b, t = self._of_readings(q)
+        dq = b @ theta
+        if t is None:
+            return dq, b
+        jac = b.copy()
+        kinds = np.array(self.kinds)
+        pay = np.flatnonzero(np.char.startswith(kinds, "payload"))
+        comp = np.flatnonzero(kinds == "compliance")
+        joints = np.array(self.joints)[comp]
+        c = np.zeros(q.shape[1])
+        c[joints] = theta[comp]
+        tp = t @ theta[pay]  # (N, n) payload holding torque
+        # dq_j = -c_j (g_j + T_j pi): d/dc_j adds -T_j pi, d/dpi = -c_j T_j
+        dq = dq - c * tp
+        jac[:, joints, comp] -= tp[:, joints]
+        jac[:, :, pay] = -c[None, :, None] * t
+        return dq, jac
+
+    def _basis(self, q: np.ndarray) -> np.ndarray:
         out = np.zeros((len(q), q.shape[1], self.n_params))
         tau = self.torque(q) if "compliance" in self.kinds else None
         for m, (j, kind) in enumerate(zip(self.joints, self.kinds, strict=True)):
@@ -92,8 +147,9 @@ class NonGeometric:
                 out[:, j, m] = np.sin(q[:, j])
             elif kind == "motor_cos":
                 out[:, j, m] = np.cos(self.gear_ratio[j] * q[:, j])  # motor angle G q
-            else:
+            elif kind == "motor_sin":
                 out[:, j, m] = np.sin(self.gear_ratio[j] * q[:, j])
+            # payload_mass, payload_moment: bilinear, in correction()
         return out
 
     def as_dict(self, values: np.ndarray) -> dict:
@@ -139,6 +195,32 @@ def _point_mass_torque(frames: Callable[[np.ndarray], tuple[np.ndarray, np.ndarr
     return torque
 
 
+def _payload_unit_torque(frames: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
+                         types: Sequence[str], gravity: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    """``T(q)`` (N, n, 4): holding torques per unit payload mass and per unit first moment.
+
+    A payload of mass ``m`` with centre ``r`` (tool frame) sits at ``p = R r + t``; its holding
+    torque ``-m (dp/dq_j) . gravity`` is linear in ``pi = (m, m r)``.
+    """
+    types = tuple(types)
+
+    def torque(q: np.ndarray) -> np.ndarray:
+        origins, axes, tool = frames(q)
+        out = np.zeros((len(q), len(types), 4))
+        for j, kind in enumerate(types):
+            z = axes[:, j]
+            if kind == "revolute":
+                # m dp/dq_j = m z x (t - o_j) + z x (R m r)
+                out[:, j, 0] = -np.cross(z, tool[:, :3, 3] - origins[:, j]) @ gravity
+                for k in range(3):
+                    out[:, j, k + 1] = -np.cross(z, tool[:, :3, k]) @ gravity
+            else:
+                out[:, j, 0] = -z @ gravity  # dp/dq_j = z
+        return out
+
+    return torque
+
+
 def nominal_frames(geometry) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """``frames(q)`` of :func:`build_nongeometric` from the nominal geometry (Hayati chain, world frame)."""
     from robodyn.calibrate.kinematics import evaluate
@@ -158,7 +240,8 @@ def nominal_frames(geometry) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndar
 
 
 def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
-                       payload: tuple[float, Sequence[float]] | None = None) -> NonGeometric:
+                       payload: tuple[float, Sequence[float]] | None = None,
+                       identify_payload: bool = False) -> NonGeometric:
     """The non-geometric terms ``terms`` of ``robot``.
 
     Parameters
@@ -173,17 +256,23 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
         and the payload).
     payload : (float, sequence of float), optional
         Payload mass (kg) and centre of mass in the tool frame (m): its holding torque is added
-        to the gravity model's.
+        to the gravity model's (or, with ``identify_payload``, the starting values).
+    identify_payload : bool
+        Estimate the payload (parameters ``payload.mass``, kg, and ``payload.mx``, ``.my``,
+        ``.mz``, its first moments in the tool frame, kg m); needs ``"compliance"``.
 
     Raises
     ------
     ValueError
-        An unknown term, a negative payload mass.
+        An unknown term, a negative payload mass, ``identify_payload`` without compliance.
     """
     terms = tuple(dict.fromkeys(terms))
     unknown = [t for t in terms if t not in NONGEOMETRIC]
     if unknown:
         raise ValueError(f"unknown non-geometric term {unknown[0]!r}; choose from {', '.join(NONGEOMETRIC)}")
+    if identify_payload and "compliance" not in terms:
+        raise ValueError("identify_payload needs the 'compliance' term: the payload is seen only "
+                         "through the joints' deflection under its weight")
     subs = robot.defaults()
     n = robot.dof
     gear = np.full(n, np.nan)
@@ -203,20 +292,22 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
             if not mass >= 0:
                 raise ValueError(f"payload mass must be >= 0 kg, got {mass}")
             load = (mass, com)
+        known = None if identify_payload else load
         types = [j.type for j in robot.joints]
         if any(m > 0 for m in masses):
             from robodyn.numeric.model import compile_model
 
             model = compile_model(robot)
-            extra = _point_mass_torque(frames, types, gravity, [], load) if load else None
+            extra = _point_mass_torque(frames, types, gravity, [], known) if known else None
 
             def torque(q: np.ndarray, model=model, extra=extra) -> np.ndarray:
                 tau = np.asarray(model.gravity(q), dtype=float).reshape(len(q), -1)
                 return tau + extra(q) if extra is not None else tau
 
-            source = "gravity model" + (" + payload" if load else "")
+            source = "gravity model" + (" + payload" if known else "")
         else:
-            torque = _point_mass_torque(frames, types, gravity, [(k, 1.0) for k in range(1, n + 1)], load)
+            torque = _point_mass_torque(frames, types, gravity, [(k, 1.0) for k in range(1, n + 1)],
+                                        known)
             source = "gravity-shaped basis"
         for j, joint in enumerate(robot.joints):
             names.append(f"{joint.name}.compliance")
@@ -235,5 +326,19 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
                 units.append("1" if kind == "ratio" else "rad")
                 joints.append(j)
                 kinds.append(kind)
+    initial = [0.0] * len(names)
+    payload_torque = None
+    if identify_payload:
+        payload_torque = _payload_unit_torque(frames, [j.type for j in robot.joints], gravity)
+        source += " + identified payload"
+        start = [0.0] * 4 if load is None else [load[0], *(load[0] * load[1])]
+        kinds4 = ("payload_mass", "payload_moment", "payload_moment", "payload_moment")
+        for suffix, kind, unit, v in zip(("mass", "mx", "my", "mz"), kinds4,
+                                         ("kg", "kg m", "kg m", "kg m"), start, strict=True):
+            names.append(f"payload.{suffix}")
+            units.append(unit)
+            joints.append(-1)
+            kinds.append(kind)
+            initial.append(float(v))
     return NonGeometric(terms, tuple(names), tuple(units), tuple(joints), tuple(kinds), gear, torque,
-                        source)
+                        source, np.array(initial), payload_torque)

@@ -338,6 +338,7 @@ def calibrate(
     max_nfev: int | None = None,
     nongeometric: Sequence[str] = (),
     payload: tuple[float, Sequence[float]] | None = None,
+    identify_payload: bool = False,
     length_unit: str = "m",
     angle_unit: str = "rad",
 ) -> Calibration:
@@ -381,6 +382,13 @@ def calibrate(
         holding torques, first harmonics of the joint (and motor) angles.
     payload : (float, sequence of float), optional
         Known payload for the compliance torques: mass (kg) and centre of mass in the tool frame (m).
+    identify_payload : bool
+        Estimate the payload (``payload.mass``, kg, and its first moments ``payload.mx``, ``.my``,
+        ``.mz``, kg m, in the tool frame; ``payload`` is then the starting value, else zero) with
+        the compliances. The payload acts only through the compliances, so the fit runs in
+        stages: compliances and geometry first, then again from that solution with the
+        identifiability checked there, while the identifiable set grows (at most three more
+        times). Needs ``"compliance"`` in ``nongeometric``.
     length_unit : {"m", "mm"}
         Unit of ``points`` and ``sigma`` (converted to m; the result is in m).
     angle_unit : {"rad", "deg"}
@@ -433,7 +441,8 @@ def calibrate(
         if nongeometric:
             from robodyn.calibrate.nongeometric import build_nongeometric, nominal_frames
 
-            ng = build_nongeometric(robot, nongeometric, nominal_frames(geometry), payload=payload)
+            ng = build_nongeometric(robot, nongeometric, nominal_frames(geometry), payload=payload,
+                                    identify_payload=identify_payload)
         offsets, _ = target_offsets(em, em.initial, q, pts3[:, 1:])
         em = extend_model(em, offsets, ng)
     points = pts3.reshape(-1, 3)
@@ -452,6 +461,16 @@ def calibrate(
         )
     res = fit(em, em.initial, free, q, points, sigma=sig, orientations=orientations,
               sigma_rot=sigma_rot, loss=loss, loss_scale=loss_scale, max_nfev=max_nfev)
+    for _ in range(3 if identify_payload else 0):
+        # at c = 0 the payload has no effect, and a joint the arm alone does not load (a wrist)
+        # shows its compliance only under the payload: identifiability again at the solution,
+        # refit from it while the identifiable set grows
+        again, unid_again = identifiable_parameters(robot, em, res.params, q, weights, rot_weight)
+        if set(again) <= set(free):
+            break
+        free, unid = again, unid_again
+        res = fit(em, res.params, free, q, points, sigma=sig, orientations=orientations,
+                  sigma_rot=sigma_rot, loss=loss, loss_scale=loss_scale, max_nfev=max_nfev)
     if not res.success:
         warnings.warn(f"calibration of {robot.name} did not converge: {res.message}", RuntimeWarning,
                       stacklevel=2)
