@@ -687,9 +687,12 @@ class _Problem:
 
         ``gk`` (K, n, p): ``d value / d Y`` on the design columns.
         """
-        d = np.concatenate(self.model.regressor_derivatives(*states), axis=-1)  # (K, n, P, 3 n)
-        # dV/ds_v(t_k) = sum_jc G_kjc dY_kjc/ds_v
-        return np.einsum("kjcv,kjc->vk", d[:, :, self.cols], gk, optimize=True)
+        parts = self.model.regressor_derivatives(*states)  # 3 x (K, n, P, n), views
+        k, n, p = parts[0].shape[:3]
+        g = np.zeros((k, 1, n * p))
+        g.reshape(k, n, p)[:, :, self.cols] = gk
+        # dV/ds_v(t_k) = sum_jc G_kjc dY_kjc/ds_v: one (1, n P) x (n P, n) product per sample
+        return np.concatenate([(g @ d.reshape(k, n * p, n))[:, 0, :] for d in parts], axis=1).T
 
     def state_gradient_fd(self, states: tuple[np.ndarray, ...], y: np.ndarray,
                           gk: np.ndarray) -> np.ndarray:
