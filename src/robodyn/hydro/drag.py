@@ -1,7 +1,8 @@
 """Drag: normal (form) drag integrated along each cylinder, and axial skin friction.
 
 Normal drag per unit length at arc length xi, on the normal velocity relative to the current
-``u_n(xi) = P (v(xi) - c) = A + xi B`` (``A = P (J_s qd - c)``, ``B = J_b qd``)::
+``u_n(xi) = P (v(xi) - c) = A + xi B`` (``A = P (J_s qd - R^T c)``, ``B = J_b qd``, link-frame
+components: :mod:`robodyn.hydro.geometry`)::
 
     f_d(xi) = -1/2 rho C_d D |u_n| u_n            (D = 2 r)
 
@@ -35,10 +36,11 @@ __all__ = ["drag_torque", "normal_relative_velocity", "skin_friction_torque"]
 
 def normal_relative_velocity(motion: CylinderMotion, qd: Sequence[sp.Expr],
                              current: sp.MatrixBase) -> tuple[sp.Matrix, sp.Matrix]:
-    """``(A, B)`` with ``u_n(xi) = A + xi B``, each (3, 1), m/s and 1/s."""
+    """``(A, B)`` with ``u_n(xi) = A + xi B``, each (3, 1), m/s and 1/s, link-frame
+    components (``current``: world frame)."""
     qv = sp.Matrix(qd)
-    # A = P (J_s qd - c),  B = J_b qd
-    a = motion.normal_projector() * (motion.j_start * qv - sp.Matrix(current))
+    # A = P (J_s qd - R^T c),  B = J_b qd
+    a = motion.normal_projector() * (motion.j_start * qv - motion.to_link(current))
     return a, motion.j_bend * qv
 
 
@@ -84,8 +86,8 @@ def skin_friction_torque(fluid: Fluid, h: LinkHydro, cyl: Cylinder, motion: Cyli
     if h.skin_friction == 0:
         return sp.ImmutableMatrix(sp.zeros(n, 1))
     e = motion.axis
-    # u_a = e . (J_s qd - c)
-    u_a = (e.T * (motion.j_start * sp.Matrix(qd) - sp.Matrix(fluid.current)))[0, 0]
+    # u_a = a . (J_s qd - R^T c)   (link frame)
+    u_a = (e.T * (motion.j_start * sp.Matrix(qd) - motion.to_link(fluid.current)))[0, 0]
     # tau_f = L J_s^T e (1/2 rho C_f pi D |u_a| u_a),  D = 2 r
     force = fluid.density * h.skin_friction * sp.pi * cyl.radius * sp.sqrt(u_a**2) * u_a
     return sp.ImmutableMatrix(cyl.length * motion.j_start.T * e * force)

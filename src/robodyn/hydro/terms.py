@@ -98,7 +98,7 @@ def hydro_terms(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Expr],
         if h is None:
             continue
         for cyl in h.cylinders:
-            motion = cylinder_motion(robot, kin, i, cyl)
+            motion = cylinder_motion(robot, kin, i, cyl, q)
             m_a += added_mass_matrix(fluid, h, cyl, motion)
             drag += drag_torque(fluid, h, cyl, motion, qd, h.quadrature)
             skin += skin_friction_torque(fluid, h, cyl, motion, qd)

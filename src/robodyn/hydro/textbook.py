@@ -28,6 +28,7 @@ printed objects themselves into numbers (each integral by the model's own quadra
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -178,17 +179,12 @@ def _matrix_lines(name: str, mat: sp.MatrixBase, rates: Sequence[sp.Symbol], *,
                  for i in range(rows) for j in range(i if symmetric else 0, cols))
 
 
-def _link_frame(motion: CylinderMotion, rotation: sp.MatrixBase, axis: sp.MatrixBase,
-                q: Sequence[sp.Symbol]) -> CylinderMotion:
-    """The cylinder's Jacobians in its link frame, each entry trig-simplified (invariant
-    quantities like ``J^T J`` are unchanged; the entries lose the base angle)."""
-    rt = rotation.T
-
+def _simplified(motion: CylinderMotion) -> CylinderMotion:
+    """The cylinder's link-frame Jacobians with each entry trig-simplified."""
     def simp(m: sp.MatrixBase) -> sp.ImmutableMatrix:
         return sp.ImmutableMatrix(m.applyfunc(lambda e: sp.factor_terms(sp.trigsimp(sp.expand(e)))))
 
-    return CylinderMotion(axis=sp.ImmutableMatrix(axis), start=motion.start,
-                          j_start=simp(rt * motion.j_start), j_bend=simp(rt * motion.j_bend))
+    return dataclasses.replace(motion, j_start=simp(motion.j_start), j_bend=simp(motion.j_bend))
 
 
 def _rule_text(points: int) -> str:
@@ -229,13 +225,12 @@ def underwater_textbook(eom: EquationsOfMotion) -> UnderwaterTextbook:
     for i, h in enumerate(hydro_of(robot)):
         if h is None:
             continue
-        rot = S.rotation(kin.links[i])
         for c, cyl in enumerate(h.cylinders):
-            motion = _link_frame(cylinder_motion(robot, kin, i, cyl), rot, cyl.axis, q)
+            motion = _simplified(cylinder_motion(robot, kin, i, cyl, q))
             m_a += added_mass_matrix(fluid, h, cyl, motion)
             # u_n(s) = P (J_s qd - R^T c) + s J_b qd   (link frame)
             p = sp.eye(3) - cyl.axis * cyl.axis.T
-            current = sp.Matrix(rot.T * sp.Matrix(fluid.current))
+            current = sp.Matrix(motion.to_link(fluid.current))
             u = p * (motion.j_start * sp.Matrix(qd) - current) + s * motion.j_bend * sp.Matrix(qd)
             u = u.applyfunc(lambda e: _linear_simplify(e, [*qd, s]))
             tag = f"{i + 1}" + (chr(ord("a") + c) if len(h.cylinders) > 1 else "")

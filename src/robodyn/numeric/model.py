@@ -741,10 +741,12 @@ def _generator_hash() -> str:
     generates under the hash of the edited files.
     """
     import robodyn.codegen as codegen_pkg
+    import robodyn.hydro as hydro_pkg
     import robodyn.symbolic as symbolic_pkg
 
     digest = hashlib.sha256()
-    for pkg in (codegen_pkg, symbolic_pkg):
+    # the hydrodynamic terms (robodyn.hydro) are part of every underwater model's kernels
+    for pkg in (codegen_pkg, hydro_pkg, symbolic_pkg):
         for path in sorted(Path(pkg.__file__).parent.glob("*.py")):
             digest.update(path.read_bytes())
     return digest.hexdigest()
