@@ -223,32 +223,10 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
     if target is None and ident is not None:
         target = getattr(ident, "target", None)
     tgt = resolve_target(rec, target)
-    t = np.array(rec.t, dtype=float)  # copies: the result's arrays are frozen, the user's are not
-    if len(t) < MIN_SAMPLES:
-        raise ValidationError(f"{where}: {len(t)} samples; validation needs at least {MIN_SAMPLES}")
-    check_finite(rec, "t", t)
-    arrays = {}
-    for field in ("q", "qd", "qdd"):
-        value = getattr(rec, field, None)
-        if value is None:
-            raise ValidationError(f"{where}: field {field} is missing (a Recording estimates qd and "
-                                  "qdd; pass a robodyn.measure.Recording)")
-        arrays[field] = np.array(value, dtype=float)
-        check_finite(rec, field, arrays[field])
+    t, arrays = _checked_arrays(rec, where)
     y = np.array(measured_target(rec, tgt))
     has = ~np.all(np.isnan(y), axis=0)  # an all-NaN column: that joint has no such sensor
-    q, qd, qdd = arrays["q"], arrays["qd"], arrays["qdd"]
-    settings = getattr(ident, "preprocess", None)
-    if cutoff is None and settings is not None:
-        cutoff = getattr(settings, "cutoff", None)
-    if cutoff is not None:
-        cut = min(float(cutoff), 0.4 / float(np.median(np.diff(t))))
-        if getattr(settings, "velocity", "position") == "measured":
-            # qd = lowpass(qd_measured), qdd = d/dt of it
-            qd, qdd, _ = differentiate(t, qd, cut)
-        else:
-            # q = lowpass(q), qd and qdd its derivatives
-            q, qd, qdd = differentiate(t, q, cut)
+    q, qd, qdd = _model_states(t, arrays, ident, cutoff)
     if model is None:
         model = compile_model(robot, backend=backend)
     if ident is not None and getattr(ident, "target", tgt) != tgt:
@@ -256,12 +234,7 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
                               f"target={tgt!r} was asked for")
     if ident is not None and gains is None and tgt == "current" and hasattr(ident, "gains"):
         gains = ident.gains  # the gains the identification divided its torque by
-    k = drive_gains(robot, model.parameters) if tgt == "current" and gains is None else None
-    if tgt == "current" and gains is not None:
-        k = np.asarray(gains, dtype=float).reshape(-1)
-        if k.shape != (robot.dof,) or not np.all(np.isfinite(k)) or np.any(k == 0):
-            raise ValidationError(f"gains: expected {robot.dof} finite non-zero values (N m per A), "
-                                  f"got {np.asarray(gains).tolist()}")
+    k = _current_gains(robot, model, tgt, gains)
     scale = k if k is not None else np.ones(robot.dof)
     # tau_model = M(q) qdd + C(q, qd) qd + g(q) + friction(qd)
     tau_model = model.inverse_dynamics(q, qd, qdd)
@@ -279,21 +252,13 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
     filtered[:, has] = reference_filter(t, y[:, has], cutoff)
     # tau_measured = N K_t current
     tau_meas = y * scale
-    friction_model_at_data = friction_torque(robot, qd, model.parameters)
     # friction the data imply = measured torque - (model torque - model friction)
-    friction_data = tau_meas - (tau_model - friction_model_at_data)
+    friction_data = tau_meas - (tau_model - friction_torque(robot, qd, model.parameters))
     vmax = np.maximum(np.abs(qd).max(axis=0), 1e-3)
     grid = np.linspace(-vmax, vmax, 201)
     moving = np.abs(qd).max(axis=0) > MOVING_SPEED
-    notes = [f"{name} never moves (|qd| <= {MOVING_SPEED} rad/s): its friction and inertia are not "
-             "exercised by this recording" for name, m in zip(robot.joint_names, moving, strict=True)
-             if not m]
+    notes = _notes(robot, recording, rec, tgt, moving, has)
     simulation = None
-    extra = ignored_joints(robot, recording) if rec is not recording else []
-    if extra:
-        notes.append(f"joints not in {robot.name} left out of the recording: {', '.join(extra)}")
-    notes += [f"{name} has no {tgt} measurement: its errors are NaN"
-              for name, h in zip(robot.joint_names, has, strict=True) if not h]
     if window is not None and not has.all():
         notes.append("simulation check skipped: the measured torque is missing on some joints")
     elif window is not None:
@@ -315,3 +280,68 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
                 out.friction_grid, out.friction_model, out.moving, out.friction_velocity):
         arr.flags.writeable = False
     return out
+
+
+def _checked_arrays(rec: Any, where: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Copies of ``t`` (N,) and ``q``, ``qd``, ``qdd`` (N, n), checked present and finite.
+
+    Copies: the result's arrays are frozen, the user's are not.
+    """
+    t = np.array(rec.t, dtype=float)
+    if len(t) < MIN_SAMPLES:
+        raise ValidationError(f"{where}: {len(t)} samples; validation needs at least {MIN_SAMPLES}")
+    check_finite(rec, "t", t)
+    arrays = {}
+    for field in ("q", "qd", "qdd"):
+        value = getattr(rec, field, None)
+        if value is None:
+            raise ValidationError(f"{where}: field {field} is missing (a Recording estimates qd and "
+                                  "qdd; pass a robodyn.measure.Recording)")
+        arrays[field] = np.array(value, dtype=float)
+        check_finite(rec, field, arrays[field])
+    return t, arrays
+
+
+def _model_states(t: np.ndarray, arrays: dict[str, np.ndarray], ident: Any,
+                  cutoff: float | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The states (N, n) the model is evaluated at: as recorded, or processed as identification did."""
+    q, qd, qdd = arrays["q"], arrays["qd"], arrays["qdd"]
+    settings = getattr(ident, "preprocess", None)
+    if cutoff is None and settings is not None:
+        cutoff = getattr(settings, "cutoff", None)
+    if cutoff is None:
+        return q, qd, qdd
+    cut = min(float(cutoff), 0.4 / float(np.median(np.diff(t))))
+    if getattr(settings, "velocity", "position") == "measured":
+        # qd = lowpass(qd_measured), qdd = d/dt of it
+        qd, qdd, _ = differentiate(t, qd, cut)
+        return q, qd, qdd
+    # q = lowpass(q), qd and qdd its derivatives
+    return differentiate(t, q, cut)
+
+
+def _current_gains(robot: Robot, model: Model, tgt: str, gains: Any) -> np.ndarray | None:
+    """Joint torque per motor ampere (n,) for a current target (None for a torque target)."""
+    if tgt != "current":
+        return None
+    if gains is None:
+        return drive_gains(robot, model.parameters)
+    k = np.asarray(gains, dtype=float).reshape(-1)
+    if k.shape != (robot.dof,) or not np.all(np.isfinite(k)) or np.any(k == 0):
+        raise ValidationError(f"gains: expected {robot.dof} finite non-zero values (N m per A), "
+                              f"got {np.asarray(gains).tolist()}")
+    return k
+
+
+def _notes(robot: Robot, recording: Any, rec: Any, tgt: str, moving: np.ndarray,
+           has: np.ndarray) -> list[str]:
+    """Notes on joints that never move, joints left out and joints without the target."""
+    notes = [f"{name} never moves (|qd| <= {MOVING_SPEED} rad/s): its friction and inertia are not "
+             "exercised by this recording" for name, m in zip(robot.joint_names, moving, strict=True)
+             if not m]
+    extra = ignored_joints(robot, recording) if rec is not recording else []
+    if extra:
+        notes.append(f"joints not in {robot.name} left out of the recording: {', '.join(extra)}")
+    notes += [f"{name} has no {tgt} measurement: its errors are NaN"
+              for name, h in zip(robot.joint_names, has, strict=True) if not h]
+    return notes
