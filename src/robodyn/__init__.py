@@ -24,6 +24,7 @@ _EXPORTS = {
     "calibrate": "robodyn.calibrate",
     "Identification": "robodyn.identify",
     "identify": "robodyn.identify",
+    "Payload": "robodyn.identify",
     "Recording": "robodyn.measure",
     "excitation": "robodyn.measure",
     "read_recording": "robodyn.measure",
@@ -47,7 +48,7 @@ _EXPORTS = {
 
 if TYPE_CHECKING:  # static analysers see ordinary imports
     from robodyn.calibrate import Calibration, calibrate
-    from robodyn.identify import Identification, identify
+    from robodyn.identify import Identification, Payload, identify
     from robodyn.measure import Recording, excitation, read_recording
     from robodyn.numeric.model import Model, compile_model
     from robodyn.robot.load import builtin_names, load
@@ -93,6 +94,7 @@ __all__ = [
     "Drive",
     "EquationsOfMotion",
     "Identification",
+    "Payload",
     "Friction",
     "Joint",
     "Link",

@@ -6,6 +6,7 @@ Public entry point: :func:`identify` (``rd.identify``), returning an :class:`Ide
 from robodyn.identify.base import BaseRelations, base_relations
 from robodyn.identify.friction import FrictionFit, fit_friction, friction_table
 from robodyn.identify.jointwise import JointIdentification, identify_joint
+from robodyn.identify.payload import Payload
 from robodyn.identify.pipeline import identify
 from robodyn.identify.preprocess import Preprocess
 from robodyn.identify.result import BaseParameters, Identification
@@ -16,6 +17,7 @@ __all__ = [
     "FrictionFit",
     "Identification",
     "JointIdentification",
+    "Payload",
     "Preprocess",
     "base_relations",
     "fit_friction",

@@ -27,8 +27,10 @@ import numpy as np
 import sympy as sp
 
 from robodyn.identify.base import BaseRelations, base_relations
+from robodyn.identify.drive_gains import estimate_drive_gains
 from robodyn.identify.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identify.friction import FRICTION_MODELS, NONLINEAR, fit_friction_samples, without_friction
+from robodyn.identify.payload import Payload, payload_standard, payload_torque
 from robodyn.identify.preprocess import Preprocess, Samples, preprocess, resolve_preprocess
 from robodyn.identify.prior import joint_prior
 from robodyn.identify.result import BaseParameters, Identification
@@ -110,13 +112,15 @@ def _description_gains(robot: Robot) -> np.ndarray:
 
 
 def _stack(samples: Sequence[Samples], y_full: Sequence[np.ndarray], columns: np.ndarray,
-           gains: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``Phi`` (m, b), ``y`` (m,), joint of each row, CV block of each row (m = sum N_k n)."""
+           gains: np.ndarray, loads: Sequence[np.ndarray]
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``Phi`` (m, b), ``y`` (m,), joint of each row, CV block of each row (m = sum N_k n);
+    ``loads`` (N_k, n): the known payload torque of each recording, taken off the target."""
     phis, ys, joints, blocks = [], [], [], []
-    for s, y in zip(samples, y_full, strict=True):
+    for s, y, load in zip(samples, y_full, loads, strict=True):
         count, n = s.q.shape
         phis.append(y[:, :, columns].reshape(count * n, -1))
-        ys.append((s.y * gains[None, :]).reshape(-1))  # K_j i_j (or tau_j)
+        ys.append((s.y * gains[None, :] - load).reshape(-1))  # K_j i_j - P_j (or tau_j - P_j)
         joints.append(np.tile(np.arange(n), count))
         blocks.append(np.repeat(np.arange(count) * FOLDS // count, n))
     return np.vstack(phis), np.concatenate(ys), np.concatenate(joints), np.concatenate(blocks)
@@ -126,8 +130,8 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
              friction: str = "linear", regularization: float | str | None = "auto",
              cutoff: float | str | None = "auto", decimate: int | str = "auto",
              velocity: str = "position", gains: str = "auto",
-             bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None
-             ) -> Identification:
+             bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None,
+             payloads: Sequence[Payload | None] | None = None) -> Identification:
     """Identify the base inertial, drive and friction parameters of a robot from recordings.
 
     Parameters
@@ -162,6 +166,12 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         (e.g. ``{"M7": (0.3, 2.0)}`` for a known payload range).
     model : Model, optional
         A compiled model of ``robot`` to reuse (default ``rd.compile_model(robot)``).
+    payloads : sequence of Payload or None, optional
+        One per recording: the known payload attached to the last link during that run (None:
+        none). Its torque is taken off the target; with ``target="current"``, a payload run
+        together with a run without it (or with another payload) identifies the drive gains
+        (:mod:`robodyn.identify.drive_gains`; ``gains_source="payload"``, ``gains_std``).
+        ``ident.robot`` is the robot without payloads.
 
     Returns
     -------
@@ -188,6 +198,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         raise IdentificationError(f"gains: expected 'auto', 'description' or 'absorbed', got {gains!r}")
     for i, rec in enumerate(recs):
         check_recording(robot, rec, i, target)
+    pays = _check_payloads(payloads, len(recs))
     settings = resolve_preprocess(recs, cutoff, decimate, velocity)
     model = model if model is not None else compile_model(robot)
     relations = base_relations(model)
@@ -204,10 +215,23 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
             f"= {count * robot.dof} equations after decimation by {settings.decimate} for {b} base "
             f"parameters (at least {2 * b} needed; record longer or pass decimate=1)")
     nominal = nominal_standard(robot)
+    loads = [np.zeros_like(s.q) if p is None else payload_torque(y, payload_standard(robot, p))
+             for s, y, p in zip(samples, y_full, pays, strict=True)]
+    has_payload = any(p is not None for p in pays)
     k, k_source, prior = joint_prior(robot, samples, y_full, nominal, target, gains)
+    k_std = np.full(robot.dof, np.inf if k_source.startswith("absorbed") else np.nan)
+    if target == "current" and has_payload:
+        phi, y, joint, _ = _stack(samples, y_full, relations.independent, np.ones(robot.dof),
+                                  [np.zeros_like(x) for x in loads])
+        est = estimate_drive_gains(phi, y, np.concatenate([x.reshape(-1) for x in loads]), joint,
+                                   robot.joint_names)
+        # the prior's drive and friction terms were fitted in the units of the absorbed gains
+        for j in range(robot.dof):
+            prior[PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)] *= est.gains[j] / k[j]
+        k, k_source, k_std = est.gains, "payload", est.std
     if friction == "none":
         prior = without_friction(prior)
-    phi, y, joint, blocks = _stack(samples, y_full, relations.independent, k)
+    phi, y, joint, blocks = _stack(samples, y_full, relations.independent, k, loads)
     theta0 = relations.to_base(prior)
     lin_method = "ols" if method == "ols" else "wls"
     fit = fit_linear(phi, y, theta0, joint, blocks, method=lin_method, regularization=regularization)
@@ -226,13 +250,31 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     weak = fit.directions[:, s < UNEXCITED_RTOL * s[0]]
     result = Identification(
         robot=ident_robot, base_parameters=table, standard=standard, preprocess=settings,
-        target=target, method=method, gains=k, gains_source=k_source, regularization=fit.lam,
+        target=target, method=method, gains=k, gains_source=k_source, gains_std=k_std,
+        regularization=fit.lam,
         condition=fit.condition, singular_values=s, unexcited_directions=weak,
         residual_std=fit.sigma / k, samples=count, relations=relations,
         _model=model)
     if friction in NONLINEAR:
         result = replace(result, friction_fit=fit_friction_samples(result, samples, y_full, friction))
     return result
+
+
+def _check_payloads(payloads: Any, count: int) -> list[Payload | None]:
+    """One ``Payload`` or None per recording (an error naming the entry otherwise)."""
+    if payloads is None:
+        return [None] * count
+    if isinstance(payloads, Payload):
+        raise IdentificationError("payloads: expected a sequence with one Payload or None per "
+                                  "recording, got a single Payload")
+    pays = list(payloads)
+    if len(pays) != count:
+        raise IdentificationError(f"payloads: expected one per recording ({count}), got {len(pays)}")
+    for i, p in enumerate(pays):
+        if p is not None and not isinstance(p, Payload):
+            raise IdentificationError(f"payloads[{i}]: expected a Payload or None, got "
+                                      f"{type(p).__name__}")
+    return pays
 
 
 def _without_friction_columns(relations: BaseRelations) -> BaseRelations:

@@ -100,7 +100,8 @@ class Identification:
     gains : numpy.ndarray, shape (n,)
         Drive gains ``K_j`` (N m / A) dividing the predicted torque when ``target="current"``
         (ones for ``target="tau"``).
-    gains_source : {"none", "description", "absorbed"}
+    gains_source : {"none", "description", "absorbed", "payload"}
+        "payload": estimated from a run with a known payload (:mod:`robodyn.identify.drive_gains`).
     regularization : float
         Tikhonov weight used (dimensionless; 0: none).
     condition : float
@@ -114,6 +115,10 @@ class Identification:
     samples : int
         Samples (after decimation) used in the fit.
     relations : BaseRelations
+    gains_std : numpy.ndarray, shape (n,)
+        Standard deviations of ``gains`` (N m / A) when they were estimated (``"payload"``);
+        inf when absorbed (current alone leaves a common scale of the gains free: not
+        identified); nan when given (description) or not used (``target="tau"``).
     friction_fit : FrictionFit or None
         A nonlinear friction law fitted after the linear step
         (:func:`robodyn.identify.friction.fit_friction`); :meth:`predict` then uses it in place
@@ -137,8 +142,14 @@ class Identification:
     relations: BaseRelations
     _model: Model
     friction_fit: FrictionFit | None = None
+    gains_std: np.ndarray | None = None
 
-    def predict(self, recording: Any) -> np.ndarray:
+    @property
+    def gains_identified(self) -> bool:
+        """Whether the drive gains were identified from the data (a known-payload run)."""
+        return self.gains_source == "payload"
+
+    def predict(self, recording: Any, payload: Any = None) -> np.ndarray:
         """Predicted target at the recording's own samples.
 
         The raw recording is processed as the identification data were (same filter cut-off
@@ -148,6 +159,8 @@ class Identification:
         ----------
         recording : Recording
             ``t`` (N,), ``q`` (N, n) in the robot's joint order.
+        payload : Payload, optional
+            A known payload on the last link during this recording; its torque is added.
 
         Returns
         -------
@@ -164,4 +177,8 @@ class Identification:
         else:
             load = y @ without_friction(self.standard)  # rigid body and rotor inertia
             tau = load + self.friction_fit.torque(s.qd, load)
+        if payload is not None:
+            from robodyn.identify.payload import payload_standard, payload_torque
+
+            tau = tau + payload_torque(y, payload_standard(self.robot, payload))
         return tau / self.gains[None, :]
