@@ -53,3 +53,46 @@ def test_state_noise_option_is_validated():
         state_noise_std((0.1, -1.0, 0.0), 2)
     with pytest.raises(IdentificationError, match=r"state_noise.s_q: expected a scalar or shape \(2,\)"):
         state_noise_std(([0.1, 0.1, 0.1], 0.0, 0.0), 2)
+
+
+def _noisy_velocity_log(model, seed, s_qd):
+    from tests.identify.helpers import fourier
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 20.0, 0.01)
+    q, qd, qdd = fourier(t, model.dof, rng)
+    tau = model.inverse_dynamics(q, qd, qdd)
+    return rd.Recording(t=t, q=q, qd=qd + rng.normal(0.0, s_qd, qd.shape), qdd=qdd,
+                        tau=tau + rng.normal(0.0, 0.05, tau.shape), source=f"noisy-qd-{seed}")
+
+
+def test_state_noise_weighting_reduces_the_parameter_error(arm):
+    """Velocity noise 0.3 rad/s (exact q, qdd; torque noise 0.05 N m), four seeds: the
+    errors-in-variables weighting against WLS with per-joint residual weights. Measured error
+    ratios 0.16, 0.40, 0.29, 0.65 (seeds 0-3) on the inertial base parameters."""
+    robot, model = arm
+    state = (0.0, 0.3, 0.0)
+    ratios = []
+    for seed in range(4):
+        rec = _noisy_velocity_log(model, seed, state[1])
+        errs = []
+        for w in ("residual", "state-noise"):
+            ident = rd.identify(robot, rec, method="wls", cutoff=None, regularization=None,
+                                model=model, weights=w, state_noise=state)
+            true = ident.relations.to_base(nominal_standard(robot))
+            inertial = ident.relations.independent % 15 < 10
+            errs.append(np.linalg.norm((ident.base_parameters.values - true)[inertial])
+                        / np.abs(true[inertial]).max())
+        ratios.append(errs[1] / errs[0])
+    print("error ratio state-noise / residual weights:", np.round(ratios, 3))
+    assert max(ratios) < 1.0  # better on every seed
+    assert np.mean(ratios) < 0.6
+
+
+def test_state_noise_weighting_options_are_checked(arm):
+    robot, model = arm
+    rec = _noisy_velocity_log(model, 0, 0.1)
+    with pytest.raises(IdentificationError, match=r"state_noise: weights='state-noise' needs"):
+        rd.identify(robot, rec, cutoff=None, model=model, weights="state-noise")
+    with pytest.raises(IdentificationError, match=r"weights: expected one of"):
+        rd.identify(robot, rec, cutoff=None, model=model, weights="eiv")

@@ -110,8 +110,9 @@ def _cv_errors(a: np.ndarray, b: np.ndarray, z0: np.ndarray, blocks: np.ndarray)
 
 
 def _one(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, joint: np.ndarray, blocks: np.ndarray,
-         weights: np.ndarray, regularization: float | str | None) -> LinearFit:
-    w = weights[joint]
+         weights: np.ndarray, regularization: float | str | None,
+         rows: np.ndarray | None = None) -> LinearFit:
+    w = weights[joint] if rows is None else rows
     norms = np.linalg.norm(phi * w[:, None], axis=0)
     scale = np.where(norms > 0, norms, 1.0)
     a = phi * w[:, None] / scale[None, :]
@@ -152,7 +153,8 @@ def _one(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, joint: np.ndarray, 
 
 def fit_linear(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, joint: np.ndarray,
                blocks: np.ndarray, *, method: str = "ols",
-               regularization: float | str | None = None) -> LinearFit:
+               regularization: float | str | None = None,
+               row_sigma: np.ndarray | None = None) -> LinearFit:
     """Least squares toward a prior (module docstring).
 
     Parameters
@@ -170,12 +172,19 @@ def fit_linear(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, joint: np.nda
     method : {"ols", "wls"}
     regularization : "auto", float or None
         Weight ``lam`` (dimensionless), chosen by cross-validation with "auto"; None: none.
+    row_sigma : numpy.ndarray, shape (m,), optional
+        Standard deviation of each row's error (e.g. :mod:`robodyn.identify.state_noise`): the
+        rows are weighted by ``1 / row_sigma`` instead of per joint (``method`` is then unused).
 
     Returns
     -------
     LinearFit
     """
     n = int(joint.max()) + 1
+    if row_sigma is not None:
+        rows = 1.0 / np.asarray(row_sigma, dtype=float)
+        per_joint = np.array([np.sqrt(np.mean(rows[joint == j] ** 2)) for j in range(n)])
+        return _one(phi, y, theta0, joint, blocks, per_joint, regularization, rows)
     first = _one(phi, y, theta0, joint, blocks, np.ones(n), regularization)
     if method == "ols":
         return first

@@ -34,6 +34,7 @@ from robodyn.identify.payload import Payload, payload_standard, payload_torque
 from robodyn.identify.preprocess import Preprocess, Samples, preprocess, resolve_preprocess
 from robodyn.identify.prior import joint_prior
 from robodyn.identify.result import BaseParameters, Identification
+from robodyn.identify.state_noise import state_noise_std, torque_variance
 from robodyn.identify.to_robot import robot_with_parameters
 from robodyn.measure.filtering import lowpass
 from robodyn.numeric.model import Model, compile_model
@@ -45,6 +46,9 @@ __all__ = ["check_recording", "identify", "nominal_standard"]
 
 TARGETS = ("tau", "current")
 METHODS = ("ols", "wls", "consistent")
+WEIGHTS = ("residual", "state-noise")
+#: Floor of the measurement variance, as a fraction of the first fit's residual variance.
+MEAS_FLOOR = 0.01
 #: Samples per cut-off period kept for the parallel filtering of the regressor.
 MID_RATE = 100
 #: Unit directions whose singular value is below this fraction of the largest are reported.
@@ -131,7 +135,8 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
              cutoff: float | str | None = "auto", decimate: int | str = "auto",
              velocity: str = "position", gains: str = "auto",
              bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None,
-             payloads: Sequence[Payload | None] | None = None) -> Identification:
+             payloads: Sequence[Payload | None] | None = None, weights: str = "residual",
+             state_noise: Any = None) -> Identification:
     """Identify the base inertial, drive and friction parameters of a robot from recordings.
 
     Parameters
@@ -172,6 +177,14 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         together with a run without it (or with another payload) identifies the drive gains
         (:mod:`robodyn.identify.drive_gains`; ``gains_source="payload"``, ``gains_std``).
         ``ident.robot`` is the robot without payloads.
+    weights : {"residual", "state-noise"}
+        Row weights of ``method="wls"``/``"consistent"``: per joint from the residuals of a first
+        fit, or per sample and joint ``1 / sigma_tau`` with ``sigma_tau^2`` the measurement
+        variance plus the state noise propagated through the analytic derivatives of the first
+        fit's model (errors in variables, :mod:`robodyn.identify.state_noise`).
+    state_noise : (s_q, s_qd, s_qdd), optional
+        Standard deviations of the processed states' noise (rad, rad/s, rad/s^2; scalars or
+        (n,)), required by ``weights="state-noise"``.
 
     Returns
     -------
@@ -194,6 +207,11 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         raise IdentificationError(f"method: expected one of {METHODS}, got {method!r}")
     if friction not in FRICTION_MODELS:
         raise IdentificationError(f"friction: expected one of {FRICTION_MODELS}, got {friction!r}")
+    if weights not in WEIGHTS:
+        raise IdentificationError(f"weights: expected one of {WEIGHTS}, got {weights!r}")
+    if weights == "state-noise" and state_noise is None:
+        raise IdentificationError("state_noise: weights='state-noise' needs the state noise "
+                                  "(s_q, s_qd, s_qdd) in rad, rad/s, rad/s^2")
     if gains not in ("auto", "description", "absorbed"):
         raise IdentificationError(f"gains: expected 'auto', 'description' or 'absorbed', got {gains!r}")
     for i, rec in enumerate(recs):
@@ -235,6 +253,16 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     theta0 = relations.to_base(prior)
     lin_method = "ols" if method == "ols" else "wls"
     fit = fit_linear(phi, y, theta0, joint, blocks, method=lin_method, regularization=regularization)
+    if weights == "state-noise":
+        noise = state_noise_std(state_noise, robot.dof)
+        first = _complete(relations, fit.theta, prior)
+        var = np.concatenate([torque_variance(model, s.q, s.qd, s.qdd, *noise, standard=first)
+                              for s in samples]).reshape(-1)
+        # sigma_meas^2: what the propagated variance leaves of each joint's residual variance
+        prop = np.array([np.mean(var[joint == j]) for j in range(robot.dof)])
+        meas = np.maximum(fit.sigma**2 - prop, MEAS_FLOOR * fit.sigma**2)
+        fit = fit_linear(phi, y, theta0, joint, blocks, regularization=regularization,
+                         row_sigma=np.sqrt(meas[joint] + var))
     if method == "consistent":
         from robodyn.identify.consistent import consistent_standard
 
