@@ -176,7 +176,13 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     import json
 
     from robodyn.calibrate.io import read_calibration_csv, read_joint_map, write_calibration
-    from robodyn.calibrate.pipeline import LENGTH_UNITS, convert_units, validate
+    from robodyn.calibrate.pipeline import (
+        ANGLE_UNITS,
+        LENGTH_UNITS,
+        convert_units,
+        validate,
+        validate_orientation,
+    )
 
     robot = rd.load(args.robot, tool=args.tool)
     stem = check_stem(args.stem) if args.stem is not None else f"{robot.name}_calibrated"
@@ -196,10 +202,13 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         circle = [si(read_calibration_csv(path, robot, joint_map=jmap)) for path in args.circle]
     # sigma in the data's length unit (the option is in mm)
     sigma = data.sigma if data.sigma is not None else args.sigma * 1e-3 / LENGTH_UNITS[args.length_unit]
+    # sigma_rot in the angle unit (the option is in mrad)
+    sigma_rot = args.sigma_rot * 1e-3 / ANGLE_UNITS[args.angle_unit]
     with progress(f"calibrating {robot.name} from {len(data.q)} poses ({args.model} model)"):
         cal = rd.calibrate(robot, data.q, data.points, args.model, sigma=sigma, loss=args.loss,
                            initial="circle-point" if circle else "nominal", circle_data=circle,
-                           orientations=data.orientations, nongeometric=tuple(args.nongeometric or ()),
+                           orientations=data.orientations, sigma_rot=sigma_rot,
+                           nongeometric=tuple(args.nongeometric or ()),
                            payload=_payload(args.payload), identify_payload=args.identify_payload,
                            **units)
     validation = None
@@ -207,9 +216,12 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         from robodyn.calibrate.result import ErrorStats
         from robodyn.calibrate.simulate_study import robot_positions
 
-        held_q, held_pts = si(read_calibration_csv(args.validate, robot, targets=args.targets,
-                                                   joint_map=jmap))
+        held = read_calibration_csv(args.validate, robot, targets=args.targets, joint_map=jmap)
+        held_q, held_pts = si(held)
         stats = validate(cal, held_q, held_pts)
+        rot_stats = None
+        if held.orientations is not None and cal.model.orientation:
+            rot_stats = validate_orientation(cal, held_q, held.orientations)
         first = held_pts if held_pts.ndim == 2 else held_pts[:, 0]
         # before: the nominal kinematics placed in the instrument frame, first target
         stats_before = ErrorStats.from_residuals(first - robot_positions(cal.before_robot, held_q))
@@ -221,6 +233,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         report = json.loads(paths["json"].read_text(encoding="utf-8"))
         report["validation"] = {"file": str(args.validate), "before_m": stats_before.__dict__,
                                 "before_targets": "first", "after_m": stats.__dict__}
+        if rot_stats is not None:
+            report["validation"]["orientation_after_rad"] = rot_stats.__dict__
         paths["json"].write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
     paths["html"] = calibration_html(cal, output_path(args.output, stem, "_report.html"),
                                      source=str(args.data), validation=validation)
@@ -229,6 +243,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         print(f"\nheld-out ({args.validate}), after calibration: {stats.text()}")
         print(f"held-out ({args.validate}), before (nominal, placed): {stats_before.text()}"
               + (" (first target)" if cal.targets_axis else ""))
+        if rot_stats is not None:
+            print(f"held-out ({args.validate}), orientation after calibration: {rot_stats.angle_text()}")
     print()
     for kind, path in paths.items():
         if path is not None:
@@ -377,6 +393,9 @@ def _calibrate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: st
                         "coupling: {other column: factor}} (docs/calibration.md)")
     p.add_argument("--targets", type=int, metavar="K",
                    help="targets per pose (x, y, z, x2, y2, z2, ...); checked against the columns")
+    p.add_argument("--sigma-rot", type=float, default=0.1, metavar="MRAD",
+                   help="standard uncertainty of a measured orientation (qw, qx, qy, qz columns) "
+                        "about each axis, milliradians (default: %(default)s)")
     p.add_argument("--payload", type=floats, metavar="KG,X,Y,Z",
                    help="known payload for the compliance torques: mass in kg and centre of mass in "
                         "the tool frame in m (the start value with --identify-payload)")

@@ -155,8 +155,9 @@ def test_bad_input_messages():
         calibrate(r, q, y + np.arange(20)[:, None, None] * 0.01, nongeometric=("backlash",))
     with pytest.raises(ValueError, match=r"points must have shape \(N, 3\) or \(N, K, 3\)"):
         calibrate(r, q, np.zeros((20, 2, 4)))
-    with pytest.raises(ValueError, match="several targets"):
-        calibrate(r, q, np.zeros((20, 2, 3)), orientations=np.broadcast_to(np.eye(3), (20, 3, 3)))
+    # several targets with orientations are fine (test_full_pose.py); one orientation per pose
+    with pytest.raises(ValueError, match=r"orientations must have shape \(20, 3, 3\); got \(40, 3, 3\)"):
+        calibrate(r, q, np.zeros((20, 2, 3)), orientations=np.broadcast_to(np.eye(3), (40, 3, 3)))
 
 
 @pytest.mark.filterwarnings("ignore:calibration of puma560. the variance factor")

@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from robodyn.calibrate.result import Calibration
+from robodyn.calibrate.result import Calibration, ErrorStats
 from robodyn.output_names import output_path
 from robodyn.robot.errors import DataFileError
 from robodyn.robot.model import Robot
@@ -366,6 +366,9 @@ def _report_data(cal: Calibration) -> dict:
         "targets_m": cal.target_offsets().tolist(),
         "nongeometric": cal.nongeometric,
         "residuals_m": np.asarray(cal.residuals).tolist(),
+        **({} if cal.rotation_residuals is None else {
+            "orientation_after_rad": ErrorStats.from_residuals(cal.rotation_residuals).__dict__,
+            "rotation_residuals_rad": np.asarray(cal.rotation_residuals).tolist()}),
     }
 
 

@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robodyn.calibrate.kinematics import ChainEval, Op, evaluate, hom, inv
+from robodyn.calibrate.kinematics import ChainEval, Op, evaluate, hom, inv, rot
 from robodyn.calibrate.nominal import (
     RobotGeometry,
     axis_frames,
@@ -160,11 +160,23 @@ class ErrorModel:
             return ChainEval(ev.position, ev.rotation, jp, jq)
         return self._targets(params, ev.position, ev.rotation, jp, jq)
 
+    def target_rotation(self, params: np.ndarray) -> np.ndarray:
+        """Rotation (3, 3) of the target frame in the last link frame (identity without
+        measured orientation): ``R_target = R_last @ target_rotation``."""
+        if not self.orientation:
+            return np.eye(3)
+        fixed = self.ops[-1]
+        assert fixed.kind == "fixed" and fixed.matrix is not None  # last op of _tool_ops
+        a = [params[self.index(f"tool.r{x}")] for x in "xyz"]
+        return (rot("x", a[0]) @ rot("y", a[1]) @ rot("z", a[2]))[:3, :3] @ fixed.matrix[:3, :3]
+
     def _targets(self, params, p1, r, jp, jq) -> ChainEval:
         """All ``K`` targets from the first one's evaluation (rows pose-major)."""
         big_n, k_count = len(p1), self.targets
         tool = [self.index(f"tool.{a}") for a in "xyz"]
         t1 = params[tool]
+        turn = [self.index(f"tool.r{a}") for a in "xyz"] if self.orientation else []
+        r = r @ self.target_rotation(params).T  # the last link's rotation: offsets are given there
         pos = np.empty((big_n, k_count, 3))
         pos[:, 0] = p1
         offsets = []
@@ -173,7 +185,7 @@ class ErrorModel:
             d = r @ (params[cols] - t1)  # p_k = p_1 + R (t_k - t_1)
             pos[:, k] = p1 + d
             offsets.append((cols, d))
-        rot_all = np.repeat(r, k_count, axis=0)
+        rot_all = np.repeat(r @ self.target_rotation(params), k_count, axis=0)
         if jp is None:
             return ChainEval(pos.reshape(-1, 3), rot_all, None, None)
         jp_all = np.repeat(jp[:, None], k_count, axis=1)
@@ -183,6 +195,7 @@ class ErrorModel:
             jp_all[:, k, :3] += np.cross(jp[:, 3:], d[:, :, None], axisa=1, axisb=1, axisc=1)
             jq_all[:, k, :3] += np.cross(jq[:, 3:], d[:, :, None], axisa=1, axisb=1, axisc=1)
             jp_all[:, k, :3][:, :, tool] = 0.0
+            jp_all[:, k, :3][:, :, turn] = 0.0  # turning the target frame moves no target
             jp_all[:, k, :3][:, :, cols] = r
         return ChainEval(pos.reshape(-1, 3), rot_all, jp_all.reshape(big_n * k_count, 6, -1),
                          jq_all.reshape(big_n * k_count, 6, -1))
@@ -404,14 +417,11 @@ def extend_model(model: ErrorModel, offsets: np.ndarray | None = None,
     Raises
     ------
     ValueError
-        ``model`` is already extended, or several targets with measured orientations.
+        ``model`` is already extended.
     """
     if model.targets != 1 or model.nongeometric is not None:
         raise ValueError("extend_model: the model is already extended")
     offsets = np.zeros((0, 3)) if offsets is None else np.asarray(offsets, dtype=float).reshape(-1, 3)
-    if len(offsets) and model.orientation:
-        raise ValueError("several targets per pose cannot be combined with measured orientations; "
-                         "give the orientation of one target only")
     names, units, values = list(model.names), list(model.units), list(model.initial)
     placement = [k for k in model.priority if names[k].startswith(("base.", "tool."))]
     extra = [k for k in model.priority if k in _extra_group(model)]

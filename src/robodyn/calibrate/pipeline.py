@@ -34,12 +34,13 @@ from robodyn.calibrate.kinematics import hom, inv
 from robodyn.calibrate.models import MODELS, ErrorModel, build_model, extend_model, model_frames
 from robodyn.calibrate.nominal import RobotGeometry, default_frame0, robot_geometry
 from robodyn.calibrate.result import Calibration, ErrorStats, Parameter
-from robodyn.calibrate.solve import LOSSES, fit
+from robodyn.calibrate.solve import LOSSES, fit, rotation_vector
 from robodyn.calibrate.to_robot import calibrated_robot
 from robodyn.robot.model import Robot
 
 __all__ = ["calibrate", "check_data", "compensate", "identifiable_parameters", "inverse_kinematics",
-           "nominal_placement", "random_configurations", "validate"]
+           "nominal_placement", "random_configurations", "validate",
+           "validate_orientation"]
 
 #: Threshold of :func:`~robodyn.calibrate.identifiability.independent_columns`.
 RANK_TOL = 1e-7
@@ -80,10 +81,7 @@ def check_data(robot: Robot, q, points, orientations=None, sigma=5e-5,
                          f"got {points.shape}")
     if len(q) != len(points):
         raise ValueError(f"mismatched lengths: q has {len(q)} poses but points has {len(points)}")
-    if orientations is not None:
-        if points.ndim == 3 and points.shape[1] > 1:
-            raise ValueError("orientations cannot be combined with several targets per pose; "
-                             "give the orientation of one target only")
+    if orientations is not None:  # one per pose: the frame of the body that carries the targets
         orientations = _array("orientations", orientations, "(N, 3, 3)")
         if orientations.shape != (len(q), 3, 3):
             raise ValueError(f"orientations must have shape ({len(q)}, 3, 3); got {orientations.shape}")
@@ -189,13 +187,14 @@ def target_offsets(model: ErrorModel, params: np.ndarray, q: np.ndarray, points:
     p = np.array(params, dtype=float)
     p[[model.index(f"tool.{a}") for a in "xyz"]] = 0.0
     ev = model.evaluate(p, q, derivatives=False)
+    r_last = ev.rotation @ model.target_rotation(p).T  # offsets are in the last link frame
     offsets = np.zeros((points.shape[1], 3))
     res = np.zeros(points.shape)
     for k in range(points.shape[1]):
         # R_i t = y_ik - o_i, stacked over poses
-        offsets[k], *_ = np.linalg.lstsq(ev.rotation.reshape(-1, 3), (points[:, k] - ev.position).ravel(),
+        offsets[k], *_ = np.linalg.lstsq(r_last.reshape(-1, 3), (points[:, k] - ev.position).ravel(),
                                          rcond=None)
-        res[:, k] = points[:, k] - ev.position - ev.rotation @ offsets[k]
+        res[:, k] = points[:, k] - ev.position - r_last @ offsets[k]
     return offsets, res
 
 
@@ -221,6 +220,10 @@ def _rows(model: ErrorModel, params: np.ndarray, q: np.ndarray, weights: np.ndar
     """Weighted identification Jacobian, shape (N * r, P)."""
     jac = model.evaluate(params, q).jac_param
     j = jac[:, :3] * weights[:, :, None]
+    if model.orientation and model.targets > 1:
+        # one orientation per pose (the rows of every target carry the same rotation)
+        rot = jac[:: model.targets, 3:] * rot_weight
+        return np.concatenate((j.reshape(-1, model.n_params), rot.reshape(-1, model.n_params)))
     if model.orientation:
         j = np.concatenate((j, jac[:, 3:] * rot_weight), axis=1)
     return j.reshape(-1, model.n_params)
@@ -450,10 +453,10 @@ def calibrate(
     weights = 1.0 / sig
     rot_weight = 1.0 / sigma_rot if oriented else 0.0
     free, unid = identifiable_parameters(robot, em, em.initial, q, weights, rot_weight)
-    rows = q.shape[0] * k_count * (6 if oriented else 3)
+    rows = q.shape[0] * (3 * k_count + (3 if oriented else 0))
     n_struct = em.n_params - sum(u.kind == "structural" for u in unid)
     if rows <= n_struct:
-        per = 6 if oriented else 3
+        per = 3 * k_count + (3 if oriented else 0)
         raise ValueError(
             f"too few poses: {len(q)} poses give {rows} equations for {n_struct} identifiable "
             f"parameters of the {model} model of {robot.name}; at least {n_struct // per + 1} poses "
@@ -486,8 +489,7 @@ def calibrate(
         Parameter(em.names[k], float(res.params[k]), float(s), float(em.initial[k]), em.units[k])
         for k, s in zip(res.free, std, strict=True)
     )
-    jac = em.evaluate(res.params, q).jac_param[:, : 6 if oriented else 3][:, :, res.free]
-    obs = observability(jac.reshape(-1, len(res.free)), len(q))
+    obs = observability(_rows(em, res.params, q, np.ones((len(points), 3)), 1.0)[:, res.free], len(q))
     return Calibration(
         robot=calibrated_robot(robot, geometry, em, res.params),
         model=em,
@@ -527,6 +529,32 @@ def validate(calibration: Calibration, q, points) -> ErrorStats:
     """
     q, points, _, _ = check_data(calibration.robot, q, points)
     return ErrorStats.from_residuals(points - calibration.predict(q))
+
+
+def validate_orientation(calibration: Calibration, q, orientations) -> ErrorStats:
+    """Orientation error statistics of the calibrated model on other (held-out) poses.
+
+    Parameters
+    ----------
+    calibration : Calibration
+        Fitted with measured orientations.
+    q : array_like, shape (N, n)
+    orientations : array_like, shape (N, 3, 3)
+        Measured orientations (one per pose, the targets' common frame), instrument frame.
+
+    Returns
+    -------
+    ErrorStats
+        Of the rotation vectors ``log(R_measured R_predicted^T)``: angles in rad.
+    """
+    if not calibration.model.orientation:
+        raise ValueError("validate_orientation: the calibration was fitted without orientations")
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    dummy = np.zeros((len(q), 3))
+    q, _, orientations, _ = check_data(calibration.robot, q, dummy, orientations)
+    k = calibration.model.targets
+    predicted = calibration.predict_frames(q)[::k, :3, :3]
+    return ErrorStats.from_residuals(rotation_vector(orientations @ np.swapaxes(predicted, 1, 2)))
 
 
 def compensate(

@@ -48,6 +48,11 @@ class ErrorStats:
         return (f"mean {self.mean * 1e3:.4f} mm, RMS {self.rms * 1e3:.4f} mm, "
                 f"max {self.max * 1e3:.4f} mm, std {self.std * 1e3:.4f} mm ({self.count} poses)")
 
+    def angle_text(self) -> str:
+        """One line in milliradians, for statistics of rotation vectors (rad)."""
+        return (f"mean {self.mean * 1e3:.4f} mrad, RMS {self.rms * 1e3:.4f} mrad, "
+                f"max {self.max * 1e3:.4f} mrad, std {self.std * 1e3:.4f} mrad ({self.count} poses)")
+
 
 @dataclass(frozen=True)
 class Parameter:
@@ -238,6 +243,8 @@ class Calibration:
             f"{'converged' if self.converged else 'NOT converged'} ({self.message})",
             f"before: {self.before.text()}",
             f"after:  {self.after.text()}",
+            *([] if self.rotation_residuals is None else
+              [f"orientation after: {ErrorStats.from_residuals(self.rotation_residuals).angle_text()}"]),
             "",
             f"{'parameter':<18}{'initial':>14}{'estimate':>14}{'std':>12}  unit",
         ]

@@ -99,6 +99,7 @@ class Problem:
         self.weights = weights  # (N, 3), 1 / sigma
         self.orientations = orientations
         self.rot_weight = rot_weight
+        self.k = model.targets  # targets per pose; one orientation per pose
 
     def full(self, x: np.ndarray) -> np.ndarray:
         """All parameters with the free ones set to ``x``."""
@@ -114,13 +115,16 @@ class Problem:
         ev = self._eval(x, False)
         rres = None
         if self.orientations is not None:
-            rres = rotation_vector(self.orientations @ np.swapaxes(ev.rotation, 1, 2))
+            rot = ev.rotation[:: self.k]  # every target of a pose has the body's rotation
+            rres = rotation_vector(self.orientations @ np.swapaxes(rot, 1, 2))
         return self.points - ev.position, rres
 
     def residuals(self, x: np.ndarray) -> np.ndarray:
         """Weighted residual vector, shape (m,)."""
         pos, rres = self.raw(x)
         r = pos * self.weights
+        if rres is not None and self.k > 1:
+            return np.concatenate((r.ravel(), (rres * self.rot_weight).ravel()))
         if rres is not None:
             r = np.concatenate((r, rres * self.rot_weight), axis=1)
         return r.ravel()
@@ -130,6 +134,9 @@ class Problem:
         ev = self._eval(x, True)
         jp = ev.jac_param[:, :, self.free]
         j = -jp[:, :3] * self.weights[:, :, None]  # r = (y - f) / sigma
+        if self.orientations is not None and self.k > 1:
+            jr = -jp[:: self.k, 3:] * self.rot_weight
+            return np.concatenate((j.reshape(-1, len(self.free)), jr.reshape(-1, len(self.free))))
         if self.orientations is not None:
             # r_rot = log(R_m R^T): a small world rotation dw of R changes it by -dw
             j = np.concatenate((j, -jp[:, 3:] * self.rot_weight), axis=1)
@@ -162,12 +169,13 @@ def fit(
         Indices of the parameters to estimate.
     q : numpy.ndarray, shape (N, n)
         Joint readings, rad (m).
-    points : numpy.ndarray, shape (N, 3)
-        Measured target positions in the instrument frame, m.
-    sigma : float or numpy.ndarray, shape (N,) or (N, 3)
+    points : numpy.ndarray, shape (N K, 3)
+        Measured target positions in the instrument frame, m (pose-major for ``model.targets``
+        = K targets per pose).
+    sigma : float or numpy.ndarray, shape (N K,) or (N K, 3)
         Standard uncertainty of each measured coordinate, m.
     orientations : numpy.ndarray, shape (N, 3, 3), optional
-        Measured target orientations in the instrument frame.
+        Measured orientations in the instrument frame, one per pose (the targets' common frame).
     sigma_rot : float
         Standard uncertainty of a measured orientation about each axis, rad.
     loss : {"linear", "huber", "soft_l1", "cauchy", "arctan"}
