@@ -47,6 +47,11 @@ BLOCK = 16
 #: Cores with more assignments than this are not inlined into their batch loop (compile time).
 INLINE_LIMIT = 400
 
+#: Outputs of at least this many entries per state (the regressor, the derivatives) are stored by
+#: the core straight into the caller's rows (strided, vector scatter stores where the target has
+#: them) instead of through a structure-of-arrays buffer and a transposition.
+DIRECT_MIN = 64
+
 #: Beyond this |angle| (rad), and for infinities and NaN, the block's sine and cosine come from libm.
 _POLY_LIMIT = "1.0e5"
 
@@ -158,6 +163,12 @@ class CPrinter(Printer):
         given.update(zip(steps, switches, strict=True))
         outputs = tuple(Argument(o.name, o.shape, tuple(sp.sympify(e).xreplace(given) for e in o.entries))
                         for o in kernel.outputs)
+        # outputs with constant entries (the regressor's zeros): the core computes only the
+        # others, and each state's row is written from a constant template, then those entries
+        computed = {o.name: [i for i, e in enumerate(o.entries) if not e.is_Number] for o in outputs}
+        outputs = tuple(Argument(o.name, (len(computed[o.name]),),
+                                 tuple(o.entries[i] for i in computed[o.name]))
+                        if 0 < len(computed[o.name]) < o.size else o for o in outputs)
         body = tuple((s, e.xreplace(given)) for s, e in kernel.body)
         used: set[sp.Basic] = set()
         for e in [e for _, e in body] + [sp.sympify(e) for o in outputs for e in o.entries]:
@@ -171,17 +182,24 @@ class CPrinter(Printer):
             f"    {self.prefix}{kernel.name}_range(0, 1, {', '.join(_names(kernel))});",
             "}",
         ]) + "\n"
-        return "\n".join([self.block_function(core, len(kernel.body) > INLINE_LIMIT),
-                          self.blocked_batch(kernel, core, angles, steps),
+        direct = {o.name: (o.size, computed[o.name] if 0 < len(computed[o.name]) < o.size
+                           else list(range(o.size)))
+                  for o in kernel.outputs if o.size >= DIRECT_MIN}
+        return "\n".join([self.block_function(core, len(kernel.body) > INLINE_LIMIT, direct),
+                          self.blocked_batch(kernel, core, angles, steps, computed, direct),
                           self.threaded_batch(kernel), single])
 
-    def block_function(self, core: Kernel, noinline: bool = False) -> str:
+    def block_function(self, core: Kernel, noinline: bool = False,
+                       direct: dict[str, tuple[int, list[int]]] | None = None) -> str:
         """``static void PREFIXk_block(int m_, ...)``: the body for m_ states, one vector loop.
 
         Every array is structure-of-arrays with stride :data:`BLOCK` (entry i of state k at
         ``[BLOCK * i + k]``): the loads and stores of one entry are consecutive across the
-        states, and the body has no calls but sqrt and no branches but selects.
+        states, and the body has no calls but sqrt and no branches but selects. An output in
+        ``direct`` (name: (row size, positions of the computed entries)) is the caller's rows
+        instead: entry ``c`` of state k stored at ``[size * k + position_c]``.
         """
+        direct = direct or {}
         inline = f"{self.prefix.upper()}NOINLINE " if noinline else ""
         args = [f"const double *restrict {a.name}" for a in core.inputs]
         args += [f"double *restrict {a.name}" for a in core.outputs]
@@ -199,21 +217,32 @@ class CPrinter(Printer):
             lines += [f"{ind}const double {sym.name} = {arg.name}[{BLOCK * k} + k_];"
                       for k, sym in enumerate(arg.entries) if sym in used]
         lines += [ind + self.assign(s, e) for s, e in core.body]
-        lines += [f"{ind}{arg.name}[{BLOCK * k} + k_] = {self.expr(sp.sympify(e))};"
-                  for arg in core.outputs for k, e in enumerate(arg.entries)]
+        for arg in core.outputs:
+            if arg.name in direct:
+                size, where = direct[arg.name]
+                lines += [f"{ind}{arg.name}[{size} * k_ + {where[k]}] = {self.expr(sp.sympify(e))};"
+                          for k, e in enumerate(arg.entries)]
+            else:
+                lines += [f"{ind}{arg.name}[{BLOCK * k} + k_] = {self.expr(sp.sympify(e))};"
+                          for k, e in enumerate(arg.entries)]
         return "\n".join([*lines, "    }", "}"]) + "\n"
 
     def blocked_batch(self, kernel: Kernel, core: Kernel, angles: list[tuple[sp.Symbol, str, int]],
-                      steps: list[sp.Piecewise]) -> str:
+                      steps: list[sp.Piecewise], computed: dict[str, list[int]] | None = None,
+                      direct: dict[str, tuple[int, list[int]]] | None = None) -> str:
         """``PREFIXk_range`` (states [begin, end), a block at a time) and ``PREFIXk_batch``.
 
         Per block: the inputs are transposed into structure-of-arrays buffers and the switches
         (Coulomb friction's ``qd > 0``) computed there, where they become vector selects rather
         than conditional jumps the processor would mispredict on every sign change; then one
         vector loop per angle gives the sines and cosines, the core runs, and the outputs are
-        transposed back.
+        transposed back. An output with constant entries (``computed`` lists the others, by
+        output name) is written per state from a static template of the constants, then its
+        computed entries from the block (the core neither computes nor stores the constants).
         """
         na, ns = len(angles), len(steps)
+        computed, direct = computed or {}, direct or {}
+        sizes = {a.name: a.size for a in core.outputs}
         element = {}
         for arg in kernel.inputs:
             for k, sym in enumerate(arg.entries):
@@ -225,15 +254,46 @@ class CPrinter(Printer):
                   f"{a.name}[{a.size} * j_ + i_];" for a in gathered]
         gather += [f"            step_[{BLOCK * i} + k_] = {self.expr(e.xreplace(element))};"
                    for i, e in enumerate(steps)]
-        arrays = [f"{a.name}_b_[{a.size * BLOCK}]" for a in (*gathered, *kernel.outputs)]
+        arrays = [f"{a.name}_b_[{sizes.get(a.name, a.size) * BLOCK}]"
+                  for a in (*gathered, *kernel.outputs) if a.name not in direct]
         arrays += [f"sin_[{na * BLOCK}]", f"cos_[{na * BLOCK}]"] if na else []
         arrays += [f"step_[{ns * BLOCK}]"] if ns else []
         trig = [f"        {self.prefix}sincos_block(m_, {name}_b_ + {BLOCK * idx}, sin_ + {BLOCK * i}, "
                 f"cos_ + {BLOCK * i});" for i, (_, name, idx) in enumerate(angles)]
         args = [a.name if a.name in ("sin_", "cos_", "step_") else f"{a.name}_b_"
-                for a in (*core.inputs, *core.outputs)]
-        scatter = [f"            for (int i_ = 0; i_ < {a.size}; ++i_) {a.name}[{a.size} * j_ + i_] = "
-                   f"{a.name}_b_[{BLOCK} * i_ + k_];" for a in kernel.outputs]
+                for a in core.inputs]
+        args += [f"{a.name} + {direct[a.name][0]} * k0_" if a.name in direct else f"{a.name}_b_"
+                 for a in core.outputs]
+        tables: list[str] = []
+        scatter = []
+        fill: list[str] = []
+        for a, o in zip(kernel.outputs, core.outputs, strict=True):
+            if a.name in direct and o.size == a.size:
+                continue
+            if a.name in direct:
+                # the constants first; the core then stores the computed entries over them
+                template = f"{self.prefix}{kernel.name}_{a.name}_template_"
+                values = [self.expr(sp.Float(e)) if sp.sympify(e).is_Number else "0.0" for e in a.entries]
+                tables.append(f"static const double {template}[{a.size}] = {{{', '.join(values)}}};")
+                fill += ["        for (int k_ = 0; k_ < m_; ++k_)",
+                         f"            for (int i_ = 0; i_ < {a.size}; ++i_) "
+                         f"{a.name}[{a.size} * (k0_ + k_) + i_] = {template}[i_];"]
+                continue
+            if o.size == a.size:
+                scatter.append(f"            for (int i_ = 0; i_ < {a.size}; ++i_) "
+                               f"{a.name}[{a.size} * j_ + i_] = {a.name}_b_[{BLOCK} * i_ + k_];")
+                continue
+            # the constants from a template, then the computed entries over them
+            keep = computed[a.name]
+            stem = f"{self.prefix}{kernel.name}_{a.name}"
+            template, index = f"{stem}_template_", f"{stem}_index_"
+            values = [self.expr(sp.Float(e)) if sp.sympify(e).is_Number else "0.0" for e in a.entries]
+            tables += [f"static const double {template}[{a.size}] = {{{', '.join(values)}}};",
+                       f"static const int {index}[{len(keep)}] = {{{', '.join(map(str, keep))}}};"]
+            scatter += [f"            double *restrict row_ = {a.name} + {a.size} * j_;",
+                        f"            for (int i_ = 0; i_ < {a.size}; ++i_) row_[i_] = {template}[i_];",
+                        f"            for (int i_ = 0; i_ < {len(keep)}; ++i_) row_[{index}[i_]] = "
+                        f"{a.name}_b_[{BLOCK} * i_ + k_];"]
         # (a kernel whose outputs are constants reads no input)
         transpose = ["        /* transpose the block's inputs: x_b_[BLOCK i + k] = x[size (k0 + k) + i] */",
                      "        for (int k_ = 0; k_ < m_; ++k_) {",
@@ -242,7 +302,11 @@ class CPrinter(Printer):
                      "        }"] if gather else []
         params = ", ".join(f"const double *restrict {a.name}" for a in kernel.inputs)
         params += ", " + ", ".join(f"double *restrict {a.name}" for a in kernel.outputs)
+        if tables:
+            tables = [f"/* {kernel.name}: constant entries of its outputs, and the computed ones' "
+                      "positions. */", *tables, ""]
         return "\n".join([
+            *tables,
             f"/* {kernel.name} for the states begin <= j < end stored one after another, {BLOCK} at a "
             "time. */",
             f"static void {self.prefix}{kernel.name}_range(long begin, long end, {params}) {{",
@@ -251,11 +315,12 @@ class CPrinter(Printer):
             f"        const int m_ = end - k0_ < {BLOCK} ? (int)(end - k0_) : {BLOCK};",
             *transpose,
             *trig,
+            *fill,
             f"        {self.prefix}{core.name}(m_, {', '.join(args)});",
-            "        for (int k_ = 0; k_ < m_; ++k_) {",
-            "            const long j_ = k0_ + k_;",
-            *scatter,
-            "        }",
+            *(["        for (int k_ = 0; k_ < m_; ++k_) {",
+               "            const long j_ = k0_ + k_;",
+               *scatter,
+               "        }"] if scatter else []),
             "    }",
             "}",
             "",

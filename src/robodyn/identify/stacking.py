@@ -2,7 +2,10 @@
 
 ``W[k n + i, :] = Y(q_k, qd_k, qdd_k)[i, columns]``: one row per joint ``i`` per sample ``k``
 (sample-major). With all columns the batched kernel writes ``W`` itself in one call: its
-(N, n, 15 n) output is ``W`` in memory, reshaped without a copy. With a column selection the
+(N, n, 15 n) output is ``W`` in memory, reshaped without a copy; the generated kernel stores each
+state's row straight into ``W`` (the constant zeros of the regressor from a template, the
+computed entries by the vector loop, no intermediate buffer), and ``out=`` lets repeated
+stacking reuse one matrix (no new allocation, no page faults on first touch). With a column selection the
 regressor is evaluated in chunks of ``CHUNK`` samples, each chunk's kept columns copied into one
 preallocated matrix, so that stacking 100,000 samples of a 7-joint arm does not first build a
 second full-size temporary.
@@ -22,7 +25,8 @@ CHUNK = 4096
 
 
 def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
-                          columns: Sequence[int] | None = None, *, threads: int = 1) -> np.ndarray:
+                          columns: Sequence[int] | None = None, *, threads: int = 1,
+                          out: np.ndarray | None = None) -> np.ndarray:
     """Stacked regressor.
 
     Parameters
@@ -35,6 +39,8 @@ def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.n
         Regressor columns to keep (default all ``15 n``).
     threads : int
         Threads of the batched kernel (C backend with OpenMP; the result does not depend on it).
+    out : numpy.ndarray, shape (N n, p), optional
+        C-contiguous float64 matrix to write ``W`` into (returned): reuse it across calls.
 
     Returns
     -------
@@ -44,9 +50,18 @@ def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.n
     count, n = q.shape
     if columns is None:
         # (N, n, 15 n) C-order is (N n, 15 n): a view, not a copy
-        return model.regressor(q, qd, qdd, threads=threads).reshape(count * n, -1)
+        if out is not None and out.shape != (count * n, 15 * n):
+            raise ValueError(f"identification_matrix(out=...): expected shape {(count * n, 15 * n)}, "
+                             f"got {out.shape}")
+        return model.regressor(q, qd, qdd, threads=threads, out=out).reshape(count * n, -1)
     cols = np.asarray(columns, dtype=int)
-    out = np.empty((count * n, cols.size))
+    if out is None:
+        out = np.empty((count * n, cols.size))
+    elif (not isinstance(out, np.ndarray) or out.shape != (count * n, cols.size)
+          or out.dtype != np.float64 or not out.flags.writeable):
+        raise ValueError(f"identification_matrix(out=...): expected a writeable float64 array of "
+                         f"shape {(count * n, cols.size)}, got "
+                         f"{getattr(out, 'shape', type(out).__name__)}")
     for start in range(0, count, CHUNK):
         stop = min(start + CHUNK, count)
         y = model.regressor(q[start:stop], qd[start:stop], qdd[start:stop], threads=threads)

@@ -229,10 +229,16 @@ class Model:
         return self._call("jacobian", q, threads=threads, parameters=parameters)
 
     def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, *,
-                  threads: int = 1,
-                  parameters: ParameterValues = None) -> np.ndarray:
-        """Regressor ``Y`` with ``Y @ params == tau``, (n, 15 n) or (N, n, 15 n)."""
-        return self._call("regressor", q, qd, qdd, threads=threads, parameters=parameters)
+                  threads: int = 1, parameters: ParameterValues = None,
+                  out: np.ndarray | None = None) -> np.ndarray:
+        """Regressor ``Y`` with ``Y @ params == tau``, (n, 15 n) or (N, n, 15 n).
+
+        ``out``: a C-contiguous float64 array of the result's size (any shape, e.g. the stacked
+        (N n, 15 n)) that receives the result and is returned (reshaped to the result's shape, a
+        view): repeated stacking reuses its memory instead of allocating (and first touching)
+        a new array.
+        """
+        return self._call("regressor", q, qd, qdd, threads=threads, parameters=parameters, out=out)
 
     def inverse_dynamics_derivatives(self, q: np.ndarray, qd: np.ndarray,
                                      qdd: np.ndarray, *, threads: int = 1,
@@ -532,7 +538,7 @@ class Model:
                                f"{where}(parameters=...)")
 
     def _call(self, name: str, *arrays: np.ndarray, threads: int = 1,
-              parameters: ParameterValues = None) -> np.ndarray:
+              parameters: ParameterValues = None, out: np.ndarray | None = None) -> np.ndarray:
         threads = _thread_count(threads)
         inputs, result_shape = kernel_signature(name, self.dof)
         batch_shape: tuple[int, ...] | None = None
@@ -552,14 +558,19 @@ class Model:
         if self.runtime_parameters or parameters is not None:
             args.append(self.parameter_input(parameters, batch_shape, name))
         out_shape = batch_shape + result_shape
+        target = None if out is None else _out_buffer(out, out_shape, args, name)
         if isinstance(self._impl, ModuleType):
             # a singular M divides by zero: the callers check the result, not NumPy's warnings
             with np.errstate(divide="ignore", invalid="ignore"):
-                return getattr(self._impl, name)(*args).reshape(out_shape)
+                result = getattr(self._impl, name)(*args).reshape(out_shape)
+            if target is None:
+                return result
+            target[...] = result
+            return target
         ffi, lib = self._impl.ffi, self._impl.lib
         # C-contiguous float64 inputs are passed without a copy
         args = [np.ascontiguousarray(a) for a in args]
-        out = np.empty(out_shape)
+        out = np.empty(out_shape) if target is None else target
         ptrs = [ffi.from_buffer("double[]", a) for a in args]
         out_ptr = ffi.from_buffer("double[]", out)
         if batch_shape and threads > 1:
@@ -671,6 +682,23 @@ def _compile_derivatives(model: Model, names: tuple[str, ...] = DERIVATIVE_KERNE
             _touch(path)
         impl = _import_file(path, f"robodyn_generated_{tag}_{key}")
     return Model(robot, backend, model.parameter_values, impl, runtime)
+
+
+def _out_buffer(out: np.ndarray, shape: tuple[int, ...], inputs: Sequence[np.ndarray],
+                name: str) -> np.ndarray:
+    """``out`` as a view of ``shape``, checked: float64, C-contiguous, writeable, right size."""
+    if not isinstance(out, np.ndarray) or out.dtype != np.float64 or not out.flags.c_contiguous \
+            or not out.flags.writeable:
+        raise ValueError(f"{name}(out=...): expected a writeable C-contiguous float64 NumPy array, "
+                         f"got {type(out).__name__}"
+                         + (f" of dtype {out.dtype}" if isinstance(out, np.ndarray) else ""))
+    size = int(np.prod(shape))
+    if out.size != size:
+        raise ValueError(f"{name}(out=...): the result has shape {shape} ({size} values), out has "
+                         f"shape {out.shape} ({out.size} values)")
+    if any(np.shares_memory(out, a) for a in inputs):
+        raise ValueError(f"{name}(out=...): out overlaps an input array")
+    return out.reshape(shape)
 
 
 def _thread_count(threads: int) -> int:
