@@ -3,11 +3,13 @@
 Prints, in one run:
 
   1. stacking the identification matrix (full regressor, 7 x 105 per sample) for 100,000
-     Kinova Gen3 samples: robodyn's batched compiled regressor, written in chunks into one
-     matrix (``robodyn.identify.stacking.identification_matrix``), against a
-     Python loop over Pinocchio's ``computeJointTorqueRegressor`` on the same arm (the
-     manufacturer's URDF, ../shared/data/kinova-gen3/gen3.urdf), the ratio (target >= 10x) and
-     the agreement of the rigid-body columns;
+     Kinova Gen3 samples: robodyn's batched compiled regressor writing straight into one
+     matrix (``robodyn.identify.stacking.identification_matrix``), into a fresh matrix and
+     into a reused one (``out=``), on 1 and 2 threads; the memory floor of each case (NumPy
+     writing a fresh matrix of the same shape, and filling the reused one); against a Python
+     loop over Pinocchio's ``computeJointTorqueRegressor`` on the same arm (the manufacturer's
+     URDF, ../shared/data/kinova-gen3/gen3.urdf, writing into a preallocated matrix), the
+     ratios (target >= 10x) and the agreement of the rigid-body columns;
   2. whole identifications of the Kinova whole-arm runs (all three, motor current) with
      ``rd.identify`` for OLS, WLS and the physically consistent SDP, in seconds each.
 
@@ -61,19 +63,33 @@ def main() -> None:
     rng = np.random.default_rng(0)
     q, qd, qdd = rng.uniform(-2, 2, (3, count, n))
 
+    def line(label: str, t: float) -> None:
+        print(f"  {label:<52} {t:8.3f} s  {1e9 * t / count:8.0f} ns/sample")
+
     t_rd, y = best_of(lambda: identification_matrix(model, q, qd, qdd), args.repeat)
     t_rd2, y2 = best_of(lambda: identification_matrix(model, q, qd, qdd, threads=2), args.repeat)
     assert np.array_equal(y, y2), "threads changed the identification matrix"
     y2 = None
-    print(f"stacking {count} Gen3 samples ({count * n} x {y.shape[1]}):")
-    print(f"  robodyn identification_matrix (batched C)  {t_rd:8.3f} s  "
-          f"{1e9 * t_rd / count:8.0f} ns/sample")
-    print(f"  the same on 2 threads                       {t_rd2:8.3f} s  "
-          f"{1e9 * t_rd2 / count:8.0f} ns/sample")
-    # the floor: writing a fresh matrix of the same size with NumPy (page faults + stores)
+    buf = np.empty_like(y)
+    buf.fill(0.0)  # touched once: the reused case has no page faults
+    t_out, w_out = best_of(lambda: identification_matrix(model, q, qd, qdd, out=buf), args.repeat)
+    t_out2, _ = best_of(lambda: identification_matrix(model, q, qd, qdd, threads=2, out=buf),
+                        args.repeat)
+    assert np.array_equal(w_out, y), "out= changed the identification matrix"
+    print(f"stacking {count} Gen3 samples ({count * n} x {y.shape[1]}, "
+          f"{y.nbytes / 1e6:.0f} MB):")
+    line("robodyn identification_matrix, fresh matrix", t_rd)
+    line("  the same on 2 threads", t_rd2)
+    line("robodyn into a reused matrix (out=)", t_out)
+    line("  the same on 2 threads", t_out2)
+    # the floors: NumPy writing a fresh matrix of the same size (page faults + stores), and
+    # filling the reused one (stores only)
     t_fill, _ = best_of(lambda: np.full(y.shape, 1.0), args.repeat)
-    print(f"  NumPy np.full of the same shape (memory)    {t_fill:8.3f} s  "
-          f"{1e9 * t_fill / count:8.0f} ns/sample")
+    t_refill, _ = best_of(lambda: buf.fill(1.0), args.repeat)
+    line("memory floor, fresh: NumPy np.full of the same shape", t_fill)
+    line("memory floor, reused: NumPy fill of the reused matrix", t_refill)
+    print(f"  compute beyond the floor: fresh {1e9 * (t_rd - t_fill) / count:.0f} ns/sample, "
+          f"reused {1e9 * (t_out - t_refill) / count:.0f} ns/sample (1 thread)")
     try:
         import pinocchio as pin
     except ImportError:
@@ -91,10 +107,11 @@ def main() -> None:
             return out
 
         t_pin, w = best_of(loop, 1)
-        print(f"  Pinocchio computeJointTorqueRegressor loop    {t_pin:8.3f} s  "
-              f"{1e9 * t_pin / count:8.0f} ns/sample")
-        print(f"  ratio Pinocchio / robodyn: {t_pin / t_rd:.1f}x on 1 thread, {t_pin / t_rd2:.1f}x on 2 "
-              "(target >= 10x)")
+        line("Pinocchio computeJointTorqueRegressor loop (Python)", t_pin)
+        print(f"  ratio Pinocchio loop / robodyn, fresh matrix: {t_pin / t_rd:.1f}x on 1 thread, "
+              f"{t_pin / t_rd2:.1f}x on 2; reused matrix: {t_pin / t_out:.1f}x on 1 thread, "
+              f"{t_pin / t_out2:.1f}x on 2 (target >= 10x; the Pinocchio loop writes into a "
+              "preallocated matrix, one Python call per sample)")
         cols = [PER_JOINT * j + k for j in range(n) for k in PIN_ORDER]
         dev = np.abs(y[:, cols] - w).max() / np.abs(w).max()
         print(f"  rigid-body columns agree to {dev:.1e} (relative to the largest entry)")
