@@ -23,6 +23,7 @@ unit angle error count alike, which suits arms about a metre long).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -31,6 +32,7 @@ import numpy as np
 __all__ = [
     "Observability",
     "Unidentifiable",
+    "compress_rows",
     "dependency",
     "independent_columns",
     "observability",
@@ -83,7 +85,12 @@ class Observability:
 
 
 def observability(jac: np.ndarray, n_poses: int) -> Observability:
-    """Observability indices of ``jac`` (shape (m, L), m per unit parameter) for ``n_poses`` poses."""
+    """Observability indices of ``jac`` (shape (m, L), m per unit parameter) for ``n_poses`` poses.
+
+    A tall ``jac`` is first reduced to its triangular factor (:func:`compress_rows`), which has
+    the same singular values.
+    """
+    jac = compress_rows(jac)
     s = np.linalg.svd(jac, compute_uv=False) if jac.size else np.zeros(0)
     if s.size == 0:
         return Observability(0.0, 0.0, 0.0, 0.0, 0.0, np.inf, s, n_poses)
@@ -100,6 +107,31 @@ def observability(jac: np.ndarray, n_poses: int) -> Observability:
         singular_values=s,
         n_poses=n_poses,
     )
+
+
+def compress_rows(jac: np.ndarray) -> np.ndarray:
+    """``R`` (L, L), upper triangular, with ``R^T R = J^T J`` for a tall ``jac`` (m, L), m > 2 L.
+
+    Householder QR written with :func:`numpy.einsum` and in-place updates: the same column norms,
+    angles, ranks, least-squares coefficients and singular values as ``jac``, without handing the
+    tall matrix to a multithreaded LAPACK (which can take seconds on a busy machine for what one
+    thread does in milliseconds). Other shapes are returned as given.
+    """
+    m, p = jac.shape
+    if m <= 2 * p:
+        return jac
+    a = np.array(jac, dtype=float)
+    for k in range(p):
+        x = a[k:, k]
+        nx = math.sqrt(float(np.einsum("i,i", x, x)))
+        if nx == 0.0:
+            continue
+        v = x.copy()
+        v[0] += math.copysign(nx, x[0])  # reflect x onto -sign(x0) |x| e1
+        # A <- (I - 2 v v^T / v^T v) A on the trailing block
+        w = np.einsum("i,ij->j", v, a[k:, k:]) * (2.0 / float(np.einsum("i,i", v, v)))
+        a[k:, k:] -= np.multiply.outer(v, w)
+    return np.triu(a[:p])
 
 
 def independent_columns(jac: np.ndarray, order: Sequence[int], tol: float = 1e-7) -> list[int]:

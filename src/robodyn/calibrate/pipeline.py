@@ -26,6 +26,7 @@ import numpy as np
 from robodyn.calibrate.circle_point import CirclePointResult, circle_point
 from robodyn.calibrate.identifiability import (
     Unidentifiable,
+    compress_rows,
     describe,
     independent_columns,
     observability,
@@ -306,13 +307,13 @@ def identifiable_parameters(robot: Robot, model: ErrorModel, params: np.ndarray,
                               weights, (len(q) * model.targets, 3))
     qr = random_configurations(robot, max(3 * model.n_params, 60), rng=12345)
     ones = np.ones((len(qr) * model.targets, 3))
-    js = _rows(model, params, qr, ones, 1.0)
+    js = compress_rows(_rows(model, params, qr, ones, 1.0))  # same column geometry, L rows
     kept_s = independent_columns(js, model.priority, RANK_TOL)
     drop_s = [k for k in model.priority if k not in kept_s]
     out = [Unidentifiable(model.names[k], float(params[k]), "structural", combo,
                           f"{text}, whatever the poses")
            for k, (combo, text) in zip(drop_s, describe(js, model.names, kept_s, drop_s), strict=True)]
-    jd = _rows(model, params, q, weights, rot_weight)
+    jd = compress_rows(_rows(model, params, q, weights, rot_weight))
     order = [k for k in model.priority if k in kept_s]
     kept_d = independent_columns(jd, order, RANK_TOL)
     drop_d = [k for k in order if k not in kept_d]
