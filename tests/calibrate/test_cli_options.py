@@ -130,3 +130,12 @@ def test_circle_files_with_multi_turn_joints_as_given_or_wrapped(tmp_path, capsy
     assert pa.keys() == pb.keys()
     for k in pa:
         assert pb[k] == pytest.approx(pa[k], abs=1e-9), k
+
+
+def test_cli_warns_when_sigma_is_off_by_more_than_3x(data, tmp_path, capsys):
+    # the data's noise is 0.05 mm; --sigma 0.5 mm is 10x too large
+    assert main(["calibrate", "puma560", "--data", str(data / "si.csv"), "--sigma", "0.5",
+                 "-o", str(tmp_path)]) == 0
+    err = capsys.readouterr().err
+    assert "robodyn: warning: calibration of puma560: the variance factor" in err
+    assert "wrong by a factor of about 0.1" in err

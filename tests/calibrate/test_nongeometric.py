@@ -201,3 +201,20 @@ def test_noise_level_reached_only_with_the_terms(puma_truth):
           f"geometric only {held_g * 1e3:.4f} mm ({held_g / noise:.3f} x noise)")
     assert held_c < 1.3 * noise
     assert held_g > 1.3 * noise
+
+
+@pytest.mark.parametrize(("declared", "warns"), [(5e-4, True), (1e-5, True), (1e-4, False), (3e-5, False)])
+def test_sigma_warning_both_ways_and_only_beyond_3x(puma_truth, declared, warns):
+    """Noise 0.05 mm: declared 10x too large or 5x too small warns; 2x or 0.6x does not."""
+    import warnings
+
+    r, true, _ = puma_truth
+    q = poses("puma560", 80, 4)
+    y = measured(true, q, TARGETS[:1])[:, 0] + np.random.default_rng(1).normal(0, 5e-5, (80, 3))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        calibrate(r, q, y, "s-model", sigma=declared)
+    said = [str(w.message) for w in caught if "variance factor" in str(w.message)]
+    assert bool(said) == warns, said
+    if warns:
+        assert ("smaller" if declared > 5e-5 else "larger") in said[0]
