@@ -45,6 +45,26 @@ def _gains(value: np.ndarray | None, n: int) -> np.ndarray | None:
     return value
 
 
+def _payload(args: argparse.Namespace) -> rd.Payload | None:
+    """The known payload of ``--payload`` (None without ``--payload-data``)."""
+    if (args.payload is None) != (not args.payload_data):
+        raise ValueError("--payload and --payload-data go together: the recordings made with the "
+                         "payload attached, and its mass, centre of mass (and inertia)")
+    if args.payload is None:
+        return None
+    v = args.payload
+    if v.size not in (4, 7, 10):
+        raise ValueError(f"--payload: expected KG,X,Y,Z[,IXX,IYY,IZZ[,IXY,IXZ,IYZ]] (4, 7 or 10 "
+                         f"values), got {v.size}")
+    inertia = np.zeros((3, 3))
+    if v.size >= 7:
+        inertia[np.diag_indices(3)] = v[4:7]
+    if v.size == 10:
+        for (i, j), value in zip(((0, 1), (0, 2), (1, 2)), v[7:10], strict=True):
+            inertia[i, j] = inertia[j, i] = value
+    return rd.Payload(mass=float(v[0]), com=v[1:4], inertia=inertia, frame=args.payload_frame)
+
+
 def _read(paths: Sequence[str], spec: str | None, robot: rd.Robot, what: str) -> list:
     recs = []
     for path in tqdm(paths, desc=f"reading {what}", unit="file", leave=False, disable=len(paths) < 2):
@@ -93,12 +113,17 @@ def _cmd_identify(args: argparse.Namespace) -> int:
         robot = _with_gains(robot, gains)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
+    payload = _payload(args)
     recs = _read(args.data, args.spec, robot, "identification data")
+    loaded = _read(args.payload_data or [], args.spec, robot, "payload data")
     held = _read(args.validate or [], args.spec, robot, "validation data")
-    with progress(f"identifying {robot.name} ({args.method}, {len(recs)} recording(s))"):
-        ident = rd.identify(robot, recs, target=args.target, method=args.method,
-                            friction=args.friction,
-                            **({"gains": "description"} if gains is not None else {}))
+    extra = {"gains": "description"} if gains is not None else {}
+    if loaded:
+        extra["payloads"] = [None] * len(recs) + [payload] * len(loaded)
+    with progress(f"identifying {robot.name} ({args.method}, {len(recs) + len(loaded)} "
+                  "recording(s))"):
+        ident = rd.identify(robot, recs + loaded, target=args.target, method=args.method,
+                            friction=args.friction, **extra)
     stem = f"{robot.name}_identified"
     paths = {"yaml": out / f"{stem}.yaml", "urdf": out / f"{stem}.urdf",
              "parameters": out / "parameters.csv"}
@@ -114,6 +139,10 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     for kind, rec in tqdm(jobs, desc="validating", unit="recording", leave=False):
         vals.append((f"{kind}: {rec.source}", rd.validate(ident.robot, rec, ident=ident,
                                                           window=args.window)))
+    if ident.target == "current" and loaded:
+        gain_text = ", ".join(f"{k:.4g} +- {s:.2g}" for k, s in zip(ident.gains, ident.gains_std,
+                                                                      strict=True))
+        print(f"drive gains from the payload run(s), N m/A: {gain_text}")
     paths["metrics"] = _write_metrics([v for _, v in vals], out / "validation.csv")
     with progress("writing the report and its figures"):
         paths["report"] = identification_html(ident, vals, out, [r.source for r in recs])
@@ -257,6 +286,15 @@ def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
     p.add_argument("--gains", type=floats, metavar="K",
                    help="drive gains, joint torque per motor ampere (N m/A), one or one per joint, "
                         "for --target current: fixed instead of absorbed per joint")
+    p.add_argument("--payload-data", nargs="+", metavar="FILE",
+                   help="recordings made with a known payload on the last link (with --payload): "
+                        "for --target current they separate the drive gains from the inertia")
+    p.add_argument("--payload", type=floats, metavar="KG,X,Y,Z[,IXX,IYY,IZZ[,IXY,IXZ,IYZ]]",
+                   help="the payload of --payload-data: mass (kg), centre of mass (m) and "
+                        "optionally its inertia about the centre of mass (kg m^2)")
+    p.add_argument("--payload-frame", choices=("tool", "link"), default="tool",
+                   help="frame of --payload's centre of mass and inertia: the tool frame or the "
+                        "last link's frame (default: %(default)s)")
     p.add_argument("--friction", default="linear", choices=FRICTION_MODELS,
                    help="friction model: linear (viscous, Coulomb +/-, offset, in the linear fit), "
                         "none, or a nonlinear law fitted after the linear step (default: "

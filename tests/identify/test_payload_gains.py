@@ -168,3 +168,40 @@ def test_payload_list_errors(lab):
         rd.identify(robot, [rec], target="current", cutoff=None, model=model, payloads=[None, None])
     with pytest.raises(IdentificationError, match=r"payloads\[0\]: expected a Payload or None, got dict"):
         rd.identify(robot, [rec], target="current", cutoff=None, model=model, payloads=[{"mass": 1}])
+
+
+def test_cli_payload_run_gives_the_gains(lab, tmp_path, capsys):
+    """``robodyn identify --payload-data ... --payload ...``: the same separation from files, with
+    the CLI's default preprocessing (filtered positions, differentiated), so to 1 % not 1e-6."""
+    from robodyn.cli import main
+    from robodyn.measure.csv_io import write_csv
+
+    robot, _, runs, _ = lab
+    gain = runs[0].truth.drive_gain
+    files = []
+    for k, r in enumerate(runs):
+        rec = _recording(r, r.recording.current, f"run{k}")
+        rec = rd.Recording(t=rec.t, q=rec.q, qd=rec.qd, current=rec.current,
+                           joint_names=robot.joint_names)
+        files.append(write_csv(rec, tmp_path / f"run{k}.csv"))
+    flat = [PAYLOAD.mass, *PAYLOAD.com, *np.diag(PAYLOAD.inertia)]
+    rc = main(["identify", "planar_2r", "--target", "current", "--data", str(files[0]),
+               "--payload-data", str(files[1]), "--payload", ",".join(repr(float(v)) for v in flat),
+               "--payload-frame", "link", "--method", "consistent", "-o", str(tmp_path / "out")])
+    assert rc == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("drive gains"))
+    found = np.array([float(part.split("+-")[0]) for part in line.split(":", 1)[1].split(",")])
+    np.testing.assert_allclose(found, gain, rtol=1e-2)
+
+
+def test_cli_payload_options_go_together(lab, tmp_path, capsys):
+    from robodyn.cli import main
+
+    rc = main(["identify", "planar_2r", "--data", "x.csv", "--payload", "1,0,0,0",
+               "-o", str(tmp_path)])
+    assert rc == 2
+    assert "--payload and --payload-data go together" in capsys.readouterr().err
+    rc = main(["identify", "planar_2r", "--data", "x.csv", "--payload-data", "y.csv",
+               "--payload", "1,0,0", "-o", str(tmp_path)])
+    assert rc == 2
+    assert "--payload: expected KG,X,Y,Z" in capsys.readouterr().err
