@@ -97,7 +97,7 @@ def link_frame_jacobian(robot: Robot, q: Sequence[sp.Expr], link: int,
             jac[3:, k] = z
         # ^iT_(k-1) = ^iT_k post_k^-1 motion_k(q_k)^-1 pre_k^-1
         t = jf * S.inverse(motion(joint, q[k])) * S.inverse(joint.pre)
-    return sp.ImmutableMatrix(jac.applyfunc(sp.expand))
+    return sp.ImmutableMatrix(jac)
 
 
 def cylinder_motion(robot: Robot, kin: Kinematics, link: int, cyl: Cylinder,
@@ -106,7 +106,7 @@ def cylinder_motion(robot: Robot, kin: Kinematics, link: int, cyl: Cylinder,
     link's orientation in the world (for the current)."""
     jac = link_frame_jacobian(robot, q, link, cyl.start)
     # J_b = -[a]x J_omega  (omega x a per joint velocity)
-    j_bend = (-S.skew(cyl.axis) * jac[3:, :]).applyfunc(sp.expand)
+    j_bend = -S.skew(cyl.axis) * jac[3:, :]
     return CylinderMotion(axis=sp.ImmutableMatrix(cyl.axis), start=sp.ImmutableMatrix(cyl.start),
                           j_start=sp.ImmutableMatrix(jac[:3, :]), j_bend=sp.ImmutableMatrix(j_bend),
                           rotation=sp.ImmutableMatrix(S.rotation(kin.links[link])))
