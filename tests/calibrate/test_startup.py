@@ -58,3 +58,9 @@ def test_parser_literals_match_their_sources():
     assert cli_workflows.MODELS == tuple(MODELS)
     assert cli_identify.FRICTION_MODELS == tuple(FRICTION_MODELS)
     assert cli_cache.DEFAULT_CACHE_MAX_MB == DEFAULT_CACHE_MAX_MB
+
+
+def test_calibration_code_imports_the_solver_and_plots_only_when_used():
+    loaded = _imported_after("import robodyn.calibrate, robodyn.calibrate.io, robodyn.calibrate.pipeline")
+    assert "scipy.optimize" not in loaded and "matplotlib" not in loaded
+    assert "robodyn.calibrate" in loaded  # the probe sees what was imported

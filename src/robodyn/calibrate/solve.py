@@ -18,7 +18,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from robodyn.calibrate.models import ErrorModel
 
@@ -208,6 +207,8 @@ def fit(
     -------
     Fit
     """
+    from scipy.optimize import least_squares  # 0.3-0.8 s to import: only when solving
+
     if loss not in LOSSES:
         raise ValueError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
     weights = np.broadcast_to(1.0 / np.asarray(sigma, dtype=float).reshape(
