@@ -65,6 +65,24 @@ def test_single_cylinder_equals_the_closed_form_to_1e12() -> None:
     assert drag(0.4, 2.0, *p) == pytest.approx(2 * lumped, rel=1e-13)
 
 
+def test_single_cylinder_equals_the_closed_form_symbolically() -> None:
+    robot = load_yaml_text(PENDULUM, source="pendulum.yaml")
+    eom = rd.derive(robot)
+    (q,), (qd,), (qdd,) = eom.q, eom.qd, eom.qdd
+    s = robot.symbols
+    m, L, D, rho, ca, cd, g = (s[k] for k in ("m", "L", "D", "rho", "Ca", "Cd", "g"))
+    closed = ((m * L**2 / 3 + ca * rho * sp.pi * D**2 * L**3 / 12) * qdd
+              + rho * cd * D * L**4 / 8 * qd * sp.Abs(qd)
+              + (m - rho * sp.pi * D**2 * L / 4) * g * L / 2 * sp.sin(q))
+    # L > 0 (a length); the quadrature's nodes and weights are 17-digit floats: the difference
+    # must be nothing but their rounding
+    diff = sp.expand(eom.tau[0] - closed).subs(sp.Abs(L), L)
+    diff = sp.expand(diff)
+    floats = [abs(float(f)) for f in diff.atoms(sp.Float)]
+    assert all(f < 1e-15 for f in floats), diff
+    assert sp.nsimplify(diff, tolerance=1e-15, rational=True) == 0
+
+
 def two_link_closed_form(q1: float, q2: float, p: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
     """M and g of underwater_2r written out by hand (rigid rods + strip added mass + buoyancy)."""
     m1, m2, l1, l2, r1, r2, g, rho, ca = (p[k] for k in ("m1", "m2", "l1", "l2", "r1", "r2", "g",
