@@ -108,3 +108,48 @@ def test_cli_derive_prints_the_textbook_form(tmp_path) -> None:
 def test_dry_robot_textbook_is_unchanged() -> None:
     text = render_text(rd.derive(rd.load("planar_2r")))
     assert "M_A" not in text and "\ntau1 = " in text
+
+
+FOUR_JOINTS = """\
+name: wet_4r
+gravity: [0, -9.81, 0]
+fluid: {density: 1000, current: [0.2, 0.1, 0]}
+joints:
+""" + "".join(f"""\
+  - name: j{k}
+    type: revolute
+    dh: {{a: 0.4, alpha: 0, d: 0, theta: 0}}
+    link:
+      mass: 2
+      com: [-0.2, 0, 0]
+      inertia: {{ixx: 0.01, iyy: 0.03, izz: 0.03}}
+""" for k in range(1, 5)) + """\
+      hydro:
+        cylinders: [{radius: 0.04, length: 0.4, axis: [1, 0, 0], start: [-0.4, 0, 0]}]
+        quadrature: 3
+"""
+
+
+def test_large_arm_listing_includes_the_hydrodynamic_torques() -> None:
+    from robodyn.robot.yaml_loader import load_yaml_text
+    from robodyn.symbolic.render import _layout
+
+    eom = rd.derive(load_yaml_text(FOUR_JOINTS, source="wet_4r.yaml"))
+    layout = _layout(eom)  # the recursive listing: assignments in order, then tau1..tau4
+    title, rows = layout.sections[0]
+    rng = np.random.default_rng(3)
+    x = rng.uniform(-2, 2, (3, 4))
+    values: dict[sp.Symbol, float] = dict(zip([*eom.q, *eom.qd, *eom.qdd], x.ravel(), strict=True))
+    tau = np.zeros(4)
+    for row in rows:
+        value = float(sp.Add(*(c * d for c, d in row.terms)).xreplace(values))
+        if row.index:
+            tau[row.index[0]] = value
+        else:
+            values[sp.Symbol(row.lhs, real=True)] = value
+    ref = np.array([float(e.xreplace(values)) for e in eom.tau])
+    np.testing.assert_allclose(tau, ref, rtol=1e-12)
+    # and the fluid is in it: without the hydro rows tau would differ
+    hydro = np.array([float(e.xreplace(values)) for e in eom.hydro.tau])
+    assert np.abs(hydro).max() > 0.1
+    assert "\ntau4 = " in render_text(eom)

@@ -212,8 +212,17 @@ def _layout(eom: EquationsOfMotion) -> _Layout:
                 f"({eom.method} gives no recursive form); M and g are {eom.method}'s")
     assert ne.program is not None
     program = list(ne.program.assignments)
-    tau_rows = [_Row("tau", (k,), _split(ne.program.outputs[k] + ne.rotor[k] + ne.friction[k]))
-                for k in range(n)]
+    # under water: the hydrodynamic torques (added mass, buoyancy, drag, lift) after their own
+    # common-subexpression elimination (h0, h1, ...), evaluated before tau
+    hydro: list[tuple[sp.Symbol, sp.Expr]] = []
+    extra = [sp.Integer(0)] * n
+    if eom.hydro is not None:
+        hydro, extra = sp.cse(list(eom.hydro.tau), order="none",
+                              symbols=_fresh_names("h", _used_names(eom, program)))
+        hydro = list(hydro)
+    tau_rows = [_Row("tau", (k,), _split(ne.program.outputs[k] + ne.rotor[k] + ne.friction[k]
+                                         + extra[k])) for k in range(n)]
+    program += hydro
     pairs = [(i, j) for i in range(n) for j in range(i, n)]
     subs, reduced = _cse([eom.M[i, j] for i, j in pairs] + list(eom.g),
                          _used_names(eom, program))
