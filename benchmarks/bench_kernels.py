@@ -14,7 +14,10 @@ Prints (PUMA 560, 100,000 random states, ns per state, best of several runs):
      of one run are comparable, absolute times are not.
   3. Ensemble RK4: 1000 trolley double-pendulum trajectories of 5 s at 1 ms: one
      ``model.integrate`` call with x0 (1000, 6) against 1000 one-at-a-time calls and against
-     MuJoCo's ``rollout`` with 1000 initial states (its own RK4 at 1 ms, one thread).
+     MuJoCo's ``rollout`` with 1000 initial states (its own RK4 at 1 ms, one thread); and the
+     same ensemble with one parameter set per trajectory (``compile_model(robot,
+     runtime_parameters=True)``, ``integrate(..., parameters=(1000, 6))``) against the ensemble
+     with the parameters compiled in (the cost of keeping them runtime inputs).
 
 Run: ``.venv/bin/python benchmarks/bench_kernels.py [--quick]``.
 """
@@ -188,6 +191,7 @@ def bench_kernels(quick: bool) -> None:
 
 
 def bench_ensemble(quick: bool) -> None:
+    """Ensemble RK4 against one-at-a-time runs and MuJoCo's rollout; with parameter sets too."""
     import mujoco
     from mujoco import rollout
 
@@ -206,6 +210,11 @@ def bench_ensemble(quick: bool) -> None:
             model.integrate(x, steps, dt)
 
     t_one = best_of(one_at_a_time, 2)
+    # every trajectory with its own parameter set (masses, lengths, g): runtime parameters
+    runtime = rd.compile_model(robot, runtime_parameters=True)
+    base = np.array([robot.parameters[k] for k in runtime.runtime_parameters])
+    sets = base * rng.uniform(0.8, 1.2, (count, base.size))
+    t_par = best_of(lambda: runtime.integrate(x0, steps, dt, parameters=sets), 3)
     xml, source = trolley_mjcf(robot)
     mj = mujoco.MjModel.from_xml_string(xml)
     data = mujoco.MjData(mj)
@@ -223,6 +232,8 @@ def bench_ensemble(quick: bool) -> None:
           f"(efficiency {t_ens / (2 * t_ens2):.2f})")
     print(f"robodyn one integrate call each        {t_one * per:8.3f} ms per trajectory "
           f"({t_one / t_ens:.1f}x the ensemble)")
+    print(f"robodyn ensemble, {count} parameter sets  {t_par * per:8.3f} ms per trajectory "
+          f"({t_par / t_ens:.2f}x the ensemble with compiled-in parameters; runtime_parameters)")
     print(f"MuJoCo {mujoco.__version__} rollout, {count} initial states {t_mj * per:8.3f} ms per trajectory "
           f"({t_mj / t_ens:.1f}x the ensemble; model: {source})")
     print()

@@ -160,6 +160,11 @@ def test_bad_parameter_input_is_named(robot, runtime):
     negative[1, 1] = -1.0
     with pytest.raises(DescriptionError, match="row 1"):
         runtime.integrate(np.zeros((2, 2 * runtime.dof)), 5, 1e-3, parameters=negative)
+    # one bad set among many (the vectorised screen finds it, the description's check names it)
+    many = np.tile(SETS[1], (100, 1))
+    many[57, 2] = -0.1
+    with pytest.raises(DescriptionError, match=r"row 57.*mass of link .* is negative"):
+        runtime.integrate(np.zeros((100, 2 * runtime.dof)), 5, 1e-3, parameters=many)
     folded_model = rd.compile_model(robot)
     with pytest.raises(ValueError, match="compiled with runtime parameters"):
         folded_model.gravity(q, parameters={"M": 1.0})

@@ -11,7 +11,9 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 import numpy as np
+import sympy as sp
 
+from robodyn.robot.expressions import parameter_symbol
 from robodyn.robot.model import Robot
 from robodyn.robot.overrides import checked_parameter_values
 
@@ -121,7 +123,14 @@ def parameter_array(names: tuple[str, ...], defaults: Mapping[str, float], value
 
 def check_physics(robot: Robot, names: tuple[str, ...], defaults: Mapping[str, float],
                   rows: np.ndarray, where: str) -> None:
-    """Every distinct parameter set of ``rows`` (P,) or (N, P) checked like compile-time values.
+    """Every parameter set of ``rows`` (P,) or (N, P) checked like compile-time values.
+
+    The description's rules that depend on parameters (:func:`checked_parameter_values`: link
+    mass not negative, centre of mass and inertia finite, rotor inertia, friction, velocity and
+    effort limits not negative, gear ratio not zero, lower limit not above upper, placement
+    finite) are screened for all sets at once with NumPy; a set that breaks one, and the first
+    set, go through :func:`checked_parameter_values` itself, which raises the project's error
+    naming the row (the implausible-inertia warning is given for the first set only).
 
     Raises
     ------
@@ -130,10 +139,64 @@ def check_physics(robot: Robot, names: tuple[str, ...], defaults: Mapping[str, f
         names the row.
     """
     table = np.atleast_2d(rows)
-    unique, first = np.unique(table, axis=0, return_index=True)
-    for row, i in zip(unique, first, strict=True):
-        values = {**defaults, **dict(zip(names, (float(v) for v in row), strict=True))}
-        checked_parameter_values(robot, values, where=f"{where} row {int(i)}")
+    suspects = [0] + [int(i) for i in np.flatnonzero(_screen(robot, names, defaults, table))]
+    for i in dict.fromkeys(suspects):
+        values = {**defaults, **dict(zip(names, (float(v) for v in table[i]), strict=True))}
+        checked_parameter_values(robot, values, where=f"{where} row {i}")
+
+
+_SCREENS: dict[tuple, list[tuple[str, object]]] = {}
+
+
+def _screen(robot: Robot, names: tuple[str, ...], defaults: Mapping[str, float],
+            table: np.ndarray) -> np.ndarray:
+    """(N,) bool: the sets that break a rule of :func:`check_physics` (vectorised screen)."""
+    symbols = [parameter_symbol(k) for k in robot.parameters]
+    key = (robot.description_hash, tuple(robot.parameters))
+    if key not in _SCREENS:
+        rules: list[tuple[str, object]] = []
+
+        def add(kind: str, *exprs: object) -> None:
+            if all(e is not None for e in exprs):
+                parts = [sp.sympify(e) for e in exprs]
+                if any(e.free_symbols for e in parts):
+                    rules.append((kind, sp.lambdify(symbols, parts, modules="numpy")))
+
+        for link in robot.links:
+            add("nonnegative", link.mass)
+            for e in (*link.com, *link.inertia):
+                add("finite", e)
+        for joint in robot.joints:
+            for e in (*joint.pre, *joint.axis, *joint.post):
+                add("finite", e)
+            for e in (joint.drive.rotor_inertia, joint.friction.viscous,
+                      joint.friction.coulomb_positive, joint.friction.coulomb_negative,
+                      joint.velocity_limit, joint.effort_limit):
+                add("nonnegative", e)
+            add("finite", joint.drive.torque_constant)
+            add("finite", joint.friction.offset)
+            add("nonzero", joint.drive.gear_ratio)
+            add("ordered", joint.lower, joint.upper)
+        _SCREENS[key] = rules
+    count = table.shape[0]
+    columns = {k: np.full(count, float(defaults[k])) for k in robot.parameters}
+    for j, k in enumerate(names):
+        columns[k] = table[:, j]
+    args = [columns[k] for k in robot.parameters]
+    bad = np.zeros(count, dtype=bool)
+    with np.errstate(all="ignore"):
+        for kind, fn in _SCREENS[key]:
+            vals = [np.broadcast_to(np.asarray(v, dtype=float), (count,))
+                    for v in fn(*args)]  # type: ignore[operator]
+            ok = np.all([np.isfinite(v) for v in vals], axis=0)
+            if kind == "nonnegative":
+                ok &= vals[0] >= 0
+            elif kind == "nonzero":
+                ok &= vals[0] != 0
+            elif kind == "ordered":
+                ok &= vals[0] <= vals[1]
+            bad |= ~ok
+    return bad
 
 
 def _row(names: tuple[str, ...], base: np.ndarray, value: Mapping[str, object],
