@@ -117,3 +117,30 @@ def test_cli_payload_options(loaded, tmp_path, capsys):
     capsys.readouterr()
     assert main([*base, "--payload", "4.5,0.1", "-o", str(tmp_path / "c")]) == 2
     assert "--payload: expected 4 numbers" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", ["puma560", "planar_2r"])
+def test_numeric_gravity_equals_the_compiled_models(name):
+    from robodyn.calibrate import random_configurations
+    from robodyn.calibrate.nongeometric import gravity_torque
+
+    r = robot(name)
+    q = random_configurations(r, 40, 3)
+    expected = rd.compile_model(r).gravity(q)
+    np.testing.assert_allclose(gravity_torque(r)(q), expected, rtol=0, atol=1e-12 * np.abs(expected).max())
+
+
+def test_compliance_compiles_nothing():
+    import json
+    import subprocess
+    import sys
+
+    code = ("import warnings, numpy as np, robodyn as rd\nwarnings.simplefilter('ignore')\n"
+            "from robodyn.calibrate import calibrate, random_configurations\n"
+            "r = rd.load('puma560'); q = random_configurations(r, 40, 1)\n"
+            "from robodyn.calibrate.simulate_study import robot_positions\n"
+            "calibrate(r, q, robot_positions(r, q), 'hayati', nongeometric=('compliance',))\n"
+            "import sys, json; print(json.dumps(sorted(m for m in ('cffi', 'robodyn.numeric.model',"
+            " 'robodyn.codegen.build') if m in sys.modules)))")
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True)
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == []

@@ -9,7 +9,8 @@ geometric error model (:mod:`robodyn.calibrate.models`) can carry them.
 
 Compliance (elastostatic joints): joint ``j`` twists under the load its drive holds,
 ``dq_j = -c_j tau_j(q)``, with ``tau_j(q)`` the static torque that holds the arm still
-(``rd.compile_model(robot).gravity(q)``, plus a payload when given) and ``c_j >= 0`` the joint's
+(the robot's gravity model, ``rd.compile_model(robot).gravity(q)``, evaluated numerically by
+:func:`gravity_torque` without compiling anything; plus a payload when given) and ``c_j >= 0`` the joint's
 compliance in rad/(N m) (m/N for a prismatic joint). When the description has no masses, ``tau``
 is a gravity-shaped basis instead: the holding torque of a 1 kg point mass at the origin of every
 joint frame after joint ``j`` and at the tool (then ``c_j`` absorbs the unknown mass scale and its
@@ -40,7 +41,7 @@ import numpy as np
 
 from robodyn.robot.model import Robot
 
-__all__ = ["NONGEOMETRIC", "NonGeometric", "build_nongeometric", "nominal_frames"]
+__all__ = ["NONGEOMETRIC", "NonGeometric", "build_nongeometric", "gravity_torque", "nominal_frames"]
 
 #: The non-geometric terms, by name.
 NONGEOMETRIC = ("compliance", "harmonics")
@@ -195,6 +196,60 @@ def _point_mass_torque(frames: Callable[[np.ndarray], tuple[np.ndarray, np.ndarr
     return torque
 
 
+def gravity_torque(robot: Robot) -> Callable[[np.ndarray], np.ndarray]:
+    """``g(q)`` (N, n), N m (N): the holding torques of the robot's own links, evaluated numerically.
+
+    The links' masses and centres of mass ride on the nominal geometry at ``q = 0``
+    (:func:`robodyn.calibrate.nominal.robot_geometry`) moved by the joints' screw motions
+    (product of exponentials); ``g_j = -sum_{i >= j} m_i gravity . dc_i/dq_j`` with
+    ``dc/dq_j = u_j x (c - p_j)`` (revolute) or ``u_j`` (prismatic) about the moved axis
+    ``(p_j, u_j)``. The same as ``rd.compile_model(robot).gravity(q)`` without deriving or
+    compiling the whole model (tests/calibrate/test_payload.py compares them).
+    """
+    from robodyn.calibrate.nominal import numeric, robot_geometry
+
+    geometry = robot_geometry(robot)
+    subs = robot.defaults()
+    gravity = np.array(robot.gravity.xreplace(subs), dtype=float).ravel()
+    masses = np.array([float(link.mass.xreplace(subs)) for link in robot.links])
+    coms = np.array([numeric(link.com, subs).ravel() for link in robot.links])
+    com0 = np.einsum("nij,nj->ni", geometry.link_frames[:, :3, :3], coms) + geometry.link_frames[:, :3, 3]
+    pts, dirs, types = geometry.points, geometry.directions, geometry.joint_types
+    n = len(types)
+
+    def torque(q: np.ndarray) -> np.ndarray:
+        q = np.asarray(q, dtype=float)
+        big_n = len(q)
+        rot = np.broadcast_to(np.eye(3), (big_n, 3, 3)).copy()  # G = prod exp(S_k q_k), k < j
+        trans = np.zeros((big_n, 3))
+        axis_p, axis_u, c = (np.zeros((big_n, n, 3)) for _ in range(3))
+        for j in range(n):
+            axis_p[:, j] = rot @ pts[j] + trans
+            axis_u[:, j] = rot @ dirs[j]
+            if types[j] == "revolute":
+                k = np.array([[0, -dirs[j][2], dirs[j][1]], [dirs[j][2], 0, -dirs[j][0]],
+                              [-dirs[j][1], dirs[j][0], 0]])
+                s, co = np.sin(q[:, j])[:, None, None], np.cos(q[:, j])[:, None, None]
+                r = np.eye(3) + s * k + (1 - co) * (k @ k)  # Rodrigues
+                t = pts[j] - r @ pts[j]  # rotation about the line through p_j
+            else:
+                r = np.broadcast_to(np.eye(3), (big_n, 3, 3))
+                t = q[:, j, None] * dirs[j]
+            trans = np.einsum("nij,nj->ni", rot, t) + trans
+            rot = rot @ r
+            c[:, j] = rot @ com0[j] + trans  # link j moves with joints 1..j
+        out = np.zeros((big_n, n))
+        for j in range(n):
+            if types[j] == "revolute":
+                dc = np.cross(axis_u[:, j, None], c[:, j:] - axis_p[:, j, None])
+            else:
+                dc = np.broadcast_to(axis_u[:, j, None], c[:, j:].shape)
+            out[:, j] = -(dc @ gravity) @ masses[j:]
+        return out
+
+    return torque
+
+
 def _payload_unit_torque(frames: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
                          types: Sequence[str], gravity: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
     """``T(q)`` (N, n, 4): holding torques per unit payload mass and per unit first moment.
@@ -295,13 +350,11 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
         known = None if identify_payload else load
         types = [j.type for j in robot.joints]
         if any(m > 0 for m in masses):
-            from robodyn.numeric.model import compile_model
-
-            model = compile_model(robot)
+            own = gravity_torque(robot)  # numerically: no model to derive or compile
             extra = _point_mass_torque(frames, types, gravity, [], known) if known else None
 
-            def torque(q: np.ndarray, model=model, extra=extra) -> np.ndarray:
-                tau = np.asarray(model.gravity(q), dtype=float).reshape(len(q), -1)
+            def torque(q: np.ndarray, own=own, extra=extra) -> np.ndarray:
+                tau = own(q)
                 return tau + extra(q) if extra is not None else tau
 
             source = "gravity model" + (" + payload" if known else "")
