@@ -90,9 +90,13 @@ def test_identified_payload_is_recovered(loaded):
 def test_identify_payload_needs_compliance():
     r = robot("puma560")
     q = poses("puma560", 30, 1)
+    y = measured(r, q, TARGETS[:1])[:, 0]
     with pytest.raises(ValueError, match="identify_payload needs the 'compliance' term"):
-        calibrate(r, q, measured(r, q, TARGETS[:1])[:, 0], "s-model", nongeometric=("harmonics",),
-                  identify_payload=True)
+        calibrate(r, q, y, "s-model", nongeometric=("harmonics",), identify_payload=True)
+    with pytest.raises(ValueError, match="identify_payload needs the 'compliance' term"):
+        calibrate(r, q, y, "s-model", identify_payload=True)
+    with pytest.raises(ValueError, match="payload needs the 'compliance' term"):
+        calibrate(r, q, y, "s-model", payload=(2.0, (0.0, 0.0, 0.1)))
 
 
 @pytest.mark.filterwarnings("ignore:calibration of puma560. the variance factor")

@@ -414,6 +414,10 @@ def calibrate(
         raise ValueError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
     if initial not in ("nominal", "circle-point"):
         raise ValueError(f"initial must be 'nominal' or 'circle-point', got {initial!r}")
+    if (identify_payload or payload is not None) and "compliance" not in tuple(nongeometric):
+        raise ValueError(f"{'identify_payload' if identify_payload else 'payload'} needs the "
+                         "'compliance' term (nongeometric=('compliance', ...)): the payload is seen "
+                         "only through the joints' deflection under its weight")
     if initial == "circle-point" and circle_data is None:
         raise ValueError("initial='circle-point' needs circle_data: one (q, points) set per joint")
     q, points, sigma, sigma_rot = convert_units(robot, q, points, sigma, sigma_rot, length_unit,
