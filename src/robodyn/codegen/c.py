@@ -47,10 +47,13 @@ BLOCK = 16
 #: Cores with more assignments than this are not inlined into their batch loop (compile time).
 INLINE_LIMIT = 400
 
-#: Outputs of at least this many entries per state (the regressor, the derivatives) are stored by
-#: the core straight into the caller's rows (strided, vector scatter stores where the target has
-#: them) instead of through a structure-of-arrays buffer and a transposition.
-DIRECT_MIN = 64
+#: Outputs of at least this many entries per state (the regressor, the derivatives) can be stored
+#: by the core straight into the caller's rows (strided, vector scatter stores) instead of through
+#: a structure-of-arrays buffer and a transposition. Off (None): measured 1.46x faster stacking of
+#: the Gen3 regressor into a reused matrix, but GCC then evaluates one state alone and the same
+#: state in a block differently in the last bit (1 ulp in 2 of 540 PUMA regressor entries), and
+#: the batch kernels keep one state's bits whatever the batch (tests/numeric/test_model.py).
+DIRECT_MIN: int | None = None
 
 #: Beyond this |angle| (rad), and for infinities and NaN, the block's sine and cosine come from libm.
 _POLY_LIMIT = "1.0e5"
@@ -184,7 +187,7 @@ class CPrinter(Printer):
         ]) + "\n"
         direct = {o.name: (o.size, computed[o.name] if 0 < len(computed[o.name]) < o.size
                            else list(range(o.size)))
-                  for o in kernel.outputs if o.size >= DIRECT_MIN}
+                  for o in kernel.outputs if DIRECT_MIN is not None and o.size >= DIRECT_MIN}
         return "\n".join([self.block_function(core, len(kernel.body) > INLINE_LIMIT, direct),
                           self.blocked_batch(kernel, core, angles, steps, computed, direct),
                           self.threaded_batch(kernel), single])

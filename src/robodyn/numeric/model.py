@@ -22,7 +22,6 @@ from types import ModuleType
 from typing import Literal
 
 import numpy as np
-import sympy as sp
 
 from robodyn.codegen.build import (
     CFLAGS,
@@ -41,6 +40,7 @@ from robodyn.codegen.kernels import (
     kernel_signature,
 )
 from robodyn.codegen.python import PythonPrinter
+from robodyn.numeric.checks import check_structure, out_buffer
 from robodyn.numeric.integrate_numpy import integrate_numpy as _integrate_numpy
 from robodyn.numeric.runtime_parameters import check_physics, parameter_array, runtime_names
 from robodyn.robot.errors import SimulationError, SingularMassMatrixError
@@ -558,7 +558,7 @@ class Model:
         if self.runtime_parameters or parameters is not None:
             args.append(self.parameter_input(parameters, batch_shape, name))
         out_shape = batch_shape + result_shape
-        target = None if out is None else _out_buffer(out, out_shape, args, name)
+        target = None if out is None else out_buffer(out, out_shape, args, name)
         if isinstance(self._impl, ModuleType):
             # a singular M divides by zero: the callers check the result, not NumPy's warnings
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -632,7 +632,7 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
         src, decl = directory / f"rd_model_{key}.c", directory / f"rd_model_{key}.cdef"
         if not (src.exists() and decl.exists()):
             kset = _kernels_cached(robot, values, runtime)
-            _check_structure(robot, kset, values)
+            check_structure(robot, kset, values)
             printer = CPrinter(_PREFIX)
             _write_atomic(decl, printer.declarations(kset))
             _write_atomic(src, printer.source(kset))
@@ -644,7 +644,7 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
         path = directory / f"rd_model_{key}.py"
         if not path.exists():
             kset = _kernels_cached(robot, values, runtime)
-            _check_structure(robot, kset, values)
+            check_structure(robot, kset, values)
             _write_atomic(path, PythonPrinter().module(kset))
         else:
             _touch(path)
@@ -684,23 +684,6 @@ def _compile_derivatives(model: Model, names: tuple[str, ...] = DERIVATIVE_KERNE
     return Model(robot, backend, model.parameter_values, impl, runtime)
 
 
-def _out_buffer(out: np.ndarray, shape: tuple[int, ...], inputs: Sequence[np.ndarray],
-                name: str) -> np.ndarray:
-    """``out`` as a view of ``shape``, checked: float64, C-contiguous, writeable, right size."""
-    if not isinstance(out, np.ndarray) or out.dtype != np.float64 or not out.flags.c_contiguous \
-            or not out.flags.writeable:
-        raise ValueError(f"{name}(out=...): expected a writeable C-contiguous float64 NumPy array, "
-                         f"got {type(out).__name__}"
-                         + (f" of dtype {out.dtype}" if isinstance(out, np.ndarray) else ""))
-    size = int(np.prod(shape))
-    if out.size != size:
-        raise ValueError(f"{name}(out=...): the result has shape {shape} ({size} values), out has "
-                         f"shape {out.shape} ({out.size} values)")
-    if any(np.shares_memory(out, a) for a in inputs):
-        raise ValueError(f"{name}(out=...): out overlaps an input array")
-    return out.reshape(shape)
-
-
 def _thread_count(threads: int) -> int:
     """``threads`` checked: a positive integer."""
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
@@ -733,31 +716,6 @@ def _touch(*paths: Path) -> None:
     for p in paths:
         with contextlib.suppress(OSError):
             os.utime(p)
-
-
-def _check_structure(robot: Robot, kset: KernelSet, values: Mapping[str, float]) -> None:
-    """Refuse a mass matrix that is singular everywhere: the Cholesky pivot folds to ``1/0``."""
-    fd = kset["forward_dynamics"]
-    exprs = [e for _, e in fd.body] + list(fd.outputs[0].entries)
-    if not any(sp.sympify(e).has(sp.zoo, sp.nan, sp.oo) for e in exprs):
-        return
-    mass = kset["mass_matrix"]
-    env: dict[sp.Symbol, sp.Expr] = dict.fromkeys(mass.inputs[0].entries, sp.Float(0.3))
-    if kset.runtime_parameters:
-        # runtime parameters at their default values
-        env.update({s: sp.Float(values[k]) for s, k in zip(mass.inputs[-1].entries,
-                                                            kset.runtime_parameters, strict=True)})
-    for sym, expr in mass.body:
-        env[sym] = expr.xreplace(env).evalf()
-    m = np.array([float(sp.sympify(e).xreplace(env).evalf()) for e in mass.outputs[0].entries])
-    diag = np.diag(m.reshape(robot.dof, robot.dof))
-    j = int(np.argmin(np.abs(diag)))
-    joint, link = robot.joints[j].name, robot.links[j].name
-    raise SingularMassMatrixError(
-        f"{robot.source}: the mass matrix of {robot.name} is singular in every configuration "
-        f"(M[{j}, {j}] = {diag[j]:.3g} for joint {joint!r}): joint {joint!r} moves no mass, "
-        f"inertia or rotor inertia, so the forward dynamics has no solution; give link {link!r} "
-        "(or the links beyond it) a mass and an inertia, or the joint a rotor inertia")
 
 
 @functools.cache
