@@ -139,3 +139,30 @@ def test_cli_warns_when_sigma_is_off_by_more_than_3x(data, tmp_path, capsys):
     err = capsys.readouterr().err
     assert "robodyn: warning: calibration of puma560: the variance factor" in err
     assert "wrong by a factor of about 0.1" in err
+
+
+def test_circle_file_whose_readings_do_not_follow_the_arc_says_what_to_do(tmp_path, capsys):
+    from robodyn.calibrate.simulate_study import HOME, robot_positions
+
+    r = robot("puma560")
+    true = perturbed_robot(r, 6, base=TRACKER, target=(0.031, -0.018, 0.076))
+    q = poses("puma560", 40, 44)
+    _write(tmp_path / "poses.csv", [*r.joint_names, "x", "y", "z"],
+           np.hstack((np.degrees(q), robot_positions(true, q))))
+    names = []
+    for j, (sweep, count) in enumerate(zip(np.radians([60, 60, 60, 60, 60, 340]), (12,) * 5 + (4,),
+                                           strict=True)):
+        qs = np.tile(HOME, (count, 1))
+        qs[:, j] = HOME[j] + np.linspace(-sweep, sweep, count)
+        readings = np.degrees(qs)
+        if j == 5:
+            readings[:, 5] *= 1.3  # the controller reports 1.3x the joint angle (a wrong ratio)
+        path = tmp_path / f"circle{j + 1}.csv"
+        _write(path, [*r.joint_names, "x", "y", "z"], np.hstack((readings, robot_positions(true, qs))))
+        names += ["--circle", str(path)]
+    code = main(["calibrate", "puma560", "--data", str(tmp_path / "poses.csv"), *names,
+                 "--angle-unit", "deg", "-o", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "circle-point set 5 (q6)" in err and "measure the sweep in steps under 180 deg" in err
+    assert len([line for line in err.splitlines() if line.startswith("robodyn: error:")]) == 1
