@@ -104,6 +104,9 @@ class NonGeometric:
         if last is None or last.shape != q.shape or not np.array_equal(last, q):
             b = self._basis(q)
             t = self.payload_torque(q) if self.payload_torque is not None else None
+            for a in (b, t):
+                if a is not None:
+                    a.flags.writeable = False  # shared by every evaluation of these readings
             self._cache.update(q=q.copy(), basis=b, payload=t)
         return self._cache["basis"], self._cache["payload"]
 
