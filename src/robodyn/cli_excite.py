@@ -23,7 +23,7 @@ def _cmd_excite(args: argparse.Namespace) -> int:
     limits = excitation_limits(robot, velocity=args.velocity, acceleration=args.acceleration)
     ex = rd.excitation(robot, harmonics=args.harmonics, base_frequency=args.frequency,
                        duration=args.duration, limits=limits, criterion=args.criterion,
-                       starts=args.starts, seed=args.seed, dt=args.dt)
+                       starts=args.starts, seed=args.seed, dt=args.dt, gradient=args.gradient)
     path = ex.to_csv(args.output)
     print(f"{robot.name}: {ex.series.harmonics} harmonics at {ex.series.base_frequency:g} Hz, "
           f"{ex.duration:g} s, {len(ex.columns)} base columns")
@@ -63,6 +63,12 @@ def add_excite_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: s
     p.add_argument("--velocity", type=float, default=None, help="speed limit, rad/s (all joints)")
     p.add_argument("--acceleration", type=float, default=None, help="acceleration limit, rad/s^2")
     p.add_argument("--criterion", choices=("cond", "logdet"), default="cond")
+    p.add_argument("--gradient", choices=("finite_difference", "analytic"),
+                   default="finite_difference",
+                   help="joint-state part of the gradient: central differences of the regressor, "
+                        "or compiled analytic regressor derivatives (faster per iteration; the "
+                        "first design for a robot compiles them, minutes for six joints) "
+                        "(default: %(default)s)")
     p.add_argument("--starts", type=int, default=6, help="optimiser starts")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--dt", type=float, default=1e-3, help="sample step of the CSV, s")

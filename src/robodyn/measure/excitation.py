@@ -26,14 +26,17 @@ set, found by QR with column pivoting on random states, :func:`base_columns`). T
 condition number ``cond(W) = sigma_max / sigma_min`` (``criterion="cond"``; minimised as
 ``log cond``) or ``-log det(W^T W)`` (``criterion="logdet"``, D-optimality). Both are minimised by
 SciPy's SLSQP under the *linear* joint position, velocity and acceleration limits on the ``K``
-samples, from several random feasible starts. The gradient is analytic: in the Fourier
-coefficients by the chain rule, and in the joint states by the compiled regressor derivatives
+samples, from several random feasible starts. The gradient is analytic in the Fourier
+coefficients (chain rule). In the joint states it is, by default
+(``gradient="finite_difference"``), central differences of the regressor (``5 n`` perturbed
+copies of the samples in one batched regressor call; no extra compilation); with
+``gradient="analytic"`` the compiled regressor derivatives
 (:meth:`robodyn.numeric.model.Model.regressor_derivatives`, forward-mode differentiation of the
-regressor's program, one batched call per gradient; compiled once per robot, cached).
-``gradient="finite_difference"`` uses central differences of the regressor in the joint states
-instead (``5 n`` perturbed copies of the samples in one batched regressor call; no extra
-compilation). Coulomb and offset friction columns are steps in ``qd``: their derivative is zero
-wherever it exists, and it is taken as zero.
+regressor's program, one batched call per gradient), 2.6-2.8x faster per gradient on the PUMA 560
+(``benchmarks/bench_excitation.py``) but compiled once per robot first (about 3 minutes for the
+PUMA 560 on this project's 2-core machine, then cached): worth it for repeated designs on one
+robot, not for a single design of a new one. Coulomb and offset friction columns are steps in
+``qd``: their derivative is zero wherever it exists, and it is taken as zero.
 
 Limits are enforced exactly on the returned samples: after optimisation, the oscillating part is
 shrunk about the offset (a scale factor <= 1) until the finely sampled trajectory is within every
@@ -468,7 +471,8 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
                criterion: Criterion = "cond", starts: int = 6, seed: int = 0, dt: float = 1e-3,
                design_samples: int | None = None, max_iterations: int = 40,
                columns: Sequence[int] | None = None,
-               gradient: Literal["analytic", "finite_difference"] = "analytic") -> Excitation:
+               gradient: Literal["analytic", "finite_difference"] = "finite_difference"
+               ) -> Excitation:
     """Design an optimal periodic excitation trajectory (finite Fourier series, Swevers 1997).
 
     Parameters
@@ -498,10 +502,10 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
         SLSQP iterations per start.
     columns : sequence of int, optional
         Regressor columns to use (default :func:`base_columns`).
-    gradient : {"analytic", "finite_difference"}
-        How the criterion's gradient is differentiated in the joint states: the compiled
-        regressor derivatives (default; the first design for a robot compiles them, which
-        takes minutes for a six-joint arm, then cached) or central differences of the regressor.
+    gradient : {"finite_difference", "analytic"}
+        How the criterion's gradient is differentiated in the joint states: central
+        differences of the regressor (default), or the compiled regressor derivatives (the first
+        design for a robot compiles them, which takes minutes for a six-joint arm, then cached).
 
     Returns
     -------
