@@ -41,10 +41,13 @@ import numpy as np
 
 from robodyn.robot.model import Robot
 
-__all__ = ["NONGEOMETRIC", "NonGeometric", "build_nongeometric", "gravity_torque", "nominal_frames"]
+__all__ = ["DEFLECTIONS", "NONGEOMETRIC", "NonGeometric", "build_nongeometric", "gravity_torque",
+           "nominal_frames"]
 
 #: The non-geometric terms, by name.
 NONGEOMETRIC = ("compliance", "harmonics")
+#: Compliance models: holding torque at the readings, or at the deflected pose.
+DEFLECTIONS = ("linear", "exact")
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,6 +80,14 @@ class NonGeometric:
     payload_torque : callable or None
         ``payload_torque(q)``: ``T`` (N, n, 4), the holding torques per unit payload parameter
         ``(m, m r_x, m r_y, m r_z)``, N m per kg (per kg m); None unless the payload is identified.
+    deflection : {"linear", "exact"}
+        ``"linear"``: the holding torque at the readings, ``dq = -C tau(q)``. ``"exact"``: at the
+        deflected pose, ``x = u - C tau(x)`` (:mod:`robodyn.calibrate.deflection`).
+    torque_jacobian : callable or None
+        ``torque_jacobian(x)``: ``d tau / d x`` (N, n, n) for ``"exact"``.
+    exact_torque : callable or None
+        ``exact_torque(x)``: the holding torques (N, n) used by ``"exact"`` (the compiled model's
+        gravity, plus a known payload).
     """
 
     terms: tuple[str, ...]
@@ -89,6 +100,9 @@ class NonGeometric:
     torque_source: str
     initial: np.ndarray | None = None
     payload_torque: Callable[[np.ndarray], np.ndarray] | None = None
+    deflection: str = "linear"
+    torque_jacobian: Callable[[np.ndarray], np.ndarray] | None = None
+    exact_torque: Callable[[np.ndarray], np.ndarray] | None = None
     _cache: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -120,6 +134,8 @@ class NonGeometric:
         (M,), and their Jacobian ``d dq / d theta`` (N, n, M): ``q_link = q + dq``."""
         q = np.asarray(q, dtype=float)
         b, t = self._of_readings(q)
+        if self.deflection == "exact":
+            return self._exact_correction(q, b, theta)
         dq = b @ theta
         if t is None:
             return dq, b
@@ -136,6 +152,26 @@ class NonGeometric:
         jac[:, joints, comp] -= tp[:, joints]
         jac[:, :, pay] = -c[None, :, None] * t
         return dq, jac
+
+    def _exact_correction(self, q: np.ndarray, b: np.ndarray, theta: np.ndarray,
+                          ) -> tuple[np.ndarray, np.ndarray]:
+        """``dq = x - q`` (N, n) with ``x = u - C tau(x)``, ``u = q + B_h theta_h`` (the terms other
+        than compliance), and its exact Jacobian (N, n, M) by the implicit function theorem."""
+        from robodyn.calibrate.deflection import exact_deflection
+
+        kinds = np.array(self.kinds)
+        comp = np.flatnonzero(kinds == "compliance")
+        other = np.flatnonzero(kinds != "compliance")
+        joints = np.array(self.joints)[comp]
+        c = np.zeros(q.shape[1])
+        c[joints] = theta[comp]
+        u = q + b[:, :, other] @ theta[other]
+        d = exact_deflection(u, c, self.exact_torque, self.torque_jacobian)
+        jac = np.zeros(b.shape)
+        # dx/dtheta_h = (I + C G)^-1 B_h;  dx/dc_j = -(I + C G)^-1 e_j tau_j(x)
+        jac[:, :, other] = d.sensitivity @ b[:, :, other]
+        jac[:, :, comp] = -d.sensitivity[:, :, joints] * d.torque[:, None, joints]
+        return d.q_link - q, jac
 
     def _basis(self, q: np.ndarray) -> np.ndarray:
         out = np.zeros((len(q), q.shape[1], self.n_params))
@@ -161,6 +197,7 @@ class NonGeometric:
         return {
             "terms": list(self.terms),
             "torque_source": self.torque_source,
+            "deflection": self.deflection,
             "parameters": [{"name": n, "joint": int(j), "kind": k, "value": float(v), "unit": u}
                            for n, j, k, v, u in zip(self.names, self.joints, self.kinds, values,
                                                     self.units, strict=True)],
@@ -253,6 +290,46 @@ def gravity_torque(robot: Robot) -> Callable[[np.ndarray], np.ndarray]:
     return torque
 
 
+def _compiled_gravity(robot: Robot, extra: Callable[[np.ndarray], np.ndarray] | None,
+                      h: float = 1e-6,
+                      ) -> tuple[Callable[[np.ndarray], np.ndarray], Callable[[np.ndarray], np.ndarray]]:
+    """``tau(x)`` (N, n) and ``G(x) = d tau / d x`` (N, n, n) from the compiled model.
+
+    ``tau = g(x)`` (plus ``extra(x)``, a known payload's holding torque) and ``G`` from
+    ``inverse_dynamics_derivatives(x, 0, 0)`` (at rest ``d tau / d q = d g / d q``), plus the
+    payload's derivative by central differences of ``extra`` (step ``h``). The model is compiled
+    on the first call only (cached on disk by :func:`robodyn.compile_model`), so building the
+    terms costs nothing until they are evaluated.
+    """
+    state: dict = {}
+
+    def model():
+        if "m" not in state:
+            import robodyn as rd
+
+            state["m"] = rd.compile_model(robot)
+        return state["m"]
+
+    def torque(x: np.ndarray) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        tau = np.asarray(model().gravity(x), dtype=float).reshape(x.shape)
+        return tau + extra(x) if extra is not None else tau
+
+    def jacobian(x: np.ndarray) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        zero = np.zeros_like(x)
+        g = np.array(model().inverse_dynamics_derivatives(x, zero, zero)[0]).reshape(len(x), x.shape[1],
+                                                                                   x.shape[1])
+        if extra is not None:
+            for k in range(x.shape[1]):
+                e = np.zeros(x.shape[1])
+                e[k] = h
+                g[:, :, k] += (extra(x + e) - extra(x - e)) / (2 * h)  # d tau_p / d x_k
+        return g
+
+    return torque, jacobian
+
+
 def _payload_unit_torque(frames: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
                          types: Sequence[str], gravity: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
     """``T(q)`` (N, n, 4): holding torques per unit payload mass and per unit first moment.
@@ -299,7 +376,7 @@ def nominal_frames(geometry) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndar
 
 def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
                        payload: tuple[float, Sequence[float]] | None = None,
-                       identify_payload: bool = False) -> NonGeometric:
+                       identify_payload: bool = False, deflection: str = "linear") -> NonGeometric:
     """The non-geometric terms ``terms`` of ``robot``.
 
     Parameters
@@ -318,13 +395,26 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
     identify_payload : bool
         Estimate the payload (parameters ``payload.mass``, kg, and ``payload.mx``, ``.my``,
         ``.mz``, its first moments in the tool frame, kg m); needs ``"compliance"``.
+    deflection : {"linear", "exact"}
+        ``"exact"`` solves the static equilibrium at the deflected pose
+        (:mod:`robodyn.calibrate.deflection`) with the holding torques and their analytic
+        derivatives from ``rd.compile_model(robot)`` (compiled on first use, cached); a known
+        payload's torque derivative is taken by central differences of its closed form. Needs
+        masses in the description; not combined with ``identify_payload``.
 
     Raises
     ------
     ValueError
-        An unknown term, a negative payload mass, ``identify_payload`` without compliance.
+        An unknown term, a negative payload mass, ``identify_payload`` without compliance, an
+        unknown ``deflection``, ``"exact"`` with ``identify_payload`` or without link masses.
     """
     terms = tuple(dict.fromkeys(terms))
+    if deflection not in DEFLECTIONS:
+        raise ValueError(f"deflection must be one of {', '.join(DEFLECTIONS)}, got {deflection!r}")
+    if deflection == "exact" and identify_payload:
+        raise ValueError("deflection='exact' cannot be combined with identify_payload: the exact "
+                         "Jacobian of the identified payload's terms is not implemented; identify the "
+                         "payload with deflection='linear', then give it as a known payload")
     unknown = [t for t in terms if t not in NONGEOMETRIC]
     if unknown:
         raise ValueError(f"unknown non-geometric term {unknown[0]!r}; choose from {', '.join(NONGEOMETRIC)}")
@@ -339,7 +429,7 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
         if g != 1.0:
             gear[j] = g
     names, units, joints, kinds = [], [], [], []
-    torque = None
+    torque = exact_torque = torque_jacobian = None
     source = ""
     if "compliance" in terms:
         gravity = np.array(robot.gravity.xreplace(subs), dtype=float).ravel()
@@ -361,7 +451,13 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
                 return tau + extra(q) if extra is not None else tau
 
             source = "gravity model" + (" + payload" if known else "")
+            if deflection == "exact":
+                exact_torque, torque_jacobian = _compiled_gravity(robot, extra)
         else:
+            if deflection == "exact":
+                raise ValueError(f"deflection='exact' needs the link masses of {robot.name}: its "
+                                 "description has none, so the compliance torques are a gravity-shaped "
+                                 "basis of unknown scale; use deflection='linear'")
             torque = _point_mass_torque(frames, types, gravity, [(k, 1.0) for k in range(1, n + 1)],
                                         known)
             source = "gravity-shaped basis"
@@ -396,5 +492,8 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
             joints.append(-1)
             kinds.append(kind)
             initial.append(float(v))
+    if "compliance" not in terms:
+        deflection = "linear"  # nothing deflects: the option changes nothing
     return NonGeometric(terms, tuple(names), tuple(units), tuple(joints), tuple(kinds), gear, torque,
-                        source, np.array(initial), payload_torque)
+                        source, np.array(initial), payload_torque, deflection, torque_jacobian,
+                        exact_torque)

@@ -345,6 +345,7 @@ def calibrate(
     identify_payload: bool = False,
     length_unit: str = "m",
     angle_unit: str = "rad",
+    deflection: str = "linear",
 ) -> Calibration:
     """Identify a robot's kinematics from measured target positions.
 
@@ -397,6 +398,12 @@ def calibrate(
         Unit of ``points`` and ``sigma`` (converted to m; the result is in m).
     angle_unit : {"rad", "deg"}
         Unit of the revolute joints' readings in ``q`` and of ``sigma_rot`` (converted to rad).
+    deflection : {"linear", "exact"}
+        Compliance model: the holding torque at the readings (``"linear"``, first order, compiles
+        nothing), or the static equilibrium at the deflected pose, ``x = u - C tau(x)``, solved by
+        Newton with the compiled model's analytic gravity derivatives and an exact Jacobian
+        (``"exact"``, :mod:`robodyn.calibrate.deflection`; compiles the model on first use). Needs
+        ``"compliance"`` and link masses; not with ``identify_payload``.
 
     Returns
     -------
@@ -418,6 +425,11 @@ def calibrate(
         raise ValueError(f"{'identify_payload' if identify_payload else 'payload'} needs the "
                          "'compliance' term (nongeometric=('compliance', ...)): the payload is seen "
                          "only through the joints' deflection under its weight")
+    if deflection not in ("linear", "exact"):
+        raise ValueError(f"deflection must be 'linear' or 'exact', got {deflection!r}")
+    if deflection == "exact" and "compliance" not in tuple(nongeometric):
+        raise ValueError("deflection='exact' needs the 'compliance' term (nongeometric=('compliance', "
+                         "...)): it changes how the joints deflect under their load")
     if initial == "circle-point" and circle_data is None:
         raise ValueError("initial='circle-point' needs circle_data: one (q, points) set per joint")
     q, points, sigma, sigma_rot = convert_units(robot, q, points, sigma, sigma_rot, length_unit,
@@ -450,7 +462,7 @@ def calibrate(
             from robodyn.calibrate.nongeometric import build_nongeometric, nominal_frames
 
             ng = build_nongeometric(robot, nongeometric, nominal_frames(geometry), payload=payload,
-                                    identify_payload=identify_payload)
+                                    identify_payload=identify_payload, deflection=deflection)
         offsets, _ = target_offsets(em, em.initial, q, pts3[:, 1:])
         em = extend_model(em, offsets, ng)
     points = pts3.reshape(-1, 3)
