@@ -210,7 +210,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
                            orientations=data.orientations, sigma_rot=sigma_rot,
                            nongeometric=tuple(args.nongeometric or ()),
                            payload=_payload(args.payload), identify_payload=args.identify_payload,
-                           **units)
+                           deflection=args.deflection, **units)
     validation = None
     if args.validate:
         from robodyn.calibrate.result import ErrorStats
@@ -402,6 +402,10 @@ def _calibrate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: st
     p.add_argument("--identify-payload", action="store_true",
                    help="estimate the payload's mass and centre of mass with the compliances "
                         "(needs --nongeometric compliance)")
+    p.add_argument("--deflection", choices=("linear", "exact"), default="linear",
+                   help="compliance model: holding torque at the readings (linear, default) or the "
+                        "static equilibrium at the deflected pose (exact: compiles the model's "
+                        "gravity derivatives on first use; for compliant arms such as cobots)")
     p.add_argument("--nongeometric", action="append", choices=("compliance", "harmonics"),
                    help="add joint compliance (gravity model) and/or transmission errors (ratio, "
                         "first harmonics); repeat for both")

@@ -184,3 +184,31 @@ def test_bad_combinations_are_refused():
     with pytest.raises(ValueError, match="identify_payload"):
         build_nongeometric(r, ("compliance",), nominal_frames(geometry), identify_payload=True,
                            deflection="exact")
+
+
+@pytest.mark.filterwarnings("ignore:calibration of puma560. the variance factor")
+def test_cli_deflection_exact_matches_the_api(tmp_path):
+    import csv
+    import json
+
+    from robodyn.cli import main
+
+    r = robot("puma560")
+    true = perturbed_robot(r, 7, base=TRACKER, target=(0.0, 0.0, 0.0))
+    q = poses("puma560", 60, 36)
+    y = measured(true, true_link(r, q, COBOT), TARGETS[:1])[:, 0]
+    path = tmp_path / "poses.csv"
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow([*r.joint_names, "x", "y", "z"])
+        w.writerows([[repr(float(v)) for v in row] for row in np.hstack((q, y))])
+    assert main(["calibrate", "puma560", "--data", str(path), "--nongeometric", "compliance",
+                 "--deflection", "exact", "--sigma", "0.005", "-o", str(tmp_path)]) == 0
+    report = json.loads((tmp_path / "puma560_calibrated_report.json").read_text())
+    assert report["nongeometric"]["deflection"] == "exact"
+    api = calibrate(r, q, y, "s-model", nongeometric=("compliance",), deflection="exact", sigma=5e-6)
+    cli = {p["name"]: p["value"] for p in report["parameters"]}
+    for p in api.parameters:
+        if p.name.endswith("compliance"):
+            assert cli[p.name] == pytest.approx(p.value, rel=1e-9), p.name
+            assert p.value == pytest.approx(COBOT[r.joint_names.index(p.name[:2])], rel=1e-6)
