@@ -26,6 +26,7 @@ FIXED_STEP: tuple[str, ...] = ("rk4", "semi_implicit")
 ADAPTIVE: tuple[str, ...] = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 MAX_SAMPLES = 1_000_000
 MODELS: tuple[str, ...] = ("dh", "hayati", "s-model", "poe")
+DEFLECTIONS: tuple[str, ...] = ("linear", "exact")
 
 
 def floats(text: str) -> np.ndarray:
@@ -402,7 +403,7 @@ def _calibrate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: st
     p.add_argument("--identify-payload", action="store_true",
                    help="estimate the payload's mass and centre of mass with the compliances "
                         "(needs --nongeometric compliance)")
-    p.add_argument("--deflection", choices=("linear", "exact"), default="linear",
+    p.add_argument("--deflection", choices=DEFLECTIONS, default="linear",
                    help="compliance model: holding torque at the readings (linear, default) or the "
                         "static equilibrium at the deflected pose (exact: compiles the model's "
                         "gravity derivatives on first use; for compliant arms such as cobots)")

@@ -43,6 +43,7 @@ def test_loading_a_builtin_robot_does_not_import_the_urdf_loader():
 def test_parser_literals_match_their_sources():
     from robodyn import cli, cli_cache, cli_identify, cli_workflows
     from robodyn.calibrate.models import MODELS
+    from robodyn.calibrate.nongeometric import DEFLECTIONS
     from robodyn.codegen.build import DEFAULT_CACHE_MAX_MB
     from robodyn.identify.friction import FRICTION_MODELS
     from robodyn.report.agreement import TOLERANCE
@@ -56,6 +57,7 @@ def test_parser_literals_match_their_sources():
     assert (cli_workflows.FIXED_STEP, cli_workflows.ADAPTIVE) == (FIXED_STEP, ADAPTIVE)
     assert cli_workflows.MAX_SAMPLES == MAX_SAMPLES
     assert cli_workflows.MODELS == tuple(MODELS)
+    assert cli_workflows.DEFLECTIONS == tuple(DEFLECTIONS)
     assert cli_identify.FRICTION_MODELS == tuple(FRICTION_MODELS)
     assert cli_cache.DEFAULT_CACHE_MAX_MB == DEFAULT_CACHE_MAX_MB
 
