@@ -22,10 +22,10 @@ Run: ``.venv/bin/python benchmarks/bench_calibration.py [--repeat N]``.
 from __future__ import annotations
 
 import argparse
-import time
 import warnings
 
 import numpy as np
+from timing import best_of_with_result as best_of
 
 import robodyn as rd
 from robodyn.calibrate import calibrate, random_configurations
@@ -35,16 +35,6 @@ from robodyn.calibrate.solve import fit
 
 SIGMA = 5e-5
 POSES = 200
-
-
-def best_of(fn, repeat: int):
-    """Smallest wall time of ``repeat`` calls, and the last result."""
-    best, out = float("inf"), None
-    for _ in range(repeat):
-        start = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - start)
-    return best, out
 
 
 def main() -> None:

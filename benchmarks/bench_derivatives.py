@@ -32,15 +32,7 @@ import robodyn as rd
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_simulation import pinocchio_puma  # noqa: E402 - sibling benchmark module
-
-
-def best_of(fn, repeats: int = 5) -> float:
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
+from timing import best_of  # noqa: E402
 
 
 def main() -> None:

@@ -26,17 +26,9 @@ import time
 
 import numpy as np
 import sympy as sp
+from timing import best_of  # noqa: E402
 
 import robodyn as rd
-
-
-def best_of(fn, repeats: int = 7) -> float:
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
 
 
 def main() -> None:
@@ -98,14 +90,14 @@ def strips_benchmark() -> None:
     twenty = strip_drag(q, qd, 20)
     scale = np.abs(exact).max()
     t_ours = best_of(lambda: wet.inverse_dynamics(q, qd, qdd))
-    t_strip = best_of(lambda: strip_drag(q, qd, 20), repeats=3)
+    t_strip = best_of(lambda: strip_drag(q, qd, 20), repeat=3)
     print(f"drag, {n} states, 0.3 m/s current: robodyn (6-point Gauss-Legendre, compiled, whole "
           f"wet inverse dynamics) {t_ours / n * 1e9:.0f} ns/state, max error "
           f"{np.abs(ours - exact).max() / scale:.1e} of the peak drag torque")
     print(f"  NumPy 20-strip loop (drag only) {t_strip / n * 1e9:.0f} ns/state, max error "
           f"{np.abs(twenty - exact).max() / scale:.1e}; ratio NumPy/robodyn {t_strip / t_ours:.1f}")
     for strips in (1, 2, 4):
-        t = best_of(lambda s=strips: strip_drag(q, qd, s), repeats=3)
+        t = best_of(lambda s=strips: strip_drag(q, qd, s), repeat=3)
         err = np.abs(strip_drag(q, qd, strips) - exact).max() / scale
         print(f"  NumPy {strips}-strip loop: {t / n * 1e9:.0f} ns/state ({t / t_ours:.2f}x robodyn), "
               f"max error {err:.1e}")

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 import warnings
 from pathlib import Path
 
@@ -33,20 +32,12 @@ from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+from timing import best_of_with_result as best_of  # noqa: E402
+
 from tests.identify.kinova import DATA, WHOLE_ARM_FILES, read  # noqa: E402
 from tests.urdf_chains import pin_q  # noqa: E402
 
 PIN_ORDER = [INERTIAL_NAMES.index(k) for k in ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")]
-
-
-def best_of(fn, repeat: int):
-    """Smallest wall time of ``repeat`` calls, and the last result."""
-    best, out = float("inf"), None
-    for _ in range(repeat):
-        start = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - start)
-    return best, out
 
 
 def main() -> None:

@@ -27,7 +27,6 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import sys
-import time
 import warnings
 from pathlib import Path
 
@@ -40,16 +39,7 @@ from robodyn.numeric.model import _kernels_cached
 
 sys.path.insert(0, str(Path(__file__).parent))
 from bench_simulation import pinocchio_puma, trolley_mjcf  # noqa: E402
-
-
-def best_of(fn, repeat: int = 5) -> float:
-    """Smallest wall time of ``repeat`` calls, s."""
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - start)
-    return min(times)
+from timing import best_of  # noqa: E402
 
 
 def without_friction(robot: rd.Robot) -> rd.Robot:

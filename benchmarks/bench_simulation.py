@@ -32,6 +32,7 @@ import warnings
 
 import numpy as np
 import sympy as sp
+from timing import best_of  # noqa: E402
 
 import robodyn as rd
 from robodyn.simulate import simulate
@@ -40,16 +41,6 @@ from robodyn.simulate import simulate
 #: MEX figure from the text of section 3.7.
 THESIS_TABLE_3_1 = {"AUTOLEV": 84.9, "DADS-3D": 319.26, "DADS-2D": 65.28, "SD/FAST": 21.83,
                   "a2m MEX under Simulink": 8.99}
-
-
-def best_of(fn, repeat: int = 5) -> float:
-    """Smallest wall time of ``repeat`` calls, s."""
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 # --- 1. trolley double pendulum ----------------------------------------------------------------

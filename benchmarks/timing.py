@@ -1,0 +1,22 @@
+"""Timing helpers shared by the benchmarks (run as scripts: ``benchmarks/`` is on ``sys.path``)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+
+def best_of(fn: Callable[[], Any], repeat: int = 5) -> float:
+    """Smallest wall time of ``repeat`` calls of ``fn``, s (the least disturbed by other load)."""
+    return best_of_with_result(fn, repeat)[0]
+
+
+def best_of_with_result(fn: Callable[[], Any], repeat: int = 5) -> tuple[float, Any]:
+    """Smallest wall time of ``repeat`` calls of ``fn``, s, and the last call's result."""
+    best, out = float("inf"), None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - start)
+    return best, out
