@@ -32,6 +32,7 @@ import robodyn as rd
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_simulation import pinocchio_puma  # noqa: E402 - sibling benchmark module
+from peers import pinocchio_loop  # noqa: E402
 from timing import best_of  # noqa: E402
 
 
@@ -76,10 +77,7 @@ def main() -> None:
     loops = min(n_states, 20_000)
 
     def loop(fn, *arrays):
-        def run():
-            for k in range(loops):
-                fn(pmodel, pdata, *(a[k] for a in arrays))
-        return run
+        return pinocchio_loop(fn, pmodel, pdata, loops, *arrays)
 
     def nothing(_model, _data, *_states):
         return None

@@ -25,7 +25,7 @@ import sys
 import time
 
 import numpy as np
-import sympy as sp
+from peers import lambdified_rhs  # noqa: E402
 from timing import best_of  # noqa: E402
 
 import robodyn as rd
@@ -101,24 +101,6 @@ def strips_benchmark() -> None:
         err = np.abs(strip_drag(q, qd, strips) - exact).max() / scale
         print(f"  NumPy {strips}-strip loop: {t / n * 1e9:.0f} ns/state ({t / t_ours:.2f}x robodyn), "
               f"max error {err:.1e}")
-
-
-def lambdified_rhs(robot: rd.Robot, values: dict[str, float]):
-    """SciPy rhs from ``sympy.lambdify`` of robodyn's own M(q) and h(q, qd) = tau(q, qd, 0)."""
-    eom = rd.derive(robot, "lagrange")
-    subs = eom.numeric(values)
-    zero = dict.fromkeys(eom.qdd, 0)
-    m_fn = sp.lambdify([eom.q], eom.M.xreplace(subs), "numpy", cse=True)
-    h_fn = sp.lambdify([eom.q, eom.qd], eom.tau.xreplace(zero).xreplace(subs), "numpy", cse=True)
-    n = robot.dof
-
-    def rhs(t, y):
-        q, qd = y[:n], y[n:]
-        # M qdd = -h
-        qdd = np.linalg.solve(np.asarray(m_fn(q), float), -np.asarray(h_fn(q, qd), float).ravel())
-        return np.concatenate([qd, qdd])
-
-    return rhs
 
 
 def solve_ivp_benchmark() -> None:

@@ -32,6 +32,7 @@ import warnings
 
 import numpy as np
 import sympy as sp
+from peers import lambdified_rhs, pinocchio_loop  # noqa: E402
 from timing import best_of  # noqa: E402
 
 import robodyn as rd
@@ -76,23 +77,6 @@ def trolley_mjcf(robot: rd.Robot) -> tuple[str, str]:
   <actuator><motor joint="x"/><motor joint="theta1"/><motor joint="theta2"/></actuator>
 </mujoco>"""
     return text, "hand-written MJCF (robodyn.export.mjcf not importable)"
-
-
-def lambdified_rhs(robot: rd.Robot):
-    """The usual Python route: lambdify M(q) and the bias h(q, qd), solve M qdd = -h in the rhs."""
-    eom = rd.derive(robot, "lagrange")
-    values = eom.numeric()
-    zero = dict.fromkeys(eom.qdd, 0)
-    m_fn = sp.lambdify([eom.q], eom.M.xreplace(values), "numpy", cse=True)
-    h_fn = sp.lambdify([eom.q, eom.qd], eom.tau.xreplace(zero).xreplace(values), "numpy", cse=True)
-    n = robot.dof
-
-    def rhs(t, y):
-        q, qd = y[:n], y[n:]
-        qdd = np.linalg.solve(np.asarray(m_fn(q), float), -np.asarray(h_fn(q, qd), float).ravel())
-        return np.concatenate([qd, qdd])
-
-    return rhs
 
 
 def bench_trolley(quick: bool) -> None:
@@ -276,10 +260,7 @@ def bench_puma(quick: bool) -> None:
     loops = min(n_states, 20_000)
 
     def loop(fn, *arrays):
-        def run():
-            for k in range(loops):
-                fn(pmodel, pdata, *(a[k] for a in arrays))
-        return run
+        return pinocchio_loop(fn, pmodel, pdata, loops, *arrays)
 
     theirs = {
         "inverse dynamics": best_of(loop(pin.rnea, q, qd, qdd), 3) * n_states / loops,
