@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pandas as pd
 import pytest
 
-import robodyn as rd
 from robodyn.measure.excitation import (
     ExcitationLimits,
     FourierTrajectory,
@@ -19,18 +16,6 @@ from robodyn.measure.excitation import (
     random_fourier,
 )
 from robodyn.symbolic.regressor import parameter_names
-
-
-@pytest.fixture(scope="module")
-def puma():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return rd.compile_model(rd.load("puma560"))
-
-
-@pytest.fixture(scope="module")
-def planar():
-    return rd.compile_model(rd.load("planar_2r"))
 
 
 @pytest.fixture(scope="module")

@@ -7,8 +7,6 @@ coefficients, and the earlier finite-difference gradient of the design.
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
 
@@ -26,18 +24,6 @@ from robodyn.measure.excitation import (
 from robodyn.symbolic.regressor import PER_JOINT
 
 pytestmark = pytest.mark.tool("gcc|cc")
-
-
-@pytest.fixture(scope="module")
-def puma():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return rd.compile_model(rd.load("puma560"))
-
-
-@pytest.fixture(scope="module")
-def planar():
-    return rd.compile_model(rd.load("planar_2r"))
 
 
 def _fd_regressor(model, q, qd, qdd, h=1e-6):

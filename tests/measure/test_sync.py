@@ -1,19 +1,11 @@
 """Tracker synchronisation: a known delay between tracker and joint clocks is recovered."""
 
-import warnings
 
 import numpy as np
 import pytest
 
 import robodyn as rd
 from robodyn.measure.sync import synchronise
-
-
-@pytest.fixture(scope="module")
-def puma():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return rd.compile_model(rd.load("puma560"))
 
 
 @pytest.mark.parametrize("delay", [0.0237, -0.0113])

@@ -2,22 +2,12 @@
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pandas as pd
 import pytest
 
-import robodyn as rd
 from robodyn.measure.testprog import iso_cube, jointwise
 from robodyn.simulate import UnreachableError
-
-
-@pytest.fixture(scope="module")
-def puma():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return rd.compile_model(rd.load("puma560"))
 
 
 @pytest.fixture(scope="module")

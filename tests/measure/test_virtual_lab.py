@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
 
@@ -13,13 +11,6 @@ from robodyn.measure.virtual_lab import Sensors, virtual_lab
 
 IDEAL = Sensors(jitter=0.0, counts_per_rev=0.0, current_noise=0.0, current_offset=0.0,
                 torque_constant_error=0.0, torque_noise=0.0, tracker_noise=0.0, tracker_latency=0.005)
-
-
-@pytest.fixture(scope="module")
-def puma():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return rd.compile_model(rd.load("puma560"))
 
 
 @pytest.fixture(scope="module")
