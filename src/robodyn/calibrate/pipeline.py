@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -415,23 +416,8 @@ def calibrate(
         On bad input: shapes, lengths, NaN, unknown options, too few poses for the identifiable
         parameters, a circle-point set in which its joint never moved.
     """
-    if model not in MODELS:
-        raise ValueError(f"unknown error model {model!r}; choose one of {', '.join(MODELS)}")
-    if loss not in LOSSES:
-        raise ValueError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
-    if initial not in ("nominal", "circle-point"):
-        raise ValueError(f"initial must be 'nominal' or 'circle-point', got {initial!r}")
-    if (identify_payload or payload is not None) and "compliance" not in tuple(nongeometric):
-        raise ValueError(f"{'identify_payload' if identify_payload else 'payload'} needs the "
-                         "'compliance' term (nongeometric=('compliance', ...)): the payload is seen "
-                         "only through the joints' deflection under its weight")
-    if deflection not in ("linear", "exact"):
-        raise ValueError(f"deflection must be 'linear' or 'exact', got {deflection!r}")
-    if deflection == "exact" and "compliance" not in tuple(nongeometric):
-        raise ValueError("deflection='exact' needs the 'compliance' term (nongeometric=('compliance', "
-                         "...)): it changes how the joints deflect under their load")
-    if initial == "circle-point" and circle_data is None:
-        raise ValueError("initial='circle-point' needs circle_data: one (q, points) set per joint")
+    _check_options(model, loss, initial, nongeometric, payload, identify_payload, deflection,
+                   circle_data)
     q, points, sigma, sigma_rot = convert_units(robot, q, points, sigma, sigma_rot, length_unit,
                                                 angle_unit)
     q, points, orientations, sig = check_data(robot, q, points, orientations, sigma)
@@ -446,25 +432,8 @@ def calibrate(
     _, before_k = target_offsets(placed, placed_params, q, pts3[:, 1:])
     before_res = np.concatenate((before1[:, None], before_k), axis=1).reshape(points.shape)
     target = model_frames(placed, placed_params)[2]
-    cp: CirclePointResult | None = None
-    if initial == "circle-point":
-        cp = circle_point(geometry, circle_data, parallel_tol=parallel_tol)
-        t0 = target.copy()
-        t0[:3, 3] = cp.target
-        em = build_model(model, geometry, base=cp.registration, lines=(cp.points, cp.directions),
-                         target=t0, orientation=oriented, parallel_tol=parallel_tol)
-    else:
-        em = build_model(model, geometry, base=world, target=target, orientation=oriented,
-                         parallel_tol=parallel_tol)
-    if k_count > 1 or nongeometric:
-        ng = None
-        if nongeometric:
-            from robodyn.calibrate.nongeometric import build_nongeometric, nominal_frames
-
-            ng = build_nongeometric(robot, nongeometric, nominal_frames(geometry), payload=payload,
-                                    identify_payload=identify_payload, deflection=deflection)
-        offsets, _ = target_offsets(em, em.initial, q, pts3[:, 1:])
-        em = extend_model(em, offsets, ng)
+    em, cp = _error_model(robot, geometry, model, initial, circle_data, target, world, oriented,
+                          parallel_tol, q, pts3, nongeometric, payload, identify_payload, deflection)
     points = pts3.reshape(-1, 3)
     sig = sig3.reshape(-1, 3)
     weights = 1.0 / sig
@@ -494,13 +463,7 @@ def calibrate(
     if not res.success:
         warnings.warn(f"calibration of {robot.name} did not converge: {res.message}", RuntimeWarning,
                       stacklevel=2)
-    ratio = math.sqrt(res.variance_factor)
-    if ratio > 3.0 or ratio < 1.0 / 3.0:
-        warnings.warn(f"calibration of {robot.name}: the variance factor {res.variance_factor:.4g} says the "
-                      f"given sigma is wrong by a factor of about {ratio:.3g} (residuals "
-                      f"{'larger' if ratio > 1 else 'smaller'} than sigma); the standard uncertainties "
-                      "are scaled by it, but check sigma (or the data's units, or unmodelled errors)",
-                      RuntimeWarning, stacklevel=2)
+    _warn_variance_factor(robot.name, res.variance_factor)
     std = np.sqrt(np.diag(res.covariance))
     parameters = tuple(
         Parameter(em.names[k], float(res.params[k]), float(s), float(em.initial[k]), em.units[k])
@@ -532,6 +495,67 @@ def calibrate(
         before_robot=calibrated_robot(robot, geometry, placed, placed_params, name=f"{robot.name}_placed"),
         targets_axis=before_res.ndim == 3,
     )
+
+
+def _check_options(model: str, loss: str, initial: str, nongeometric: Sequence[str],
+                   payload: Any, identify_payload: bool, deflection: str, circle_data: Any) -> None:
+    """Refuse option values and combinations :func:`calibrate` cannot honour (ValueError)."""
+    if model not in MODELS:
+        raise ValueError(f"unknown error model {model!r}; choose one of {', '.join(MODELS)}")
+    if loss not in LOSSES:
+        raise ValueError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
+    if initial not in ("nominal", "circle-point"):
+        raise ValueError(f"initial must be 'nominal' or 'circle-point', got {initial!r}")
+    if (identify_payload or payload is not None) and "compliance" not in tuple(nongeometric):
+        raise ValueError(f"{'identify_payload' if identify_payload else 'payload'} needs the "
+                         "'compliance' term (nongeometric=('compliance', ...)): the payload is seen "
+                         "only through the joints' deflection under its weight")
+    if deflection not in ("linear", "exact"):
+        raise ValueError(f"deflection must be 'linear' or 'exact', got {deflection!r}")
+    if deflection == "exact" and "compliance" not in tuple(nongeometric):
+        raise ValueError("deflection='exact' needs the 'compliance' term (nongeometric=('compliance', "
+                         "...)): it changes how the joints deflect under their load")
+    if initial == "circle-point" and circle_data is None:
+        raise ValueError("initial='circle-point' needs circle_data: one (q, points) set per joint")
+
+
+def _error_model(robot: Robot, geometry: RobotGeometry, model: str, initial: str, circle_data: Any,
+                 target: np.ndarray, world: np.ndarray, oriented: bool, parallel_tol: float,
+                 q: np.ndarray, pts3: np.ndarray, nongeometric: Sequence[str], payload: Any,
+                 identify_payload: bool, deflection: str) -> tuple[ErrorModel, CirclePointResult | None]:
+    """The error model at its starting point (nominal or circle-point), with the other targets'
+    offsets and the non-geometric terms added; and the circle-point result when used."""
+    cp: CirclePointResult | None = None
+    if initial == "circle-point":
+        cp = circle_point(geometry, circle_data, parallel_tol=parallel_tol)
+        t0 = target.copy()
+        t0[:3, 3] = cp.target
+        em = build_model(model, geometry, base=cp.registration, lines=(cp.points, cp.directions),
+                         target=t0, orientation=oriented, parallel_tol=parallel_tol)
+    else:
+        em = build_model(model, geometry, base=world, target=target, orientation=oriented,
+                         parallel_tol=parallel_tol)
+    if pts3.shape[1] > 1 or nongeometric:
+        ng = None
+        if nongeometric:
+            from robodyn.calibrate.nongeometric import build_nongeometric, nominal_frames
+
+            ng = build_nongeometric(robot, nongeometric, nominal_frames(geometry), payload=payload,
+                                    identify_payload=identify_payload, deflection=deflection)
+        offsets, _ = target_offsets(em, em.initial, q, pts3[:, 1:])
+        em = extend_model(em, offsets, ng)
+    return em, cp
+
+
+def _warn_variance_factor(name: str, variance_factor: float) -> None:
+    """Warn when the variance factor says the given sigma is off by more than 3x either way."""
+    ratio = math.sqrt(variance_factor)
+    if ratio > 3.0 or ratio < 1.0 / 3.0:
+        warnings.warn(f"calibration of {name}: the variance factor {variance_factor:.4g} says the "
+                      f"given sigma is wrong by a factor of about {ratio:.3g} (residuals "
+                      f"{'larger' if ratio > 1 else 'smaller'} than sigma); the standard uncertainties "
+                      "are scaled by it, but check sigma (or the data's units, or unmodelled errors)",
+                      RuntimeWarning, stacklevel=3)
 
 
 def validate(calibration: Calibration, q, points) -> ErrorStats:
