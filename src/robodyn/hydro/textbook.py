@@ -210,8 +210,7 @@ def underwater_textbook(eom: EquationsOfMotion) -> UnderwaterTextbook:
     if hydro is None:
         raise ValueError(f"{eom.robot.name}: no fluid block, so no hydrodynamic terms to print")
     robot, n = eom.robot, eom.dof
-    q, qd, qdd = list(eom.q), list(eom.qd), list(eom.qdd)
-    rates = qd + qdd
+    q, qd = list(eom.q), list(eom.qd)
     fluid = fluid_of(robot)
     assert fluid is not None
     kin = eom.kinematics
@@ -271,6 +270,17 @@ def underwater_textbook(eom: EquationsOfMotion) -> UnderwaterTextbook:
                                        qd)
                 force = fluid.density * h.skin_friction * sp.pi * cyl.radius * sp.Abs(u_a) * u_a
                 skin += cyl.length * motion.j_start.T * e * force
+    sections = _sections(eom, m_a, drag, skin, lift, tuple(velocity_lines), notes)
+    return UnderwaterTextbook(tuple(sections), functions, rules)
+
+
+def _sections(eom: EquationsOfMotion, m_a: sp.Matrix, drag: sp.Matrix, skin: sp.Matrix,
+              lift: sp.Matrix, velocity_lines: tuple[Line, ...], notes: list[str]) -> list[Section]:
+    """The printed sections: rigid M, C, g (and friction), then M_A, C_A, g_B, v_n(s), tau_D,
+    tau_F (when any), tau_L."""
+    hydro, robot, n = eom.hydro, eom.robot, eom.dof
+    q, qd = list(eom.q), list(eom.qd)
+    rates = qd + list(eom.qdd)
     c_a = christoffel_coriolis(sp.ImmutableMatrix(m_a), q, qd)
     m_rigid = sp.ImmutableMatrix(eom.M - hydro.mass_matrix)
     c_rigid = sp.ImmutableMatrix(eom.C - hydro.coriolis)
@@ -292,7 +302,7 @@ def underwater_textbook(eom: EquationsOfMotion) -> UnderwaterTextbook:
         Section("buoyancy g_B(q) (rho V g at each centre of buoyancy)",
                 _matrix_lines("g_B", hydro.buoyancy, rates)),
         Section("normal velocity relative to the current, in each link frame, at arc length s "
-                "(m) along each cylinder: " + "; ".join(notes), tuple(velocity_lines)),
+                "(m) along each cylinder: " + "; ".join(notes), velocity_lines),
     ]
     points = sorted({h.quadrature for h in hydro_of(robot) if h is not None})
     rule = "; ".join(_rule_text(k) for k in points)
@@ -307,4 +317,4 @@ def underwater_textbook(eom: EquationsOfMotion) -> UnderwaterTextbook:
         "lift tau_L(q, qd) = -sum over cylinders of 1/2 rho C_L D int_0^L |v_n(s)| (e x v_n(s)) . "
         "dv_n(s)/dqd_j ds (same rule)",
         tuple(Line("tau_L", (j,), ((lift[j], sp.Integer(1)),)) for j in range(n))))
-    return UnderwaterTextbook(tuple(sections), functions, rules)
+    return sections
