@@ -89,20 +89,25 @@ def main() -> None:
         pmodel = pin.buildModelFromUrdf(str(DATA / "gen3.urdf"))
         pmodel.gravity.linear = np.array([0.0, 0.0, -9.81])
         data = pmodel.createData()
-        out = np.empty((count * n, 10 * n))
         qp = np.array([pin_q(pmodel, qi) for qi in q])  # continuous joints: (cos, sin)
 
-        def loop():
+        def loop(out: np.ndarray) -> np.ndarray:
             for i in range(count):
                 out[i * n:(i + 1) * n] = pin.computeJointTorqueRegressor(pmodel, data, qp[i], qd[i], qdd[i])
             return out
 
-        t_pin, w = best_of(loop, 1)
-        line("Pinocchio computeJointTorqueRegressor loop (Python)", t_pin)
-        print(f"  ratio Pinocchio loop / robodyn, fresh matrix: {t_pin / t_rd:.1f}x on 1 thread, "
-              f"{t_pin / t_rd2:.1f}x on 2; reused matrix: {t_pin / t_out:.1f}x on 1 thread, "
-              f"{t_pin / t_out2:.1f}x on 2 (target >= 10x; the Pinocchio loop writes into a "
-              "preallocated matrix, one Python call per sample)")
+        # like for like: into a fresh matrix (page faults, as robodyn's fresh case), and into one
+        # already written (as robodyn's out=)
+        t_pin, _ = best_of(lambda: loop(np.empty((count * n, 10 * n))), 1)
+        t_pin_out, w = best_of(lambda: loop(np.full((count * n, 10 * n), 0.0)), 1)
+        line("Pinocchio computeJointTorqueRegressor loop, fresh matrix", t_pin)
+        line("  the same into a matrix already written", t_pin_out)
+        print(f"  ratio Pinocchio loop / robodyn (target >= 10x), like for like (robodyn writes "
+              f"{y.shape[1]} columns, Pinocchio {w.shape[1]}; one Python call per sample):")
+        print(f"    fresh matrix:  {t_pin / t_rd:5.1f}x on 1 thread, {t_pin / t_rd2:5.1f}x on 2 "
+              f"(zero compute, NumPy's fresh floor, would be {t_pin / t_fill:.1f}x on 1)")
+        print(f"    reused matrix: {t_pin_out / t_out:5.1f}x on 1 thread, {t_pin_out / t_out2:5.1f}x "
+              f"on 2 (zero compute, NumPy's fill, would be {t_pin_out / t_refill:.1f}x on 1)")
         cols = [PER_JOINT * j + k for j in range(n) for k in PIN_ORDER]
         dev = np.abs(y[:, cols] - w).max() / np.abs(w).max()
         print(f"  rigid-body columns agree to {dev:.1e} (relative to the largest entry)")

@@ -13,6 +13,7 @@ import pytest
 import robodyn as rd
 from robodyn.codegen.build import CompilerNotFoundError
 from robodyn.codegen.c import BLOCK
+from robodyn.codegen.c_outputs import STREAM_MIN_BYTES
 from robodyn.symbolic.regressor import reflected_rotor_inertia
 from tests.numeric_eval import evaluator, program_evaluator
 from tests.urdf_chains import pin_q, random_urdf
@@ -104,6 +105,33 @@ def test_c_batches_across_blocks_large_angles_and_resting_joints(compiled):
         for k in (0, 2, BLOCK, count - 1):
             single = getattr(c_model, name)(*(a[k] for a in arrays))
             np.testing.assert_array_equal(single, out[k], err_msg=name)
+
+
+def test_streamed_regressor_keeps_the_bits():
+    """A regressor batch large enough for streaming stores (reused out=, >= STREAM_MIN_BYTES),
+    on 1 and 3 threads and with a destination that starts off 32-byte alignment, gives the same
+    bits as the cached path (a fresh matrix) and as each state alone; the constant entries are
+    written too (the out= buffer starts as NaN)."""
+    robot = load_quiet("puma560")
+    model = rd.compile_model(robot)
+    n = robot.dof
+    per_state = 8 * n * 15 * n
+    count = -(-STREAM_MIN_BYTES // per_state) + 2 * BLOCK + 5
+    rng = np.random.default_rng(21)
+    q, qd, qdd = rng.uniform(-2, 2, (3, count, n))
+    qd[7] = 0.0
+    fresh = model.regressor(q, qd, qdd)
+    for threads in (1, 3):
+        # the buffer one double past a 32-byte boundary: the copy's scalar head is exercised
+        raw = np.full(count * n * 15 * n + 4, np.nan)
+        skip = (-(raw.ctypes.data // 8) % 4 + 1) % 4
+        out = raw[skip:skip + count * n * 15 * n].reshape(count, n, 15 * n)
+        assert out.nbytes >= STREAM_MIN_BYTES and out.ctypes.data % 32 != 0
+        result = model.regressor(q, qd, qdd, threads=threads, out=out)
+        assert np.shares_memory(result, out)
+        np.testing.assert_array_equal(out, fresh)
+    for k in (0, 7, BLOCK + 1, count - 1):
+        np.testing.assert_array_equal(model.regressor(q[k], qd[k], qdd[k]), fresh[k])
 
 
 def test_forward_dynamics_inverts_inverse_dynamics(compiled):

@@ -28,9 +28,11 @@ The one-state function is the range of one state through the same code (the loop
 remainder runs the same operations as its vector lanes, IEEE arithmetic, the same contractions),
 so a state gives the same bits alone, in a batch, at any position of a block and on any number
 of threads; the tests check it bit for bit. Threads (OpenMP, when compiled with ``-fopenmp``)
-take whole blocks. All of it is plain C99 with ordinary IEEE arithmetic: no intrinsics, no
-special flags (vectorisation needs only -O3 and a SIMD target); the one pragma is OpenMP's,
-inside ``#ifdef _OPENMP``.
+take pieces of whole blocks. All of it is plain C99 with ordinary IEEE arithmetic, no special
+flags (vectorisation needs only -O3 and a SIMD target); the one pragma is OpenMP's, inside
+``#ifdef _OPENMP``. The one use of intrinsics moves no value through arithmetic: large outputs
+with constant entries (the regressor) are staged and, for batches too large for the cache,
+copied out with streaming stores under ``#if defined(__SSE2__)`` (:mod:`robodyn.codegen.c_outputs`).
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
 from robodyn.codegen.base import GeneratedFile, Printer
+from robodyn.codegen.c_outputs import STREAM_MIN_BYTES, copy_out_source, output_lines, staged_outputs
 from robodyn.codegen.kernels import Argument, Kernel, KernelSet
 
 #: States per block of the batch functions (one vector loop evaluates the block's sines/cosines).
@@ -54,6 +57,9 @@ INLINE_LIMIT = 400
 #: state in a block differently in the last bit (1 ulp in 2 of 540 PUMA regressor entries), and
 #: the batch kernels keep one state's bits whatever the batch (tests/numeric/test_model.py).
 DIRECT_MIN: int | None = None
+
+#: States per thread's piece of a threaded batch (whole blocks, so the same blocks as one thread).
+THREAD_CHUNK = 64 * BLOCK
 
 #: Beyond this |angle| (rad), and for infinities and NaN, the block's sine and cosine come from libm.
 _POLY_LIMIT = "1.0e5"
@@ -182,7 +188,7 @@ class CPrinter(Printer):
         core = Kernel(f"{kernel.name}_block", kernel.summary, inputs, outputs, body)
         single = "\n".join([
             *self.open_function(kernel),
-            f"    {self.prefix}{kernel.name}_range(0, 1, {', '.join(_names(kernel))});",
+            f"    {self.prefix}{kernel.name}_range(0, 1, {', '.join(_names(kernel))}, 0);",
             "}",
         ]) + "\n"
         direct = {o.name: (o.size, computed[o.name] if 0 < len(computed[o.name]) < o.size
@@ -239,13 +245,11 @@ class CPrinter(Printer):
         (Coulomb friction's ``qd > 0``) computed there, where they become vector selects rather
         than conditional jumps the processor would mispredict on every sign change; then one
         vector loop per angle gives the sines and cosines, the core runs, and the outputs are
-        transposed back. An output with constant entries (``computed`` lists the others, by
-        output name) is written per state from a static template of the constants, then its
-        computed entries from the block (the core neither computes nor stores the constants).
+        transposed back (:func:`robodyn.codegen.c_outputs.output_lines`). ``stream_`` (set
+        by the batch functions for large batches) makes staged outputs use streaming stores.
         """
         na, ns = len(angles), len(steps)
-        computed, direct = computed or {}, direct or {}
-        sizes = {a.name: a.size for a in core.outputs}
+        direct = direct or {}
         element = {}
         for arg in kernel.inputs:
             for k, sym in enumerate(arg.entries):
@@ -257,6 +261,8 @@ class CPrinter(Printer):
                   f"{a.name}[{a.size} * j_ + i_];" for a in gathered]
         gather += [f"            step_[{BLOCK * i} + k_] = {self.expr(e.xreplace(element))};"
                    for i, e in enumerate(steps)]
+        out = output_lines(self.prefix, self.expr, kernel, core, computed or {}, direct, BLOCK)
+        sizes = {a.name: a.size for a in core.outputs}
         arrays = [f"{a.name}_b_[{sizes.get(a.name, a.size) * BLOCK}]"
                   for a in (*gathered, *kernel.outputs) if a.name not in direct]
         arrays += [f"sin_[{na * BLOCK}]", f"cos_[{na * BLOCK}]"] if na else []
@@ -267,36 +273,6 @@ class CPrinter(Printer):
                 for a in core.inputs]
         args += [f"{a.name} + {direct[a.name][0]} * k0_" if a.name in direct else f"{a.name}_b_"
                  for a in core.outputs]
-        tables: list[str] = []
-        scatter = []
-        fill: list[str] = []
-        for a, o in zip(kernel.outputs, core.outputs, strict=True):
-            if a.name in direct and o.size == a.size:
-                continue
-            if a.name in direct:
-                # the constants first; the core then stores the computed entries over them
-                template = f"{self.prefix}{kernel.name}_{a.name}_template_"
-                values = [self.expr(sp.Float(e)) if sp.sympify(e).is_Number else "0.0" for e in a.entries]
-                tables.append(f"static const double {template}[{a.size}] = {{{', '.join(values)}}};")
-                fill += ["        for (int k_ = 0; k_ < m_; ++k_)",
-                         f"            for (int i_ = 0; i_ < {a.size}; ++i_) "
-                         f"{a.name}[{a.size} * (k0_ + k_) + i_] = {template}[i_];"]
-                continue
-            if o.size == a.size:
-                scatter.append(f"            for (int i_ = 0; i_ < {a.size}; ++i_) "
-                               f"{a.name}[{a.size} * j_ + i_] = {a.name}_b_[{BLOCK} * i_ + k_];")
-                continue
-            # the constants from a template, then the computed entries over them
-            keep = computed[a.name]
-            stem = f"{self.prefix}{kernel.name}_{a.name}"
-            template, index = f"{stem}_template_", f"{stem}_index_"
-            values = [self.expr(sp.Float(e)) if sp.sympify(e).is_Number else "0.0" for e in a.entries]
-            tables += [f"static const double {template}[{a.size}] = {{{', '.join(values)}}};",
-                       f"static const int {index}[{len(keep)}] = {{{', '.join(map(str, keep))}}};"]
-            scatter += [f"            double *restrict row_ = {a.name} + {a.size} * j_;",
-                        f"            for (int i_ = 0; i_ < {a.size}; ++i_) row_[i_] = {template}[i_];",
-                        f"            for (int i_ = 0; i_ < {len(keep)}; ++i_) row_[{index}[i_]] = "
-                        f"{a.name}_b_[{BLOCK} * i_ + k_];"]
         # (a kernel whose outputs are constants reads no input)
         transpose = ["        /* transpose the block's inputs: x_b_[BLOCK i + k] = x[size (k0 + k) + i] */",
                      "        for (int k_ = 0; k_ < m_; ++k_) {",
@@ -305,61 +281,103 @@ class CPrinter(Printer):
                      "        }"] if gather else []
         params = ", ".join(f"const double *restrict {a.name}" for a in kernel.inputs)
         params += ", " + ", ".join(f"double *restrict {a.name}" for a in kernel.outputs)
-        if tables:
-            tables = [f"/* {kernel.name}: constant entries of its outputs, and the computed ones' "
-                      "positions. */", *tables, ""]
+        stream = (f"count >= {-(-STREAM_MIN_BYTES // out.staged_bytes)}L" if out.staged_bytes
+                  else "(void)count, 0")
         return "\n".join([
-            *tables,
+            *out.tables,
             f"/* {kernel.name} for the states begin <= j < end stored one after another, {BLOCK} at a "
             "time. */",
-            f"static void {self.prefix}{kernel.name}_range(long begin, long end, {params}) {{",
-            f"    double {', '.join(arrays)};",
+            f"static void {self.prefix}{kernel.name}_range(long begin, long end, {params}, int stream_) {{",
+            f"    double {', '.join(arrays + out.arrays)};",
+            *(out.start or ["    (void)stream_;"]),
             f"    for (long k0_ = begin; k0_ < end; k0_ += {BLOCK}) {{",
             f"        const int m_ = end - k0_ < {BLOCK} ? (int)(end - k0_) : {BLOCK};",
             *transpose,
             *trig,
-            *fill,
+            *out.fill,
             f"        {self.prefix}{core.name}(m_, {', '.join(args)});",
             *(["        for (int k_ = 0; k_ < m_; ++k_) {",
                "            const long j_ = k0_ + k_;",
-               *scatter,
-               "        }"] if scatter else []),
+               *out.scatter,
+               "        }"] if out.scatter else []),
+            *out.per_block,
             "    }",
+            *([f"    if (stream_) {self.prefix}stream_fence();"] if out.staged_bytes else []),
+            "}",
+            "",
+            f"/* Whether a batch of count states writes {kernel.name}'s staged outputs by streaming "
+            "stores. */",
+            f"static int {self.prefix}{kernel.name}_stream_(long count) {{",
+            f"    return {stream};",
             "}",
             "",
             f"/* {kernel.name} for count states stored one after another. */",
             self.signature(kernel, batch=True) + " {",
-            f"    {self.prefix}{kernel.name}_range(0, count, {', '.join(_names(kernel))});",
+            f"    {self.prefix}{kernel.name}_range(0, count, {', '.join(_names(kernel))}, "
+            f"{self.prefix}{kernel.name}_stream_(count));",
             "}",
         ]) + "\n"
 
-    def threaded_batch(self, kernel: Kernel) -> str:
-        """``PREFIXk_batch_threads``: the batch on ``threads`` OpenMP threads, block by block.
+    @staticmethod
+    def _direct(kernel: Kernel) -> list[str]:
+        """Outputs of ``kernel`` stored by its core straight into the caller's rows."""
+        return [o.name for o in kernel.outputs if DIRECT_MIN is not None and o.size >= DIRECT_MIN]
 
-        Each block of :data:`BLOCK` states is computed by the same code whichever thread takes
-        it, so the result bits do not depend on the thread count. Compiled without OpenMP it is
-        the plain batch.
+    def threaded_batch(self, kernel: Kernel) -> str:
+        """``PREFIXk_batch_threads`` (and ``PREFIXk_batch_stream``): the batch on threads.
+
+        The work is cut into pieces of whole blocks from state 0 (at most :data:`THREAD_CHUNK`
+        states, fewer when the threads would otherwise not all get one): the same blocks,
+        computed by the same code, as on one thread, so the result bits do not depend on the
+        thread count. Compiled without OpenMP it is the plain batch. ``_batch_stream``, for
+        kernels with staged outputs, lets the caller choose the store mode (streaming for a
+        large reused matrix; not for fresh memory, whose lines the operating system has just
+        zeroed through the cache).
         """
         names = ", ".join(_names(kernel))
         rng = f"{self.prefix}{kernel.name}_range"
-        return "\n".join([
+        inner = f"{self.prefix}{kernel.name}_threads_"
+        params = ", ".join([f"const double *restrict {a.name}" for a in kernel.inputs]
+                           + [f"double *restrict {a.name}" for a in kernel.outputs])
+        lines = [
             f"/* {kernel.name} for count states on `threads` threads (OpenMP; one without). */",
-            self.signature(kernel, batch=True, threads=True) + " {",
+            f"static void {inner}(long count, int threads, int stream, {params}) {{",
             "#ifdef _OPENMP",
             f"    if (threads > 1 && count > {BLOCK}) {{",
-            f"        const long blocks = (count + {BLOCK - 1}) / {BLOCK};",
+            "        /* whole blocks, at most THREAD_CHUNK states, at least one piece per thread */",
+            f"        const long share = (count / threads + {BLOCK - 1}) / {BLOCK} * {BLOCK};",
+            f"        const long piece = share < {THREAD_CHUNK} ? share : {THREAD_CHUNK};",
+            "        const long pieces = (count + piece - 1) / piece;",
             "#pragma omp parallel for num_threads(threads) schedule(static)",
-            "        for (long b_ = 0; b_ < blocks; ++b_) {",
-            f"            const long end = {BLOCK} * b_ + {BLOCK} < count ? {BLOCK} * b_ + {BLOCK} : count;",
-            f"            {rng}({BLOCK} * b_, end, {names});",
+            "        for (long p_ = 0; p_ < pieces; ++p_) {",
+            "            const long end = piece * p_ + piece < count ? piece * p_ + piece : count;",
+            f"            {rng}(piece * p_, end, {names}, stream);",
             "        }",
             "        return;",
             "    }",
             "#endif",
             "    (void)threads;",
-            f"    {rng}(0, count, {names});",
+            f"    {rng}(0, count, {names}, stream);",
             "}",
-        ]) + "\n"
+            "",
+            self.signature(kernel, batch=True, threads=True) + " {",
+            f"    {inner}(count, threads, {self.prefix}{kernel.name}_stream_(count), {names});",
+            "}",
+        ]
+        if staged_outputs(kernel, self._direct(kernel)):
+            lines += ["", f"/* {kernel.name}'s batch with the store mode chosen: stream 1 for "
+                      "streaming stores, 0 for cached. */",
+                      self.stream_signature(kernel) + " {",
+                      f"    {inner}(count, threads, stream, {names});",
+                      "}"]
+        return "\n".join(lines) + "\n"
+
+    def stream_signature(self, kernel: Kernel) -> str:
+        """The C prototype of ``PREFIXk_batch_stream`` (without the trailing semicolon)."""
+        args = [f"const double *restrict {a.name}" for a in kernel.inputs]
+        args += [f"double *restrict {a.name}" for a in kernel.outputs]
+        return (f"void {self.prefix}{kernel.name}_batch_stream(long count, int threads, int stream, "
+                f"{', '.join(args)})")
 
     def declarations(self, kset: KernelSet, with_simulation: bool = True) -> str:
         """Prototypes of every exported function, one per line (a header, and cffi's cdef)."""
@@ -368,6 +386,8 @@ class CPrinter(Printer):
             lines.append(self.signature(kernel).replace("restrict ", "") + ";")
             lines.append(self.signature(kernel, batch=True).replace("restrict ", "") + ";")
             lines.append(self.signature(kernel, batch=True, threads=True).replace("restrict ", "") + ";")
+            if staged_outputs(kernel, self._direct(kernel)):
+                lines.append(self.stream_signature(kernel).replace("restrict ", "") + ";")
         if with_simulation and "state_derivative" in kset.names:
             runtime = len(kset.runtime_parameters)
             lines.append(simulate_signature(self.prefix, runtime) + ";")
@@ -383,7 +403,10 @@ class CPrinter(Printer):
             macro = f"{self.prefix.upper()}NOINLINE"
             parts.append(f"#if defined(__GNUC__)\n#define {macro} __attribute__((noinline))\n#else\n"
                          f"#define {macro}\n#endif\n")
-        parts.extend(self.kernel_source(kernel) for kernel in kset.kernels)
+        kernels = [self.kernel_source(kernel) for kernel in kset.kernels]
+        if any(f"{self.prefix}copy_out(" in k for k in kernels):
+            parts.append(copy_out_source(self.prefix))
+        parts.extend(kernels)
         if with_simulation and "state_derivative" in kset.names:
             runtime = len(kset.runtime_parameters)
             parts.append(simulation_source(kset.dof, self.prefix, "gravity" in kset.names,
@@ -508,18 +531,18 @@ def ensemble_source(n: int, prefix: str, runtime: int = 0) -> str:
         "        }",
         "        if (method == 0) {",
         "            /* RK4 over the block: x += dt/6 (k1 + 2 k2 + 2 k3 + k4) */",
-        f"            {sd}(0, m, x, tau{blk}, k1);",
+        f"            {sd}(0, m, x, tau{blk}, k1, 0);",
         stage.format(h="0.5 * dt", k="k1"),
-        f"            {sd}(0, m, xt, tau{blk}, k2);",
+        f"            {sd}(0, m, xt, tau{blk}, k2, 0);",
         stage.format(h="0.5 * dt", k="k2"),
-        f"            {sd}(0, m, xt, tau{blk}, k3);",
+        f"            {sd}(0, m, xt, tau{blk}, k3, 0);",
         stage.format(h="dt", k="k3"),
-        f"            {sd}(0, m, xt, tau{blk}, k4);",
+        f"            {sd}(0, m, xt, tau{blk}, k4, 0);",
         "            for (int i = 0; i < m * NX; ++i)",
         "                x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);",
         "        } else {",
         "            /* semi-implicit Euler: qd += dt qdd(q, qd); q += dt qd (new qd) */",
-        f"            {sd}(0, m, x, tau{blk}, k1);",
+        f"            {sd}(0, m, x, tau{blk}, k1, 0);",
         "            for (int j = 0; j < m; ++j) {",
         "                for (int i = 0; i < N; ++i) x[j * NX + N + i] += dt * k1[j * NX + N + i];",
         "                for (int i = 0; i < N; ++i) x[j * NX + i] += dt * x[j * NX + N + i];",

@@ -32,6 +32,7 @@ from robodyn.codegen.build import (
     find_compiler,
 )
 from robodyn.codegen.c import CPrinter
+from robodyn.codegen.c_outputs import STREAM_MIN_BYTES
 from robodyn.codegen.kernels import (
     DERIVATIVE_KERNEL_NAMES,
     REGRESSOR_DERIVATIVE_KERNEL_NAMES,
@@ -573,7 +574,13 @@ class Model:
         out = np.empty(out_shape) if target is None else target
         ptrs = [ffi.from_buffer("double[]", a) for a in args]
         out_ptr = ffi.from_buffer("double[]", out)
-        if batch_shape and threads > 1:
+        staged = getattr(lib, f"{_PREFIX}{name}_batch_stream", None) if batch_shape else None
+        if staged is not None:
+            # streaming stores into a large reused matrix; cached ones into fresh memory, whose
+            # lines the operating system has just zeroed through the cache
+            stream = int(target is not None and out.nbytes >= STREAM_MIN_BYTES)
+            staged(batch_shape[0], threads, stream, *ptrs, out_ptr)
+        elif batch_shape and threads > 1:
             getattr(lib, f"{_PREFIX}{name}_batch_threads")(batch_shape[0], threads, *ptrs, out_ptr)
         elif batch_shape:
             getattr(lib, f"{_PREFIX}{name}_batch")(batch_shape[0], *ptrs, out_ptr)
