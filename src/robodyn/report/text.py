@@ -6,9 +6,12 @@ import sys
 import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
 import numpy as np
-from tqdm import tqdm
+
+if TYPE_CHECKING:
+    from tqdm import tqdm
 
 
 def err(*args: object) -> None:
@@ -16,7 +19,7 @@ def err(*args: object) -> None:
 
 
 #: The progress bar of the innermost :func:`steps` block (empty when none is shown).
-_BARS: list[tqdm] = []
+_BARS: list[tqdm] = []  # (tqdm is imported by steps(): 40 ms the CLI's start-up does not need)
 
 
 @contextmanager
@@ -26,6 +29,8 @@ def steps(total: int, desc: str) -> Iterator[None]:
     Shown on a terminal only; elsewhere (pipes, logs, tests) each step prints its plain
     ``label... 2.1 s`` line as without a bar.
     """
+    from tqdm import tqdm
+
     bar = tqdm(total=total, desc=desc, unit="step", file=sys.stderr, disable=not sys.stderr.isatty(),
                bar_format="{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} [{elapsed}] {postfix}")
     if bar.disable:
@@ -50,7 +55,7 @@ def progress(label: str) -> Iterator[None]:
             yield
         finally:
             bar.update(1)
-            tqdm.write(f"{label}: {time.perf_counter() - start:.1f} s", file=sys.stderr)
+            bar.write(f"{label}: {time.perf_counter() - start:.1f} s", file=sys.stderr)
         return
     print(f"{label}...", end=" ", file=sys.stderr, flush=True)
     try:
