@@ -30,13 +30,3 @@ def test_import_is_light():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == ""
 
-
-def test_command_line_start_up_is_light():
-    # the command line's parser (every subcommand) needs NumPy at most: SymPy, SciPy, tqdm and
-    # the plotting and data stacks wait for the command that uses them (robodyn calibrate's
-    # start-up budget, issue 12)
-    code = ("import sys, robodyn.cli; robodyn.cli._parser(); heavy = [m for m in ('sympy', 'scipy', "
-            "'cvxpy', 'dask', 'pandas', 'matplotlib', 'tqdm', 'jinja2') if m in sys.modules]; "
-            "print(','.join(heavy))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == ""

@@ -227,8 +227,6 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         # before: the nominal kinematics placed in the instrument frame, first target
         stats_before = ErrorStats.from_residuals(first - robot_positions(cal.before_robot, held_q))
         validation = (Path(args.validate).name, (held_pts - cal.predict(held_q)).reshape(-1, 3))
-    from robodyn.report.calibration_report import calibration_html  # matplotlib: after the solve
-
     paths = write_calibration(cal, args.output, stem=stem)
     if validation is not None:
         report = json.loads(paths["json"].read_text(encoding="utf-8"))
@@ -237,8 +235,11 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         if rot_stats is not None:
             report["validation"]["orientation_after_rad"] = rot_stats.__dict__
         paths["json"].write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
-    paths["html"] = calibration_html(cal, output_path(args.output, stem, "_report.html"),
-                                     source=str(args.data), validation=validation)
+    if not args.no_report:
+        from robodyn.report.calibration_report import calibration_html  # matplotlib: after the solve
+
+        paths["html"] = calibration_html(cal, output_path(args.output, stem, "_report.html"),
+                                         source=str(args.data), validation=validation)
     print(cal.summary())
     if validation is not None:
         print(f"\nheld-out ({args.validate}), after calibration: {stats.text()}")
@@ -410,6 +411,9 @@ def _calibrate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: st
     p.add_argument("--nongeometric", action="append", choices=("compliance", "harmonics"),
                    help="add joint compliance (gravity model) and/or transmission errors (ratio, "
                         "first harmonics); repeat for both")
+    p.add_argument("--no-report", action="store_true",
+                   help="skip the HTML report and its figure (about 0.7 s of plotting); the YAML, "
+                        "URDF, JSON, text report and residual CSV are written as always")
     p.add_argument("--stem", help="file name stem (default: ROBOT_calibrated)")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
     p.set_defaults(func=_cmd_calibrate)

@@ -80,6 +80,21 @@ def test_nongeometric_option_writes_the_terms(data, tmp_path):
     assert "q2.compliance" in (tmp_path / "puma560_calibrated_terms.yaml").read_text()
 
 
+def test_no_report_skips_only_the_html(data, tmp_path, capsys):
+    a, b = tmp_path / "with", tmp_path / "without"
+    args = ["calibrate", "puma560", "--data", str(data / "si.csv"), "--model", "hayati"]
+    assert main([*args, "-o", str(a)]) == 0
+    assert main([*args, "--no-report", "-o", str(b)]) == 0
+    assert (a / "puma560_calibrated_report.html").exists()
+    assert (a / "puma560_calibrated_report.png").exists()
+    assert sorted(p.name for p in b.iterdir()) == sorted(
+        p.name for p in a.iterdir() if p.suffix not in (".html", ".png"))
+    # the rest is the same calibration
+    assert (json.loads((b / "puma560_calibrated_report.json").read_text())["parameters"]
+            == json.loads((a / "puma560_calibrated_report.json").read_text())["parameters"])
+    assert "wrote html" not in capsys.readouterr().out.split("puma560_calibrated.yaml")[-1]
+
+
 def test_bad_mapping_and_target_count(data, tmp_path, capsys):
     r = robot("puma560")
     with pytest.raises(DataFileError, match="names joint 'q9', which puma560 does not have"):

@@ -12,7 +12,7 @@ import json
 import subprocess
 import sys
 
-HEAVY = ("sympy", "matplotlib", "dask", "pandas", "cffi", "jinja2", "yourdfpy", "trimesh",
+HEAVY = ("sympy", "matplotlib", "dask", "pandas", "cffi", "jinja2", "yourdfpy", "trimesh", "tqdm",
          "scipy.optimize", "robodyn.symbolic", "robodyn.simulate", "robodyn.identify",
          "robodyn.calibrate", "robodyn.codegen")
 
