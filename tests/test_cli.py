@@ -277,3 +277,32 @@ def test_mathml_fragment(trolley_kane):
     frag = render_mathml(trolley_kane)
     assert frag.count("<math") == 4 and "&#x00A8;" in frag  # double dot of qdd
 
+
+
+@pytest.mark.parametrize(("argv", "code", "out", "err"), [
+    (["show", "planar_2r"], 0, "robot planar_2r: 2 joints", ""),
+    (["show", "no_such_robot"], 2, "", "robodyn: error: no_such_robot: no such file"),
+])
+def test_console_command_exit_code_and_streams(argv, code, out, err):
+    # the console command (robodyn.cli:run, also `python -m robodyn.cli`) ends without the
+    # interpreter's teardown: its exit code and everything printed must still arrive
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-m", "robodyn.cli", *argv], capture_output=True,
+                          text=True)
+    assert proc.returncode == code
+    assert out in proc.stdout and err in proc.stderr
+    if code == 0:
+        assert proc.stdout.rstrip().splitlines() == _show_lines(argv)
+
+
+def _show_lines(argv):
+    """The same command's output through main() in this process."""
+    import contextlib
+    import io
+
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        assert main(argv) == 0
+    return buf.getvalue().rstrip().splitlines()

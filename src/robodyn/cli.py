@@ -12,8 +12,10 @@ output); 130 interrupted.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import textwrap
+import threading
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -396,5 +398,25 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 130
 
 
+def run() -> None:
+    """The ``robodyn`` console command: :func:`main`, then a quick exit.
+
+    Tearing SymPy, SciPy and matplotlib down at interpreter exit takes 0.4 s or more, as long as
+    some commands' whole work. Once the command has returned (its files written and closed),
+    the standard streams are flushed and the process ends without that teardown, unless a
+    thread or a child process is still running: then the normal exit cleans them up.
+    """
+    code = main()
+    children = "multiprocessing" in sys.modules and sys.modules["multiprocessing"].active_children()
+    if threading.active_count() > 1 or children:
+        sys.exit(code)
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+    except (OSError, ValueError):  # a closed pipe or stream: the normal exit reports it
+        sys.exit(code)
+    os._exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run()
