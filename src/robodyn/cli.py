@@ -243,7 +243,29 @@ def _parser() -> argparse.ArgumentParser:
                "Run 'robodyn COMMAND --help' for the options of a command.")
     parser.add_argument("--version", action="version", version=f"robodyn {rd.__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    _add_model_parsers(sub, fmt)
+    _add_output_parsers(sub, fmt)
+    add_parsers(sub, fmt, _ROBOT_HELP)
+    add_identify_parsers(sub, fmt, _ROBOT_HELP)
+    add_record_parser(sub, fmt, _ROBOT_HELP)
+    add_excite_parsers(sub, fmt, _ROBOT_HELP)
+    add_cache_parser(sub, fmt)
+    add_sweep_parser(sub, fmt)
+    add_underwater_parser(sub, fmt)
+    _add_demo_parser(sub, fmt)
+    for command in ("show", "derive", "check", "codegen", "export", "simulate", "calibrate"):
+        sub.choices[command].add_argument(
+            "--tool", metavar="LINK",
+            help="URDF only: the link whose frame is the end effector, e.g. tool0 or flange "
+                 "(default: the end of the fixed joints after the last moving joint, or the "
+                 "last moving link when they branch)")
+    for each in (parser, *sub.choices.values()):
+        each.description = textwrap.fill(each.description or "", width=88)
+    return parser
 
+
+def _add_model_parsers(sub: argparse._SubParsersAction, fmt: type) -> None:
+    """``list``, ``show``, ``derive`` and ``check``."""
     p = sub.add_parser("list", help="list the built-in robots", formatter_class=fmt,
                        description="List the built-in robots: name, number of joints, joint "
                                    "types (R revolute, P prismatic) and named parameters.",
@@ -294,6 +316,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     p.set_defaults(func=_cmd_check)
 
+
+def _add_output_parsers(sub: argparse._SubParsersAction, fmt: type) -> None:
+    """``codegen`` and ``export``: source code and model files."""
     p = sub.add_parser("codegen", help="generate simulation code (C, Python, MATLAB, Fortran, ...)",
                        formatter_class=fmt,
                        description="Generate inverse dynamics, mass matrix, Coriolis, gravity, "
@@ -324,14 +349,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="FILE", help="output file (default: stdout)")
     p.set_defaults(func=_cmd_export)
 
-    add_parsers(sub, fmt, _ROBOT_HELP)
-    add_identify_parsers(sub, fmt, _ROBOT_HELP)
-    add_record_parser(sub, fmt, _ROBOT_HELP)
-    add_excite_parsers(sub, fmt, _ROBOT_HELP)
-    add_cache_parser(sub, fmt)
-    add_sweep_parser(sub, fmt)
-    add_underwater_parser(sub, fmt)
 
+def _add_demo_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
+    """``demo``: the PUMA 560 pipeline and its report."""
     p = sub.add_parser("demo", help="PUMA 560 three ways: files, comparison and HTML report",
                        formatter_class=fmt,
                        description="Derive the PUMA 560 by the three formulations, check that "
@@ -347,15 +367,6 @@ def _parser() -> argparse.ArgumentParser:
                    help="number of random states for the agreement check (default: %(default)s)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     p.set_defaults(func=_cmd_demo)
-    for command in ("show", "derive", "check", "codegen", "export", "simulate", "calibrate"):
-        sub.choices[command].add_argument(
-            "--tool", metavar="LINK",
-            help="URDF only: the link whose frame is the end effector, e.g. tool0 or flange "
-                 "(default: the end of the fixed joints after the last moving joint, or the "
-                 "last moving link when they branch)")
-    for each in (parser, *sub.choices.values()):
-        each.description = textwrap.fill(each.description or "", width=88)
-    return parser
 
 
 def _positive(text: str) -> int:
