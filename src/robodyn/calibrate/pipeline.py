@@ -36,7 +36,7 @@ from robodyn.calibrate.kinematics import hom, inv
 from robodyn.calibrate.models import MODELS, ErrorModel, build_model, extend_model, model_frames
 from robodyn.calibrate.nominal import RobotGeometry, default_frame0, robot_geometry
 from robodyn.calibrate.result import Calibration, ErrorStats, Parameter
-from robodyn.calibrate.solve import LOSSES, fit, rotation_vector
+from robodyn.calibrate.solve import LOSSES, Fit, fit, rotation_vector
 from robodyn.calibrate.to_robot import calibrated_robot
 from robodyn.robot.model import Robot
 
@@ -418,36 +418,112 @@ def calibrate(
     """
     _check_options(model, loss, initial, nongeometric, payload, identify_payload, deflection,
                    circle_data)
+    q, points, orientations, sig, sigma_rot, geometry = _prepared_data(
+        robot, q, points, orientations, sigma, sigma_rot, length_unit, angle_unit)
+    oriented = orientations is not None
+    pts3 = points if points.ndim == 3 else points[:, None]
+    sig3 = sig.reshape(pts3.shape)
+    world, target, placed, placed_params, before_res = _before_calibration(
+        geometry, q, pts3, orientations, sig3, sigma_rot, points.shape)
+    em, cp = _error_model(robot, geometry, model, initial, circle_data, target, world, oriented,
+                          parallel_tol, q, pts3, nongeometric, payload, identify_payload, deflection)
+    points = pts3.reshape(-1, 3)
+    sig = sig3.reshape(-1, 3)
+    res, unid = _identify(robot, em, model, q, points, sig, orientations, sigma_rot, pts3.shape[1],
+                          loss, loss_scale, max_nfev, identify_payload)
+    if not res.success:
+        warnings.warn(f"calibration of {robot.name} did not converge: {res.message}", RuntimeWarning,
+                      stacklevel=2)
+    _warn_variance_factor(robot.name, res.variance_factor)
+    return _calibration(robot, geometry, em, res, unid, q, sig, before_res, placed, placed_params, loss,
+                        initial, cp)
+
+
+def _prepared_data(robot: Robot, q, points, orientations, sigma, sigma_rot: float, length_unit: str,
+                   angle_unit: str,
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray, float, RobotGeometry]:
+    """The data of :func:`calibrate` in m and rad, checked, with the robot's nominal geometry.
+
+    Returns
+    -------
+    q : numpy.ndarray, shape (N, n)
+        Joint readings, rad (m for prismatic joints).
+    points : numpy.ndarray, shape (N, 3) or (N, K, 3)
+        Measured target positions, m.
+    orientations : numpy.ndarray or None, shape (N, 3, 3)
+    sigma : numpy.ndarray, shape of ``points``
+        Standard uncertainty of each coordinate, m.
+    sigma_rot : float
+        Standard uncertainty of an orientation, rad.
+    geometry : RobotGeometry
+    """
     q, points, sigma, sigma_rot = convert_units(robot, q, points, sigma, sigma_rot, length_unit,
                                                 angle_unit)
     q, points, orientations, sig = check_data(robot, q, points, orientations, sigma)
     geometry = robot_geometry(robot)
     check_magnitude(geometry, q, points, length_unit)
-    oriented = orientations is not None
-    pts3 = points if points.ndim == 3 else points[:, None]
-    sig3 = sig.reshape(pts3.shape)
-    k_count = pts3.shape[1]
+    return q, points, orientations, sig, sigma_rot, geometry
+
+
+def _before_calibration(geometry: RobotGeometry, q: np.ndarray, pts3: np.ndarray,
+                        orientations: np.ndarray | None, sig3: np.ndarray, sigma_rot: float,
+                        shape: tuple[int, ...],
+                        ) -> tuple[np.ndarray, np.ndarray, ErrorModel, np.ndarray, np.ndarray]:
+    """The nominal model placed on the measurements, and its ("before") residuals.
+
+    ``q`` is (N, n); ``pts3`` (N, K, 3) the measured positions and ``sig3`` (N, K, 3) their
+    uncertainties, m; ``orientations`` (N, 3, 3) or None, ``sigma_rot`` in rad; ``shape`` that of
+    the points as given, (N, 3) or (N, K, 3).
+
+    Returns
+    -------
+    world : numpy.ndarray, shape (4, 4)
+        The robot world frame in the instrument frame.
+    target : numpy.ndarray, shape (4, 4)
+        The first target's frame at ``q = 0``, instrument frame.
+    placed : ErrorModel
+        The placed nominal DH model.
+    placed_params : numpy.ndarray, shape (P,)
+    before_res : numpy.ndarray, shape ``shape``
+        Residuals of the placed nominal model (with every target's offset fitted), m.
+    """
     world, before1, placed, placed_params = nominal_placement(geometry, q, pts3[:, 0], orientations,
                                                               sig3[:, 0], sigma_rot)
     _, before_k = target_offsets(placed, placed_params, q, pts3[:, 1:])
-    before_res = np.concatenate((before1[:, None], before_k), axis=1).reshape(points.shape)
+    before_res = np.concatenate((before1[:, None], before_k), axis=1).reshape(shape)
     target = model_frames(placed, placed_params)[2]
-    em, cp = _error_model(robot, geometry, model, initial, circle_data, target, world, oriented,
-                          parallel_tol, q, pts3, nongeometric, payload, identify_payload, deflection)
-    points = pts3.reshape(-1, 3)
-    sig = sig3.reshape(-1, 3)
+    return world, target, placed, placed_params, before_res
+
+
+def _identify(robot: Robot, em: ErrorModel, model: str, q: np.ndarray, points: np.ndarray,
+              sig: np.ndarray, orientations: np.ndarray | None, sigma_rot: float, k_count: int,
+              loss: str, loss_scale: float, max_nfev: int | None, identify_payload: bool,
+              ) -> tuple[Fit, list[Unidentifiable]]:
+    """The identifiable parameters of ``em`` and their fit from its initial values.
+
+    With ``identify_payload``, identifiability is checked again at the solution and the fit
+    repeated from it while the identifiable set grows (at most three more times).
+
+    ``q`` is (N, n); ``points`` (N * K, 3) the measured positions (the K = ``k_count`` targets of
+    each pose together) and ``sig`` (N * K, 3) their uncertainties, m; ``orientations``
+    (N, 3, 3) or None, ``sigma_rot`` in rad.
+
+    Returns
+    -------
+    fit : Fit
+    unidentifiable : list of Unidentifiable
+        Those of the last identifiability check.
+
+    Raises
+    ------
+    ValueError
+        Too few poses for the identifiable parameters.
+    """
+    oriented = orientations is not None
     weights = 1.0 / sig
     rot_weight = 1.0 / sigma_rot if oriented else 0.0
     free, unid = identifiable_parameters(robot, em, em.initial, q, weights, rot_weight)
-    rows = q.shape[0] * (3 * k_count + (3 if oriented else 0))
-    n_struct = em.n_params - sum(u.kind == "structural" for u in unid)
-    if rows <= n_struct:
-        per = 3 * k_count + (3 if oriented else 0)
-        raise ValueError(
-            f"too few poses: {len(q)} poses give {rows} equations for {n_struct} identifiable "
-            f"parameters of the {model} model of {robot.name}; at least {n_struct // per + 1} poses "
-            "are needed (several times more for a useful calibration)"
-        )
+    _check_pose_count(robot, em, model, unid, q, k_count, oriented)
     res = fit(em, em.initial, free, q, points, sigma=sig, orientations=orientations,
               sigma_rot=sigma_rot, loss=loss, loss_scale=loss_scale, max_nfev=max_nfev)
     for _ in range(3 if identify_payload else 0):
@@ -460,16 +536,49 @@ def calibrate(
         free, unid = again, unid_again
         res = fit(em, res.params, free, q, points, sigma=sig, orientations=orientations,
                   sigma_rot=sigma_rot, loss=loss, loss_scale=loss_scale, max_nfev=max_nfev)
-    if not res.success:
-        warnings.warn(f"calibration of {robot.name} did not converge: {res.message}", RuntimeWarning,
-                      stacklevel=2)
-    _warn_variance_factor(robot.name, res.variance_factor)
+    return res, unid
+
+
+def _check_pose_count(robot: Robot, em: ErrorModel, model: str, unid: Sequence[Unidentifiable],
+                      q: np.ndarray, k_count: int, oriented: bool) -> None:
+    """Refuse fewer equations than structurally identifiable parameters (ValueError).
+
+    ``q`` is (N, n); each pose gives 3 equations per target (``k_count`` of them) and 3 more
+    with a measured orientation.
+    """
+    rows = q.shape[0] * (3 * k_count + (3 if oriented else 0))
+    n_struct = em.n_params - sum(u.kind == "structural" for u in unid)
+    if rows <= n_struct:
+        per = 3 * k_count + (3 if oriented else 0)
+        raise ValueError(
+            f"too few poses: {len(q)} poses give {rows} equations for {n_struct} identifiable "
+            f"parameters of the {model} model of {robot.name}; at least {n_struct // per + 1} poses "
+            "are needed (several times more for a useful calibration)"
+        )
+
+
+def _calibration(robot: Robot, geometry: RobotGeometry, em: ErrorModel, res: Fit,
+                 unid: Sequence[Unidentifiable], q: np.ndarray, sig: np.ndarray,
+                 before_res: np.ndarray, placed: ErrorModel, placed_params: np.ndarray, loss: str,
+                 initial: str, cp: CirclePointResult | None) -> Calibration:
+    """The :class:`Calibration` of a fit: parameters with uncertainties, statistics, robots.
+
+    Parameters
+    ----------
+    q : numpy.ndarray, shape (N, n)
+    sig : numpy.ndarray, shape (N * K, 3)
+        Standard uncertainties of the measured coordinates, m.
+    before_res : numpy.ndarray, shape (N, 3) or (N, K, 3)
+        Residuals of the placed nominal model, m (the shape of the measured points).
+    placed : ErrorModel
+        The placed nominal model, with its parameters ``placed_params`` (P',).
+    """
     std = np.sqrt(np.diag(res.covariance))
     parameters = tuple(
         Parameter(em.names[k], float(res.params[k]), float(s), float(em.initial[k]), em.units[k])
         for k, s in zip(res.free, std, strict=True)
     )
-    obs = observability(_rows(em, res.params, q, np.ones((len(points), 3)), 1.0)[:, res.free], len(q))
+    obs = observability(_rows(em, res.params, q, np.ones((len(sig), 3)), 1.0)[:, res.free], len(q))
     return Calibration(
         robot=calibrated_robot(robot, geometry, em, res.params),
         model=em,
