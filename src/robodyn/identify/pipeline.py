@@ -20,7 +20,7 @@ Steps (each a function of its own module):
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -196,6 +196,105 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         Joints not matching the robot, NaN, a missing target, too few samples for the
         parameters, an unknown option, an infeasible or failed semidefinite program.
     """
+    recs, target, pays = _checked_inputs(robot, recordings, target, method, friction, weights,
+                                         state_noise, gains, payloads)
+    data = _prepared(robot, recs, target, friction, cutoff, decimate, velocity, model)
+    drive, prior, loads = _gains_and_prior(robot, data, pays, target, gains, friction)
+    step = _linear_step(robot, data, drive.k, loads, prior, method, regularization, weights,
+                        state_noise)
+    theta, standard = _estimate_standard(robot, data.relations, step, prior, method, bounds)
+    result = _identification(robot, data, step, theta, standard, drive, target, method)
+    if friction in NONLINEAR:
+        result = replace(result, friction_fit=fit_friction_samples(result, data.samples, data.y_full,
+                                                                    friction))
+    return result
+
+
+@dataclass(frozen=True, eq=False)
+class _Prepared:
+    """The processed data of :func:`identify` (steps 2 and 3).
+
+    Attributes
+    ----------
+    settings : Preprocess
+        The resolved preprocessing settings.
+    model : Model
+        The compiled model of the robot.
+    relations : BaseRelations
+        The base relations (without the friction columns for ``friction="none"``).
+    samples : list of Samples
+        Processed and decimated samples of each recording, (N_k, n).
+    y_full : list of ndarray
+        Filtered and decimated full regressor of each recording, (N_k, n, 15 n).
+    count : int
+        Total number of samples ``sum N_k`` after decimation.
+    """
+
+    settings: Preprocess
+    model: Model
+    relations: BaseRelations
+    samples: list[Samples]
+    y_full: list[np.ndarray]
+    count: int
+
+
+@dataclass(frozen=True, eq=False)
+class _Drive:
+    """The drive gains of :func:`identify` and where they come from.
+
+    Attributes
+    ----------
+    k : ndarray, shape (n,)
+        Drive gain of each joint, N m / A (ones when absorbed or for ``target="tau"``).
+    source : str
+        Where ``k`` comes from (``Identification.gains_source``).
+    std : ndarray, shape (n,)
+        Standard deviation of ``k``, N m / A (inf when absorbed, NaN when unknown).
+    """
+
+    k: np.ndarray
+    source: str
+    std: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class _LinearStep:
+    """The stacked identification problem of :func:`identify` and its linear fit (m = sum N_k n).
+
+    Attributes
+    ----------
+    phi : ndarray, shape (m, b)
+        Identification matrix restricted to the base columns.
+    y : ndarray, shape (m,)
+        Target in torque units with the payload torque taken off, N m.
+    joint : ndarray, shape (m,)
+        Joint of each row.
+    blocks : ndarray, shape (m,)
+        Cross-validation block of each row.
+    theta0 : ndarray, shape (b,)
+        Base parameters of the prior.
+    fit : LinearFit
+        The (weighted) least-squares fit.
+    """
+
+    phi: np.ndarray
+    y: np.ndarray
+    joint: np.ndarray
+    blocks: np.ndarray
+    theta0: np.ndarray
+    fit: LinearFit
+
+
+def _checked_inputs(robot: Robot, recordings: Any, target: str | None, method: str, friction: str,
+                    weights: str, state_noise: Any, gains: str,
+                    payloads: Sequence[Payload | None] | None
+                    ) -> tuple[list[Any], str, list[Payload | None]]:
+    """The recordings as a list, the resolved target and one payload per recording (step 1).
+
+    Raises :class:`IdentificationError` on no recordings, an unknown option, missing state
+    noise for ``weights="state-noise"``, a recording that does not fit ``robot``
+    (:func:`check_recording`) or malformed payloads.
+    """
     recs = [recordings] if hasattr(recordings, "q") else list(recordings)
     if not recs:
         raise IdentificationError("recordings: none given")
@@ -216,7 +315,16 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         raise IdentificationError(f"gains: expected 'auto', 'description' or 'absorbed', got {gains!r}")
     for i, rec in enumerate(recs):
         check_recording(robot, rec, i, target)
-    pays = _check_payloads(payloads, len(recs))
+    return recs, target, _check_payloads(payloads, len(recs))
+
+
+def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff: float | str | None,
+              decimate: int | str, velocity: str, model: Model | None) -> _Prepared:
+    """Preprocessed samples, filtered regressors and base relations of ``recs`` (steps 2 and 3).
+
+    ``model`` is compiled from ``robot`` when None. Raises :class:`IdentificationError` when the
+    ``sum N_k n`` equations left after decimation are fewer than twice the ``b`` base parameters.
+    """
     settings = resolve_preprocess(recs, cutoff, decimate, velocity)
     model = model if model is not None else compile_model(robot)
     relations = base_relations(model)
@@ -232,60 +340,117 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
             f"recordings: too few samples for the parameters: {count} samples x {robot.dof} joints "
             f"= {count * robot.dof} equations after decimation by {settings.decimate} for {b} base "
             f"parameters (at least {2 * b} needed; record longer or pass decimate=1)")
+    return _Prepared(settings, model, relations, samples, y_full, count)
+
+
+def _gains_and_prior(robot: Robot, data: _Prepared, pays: list[Payload | None], target: str,
+                     gains: str, friction: str) -> tuple[_Drive, np.ndarray, list[np.ndarray]]:
+    """Drive gains, the prior (15 n,) and the payload torque (N_k, n), N m, of each recording (step 5).
+
+    With ``target="current"`` and a payload in some recording, the gains are estimated from the
+    payload runs (:func:`_payload_gains`); for ``friction="none"`` the prior has no friction.
+    """
     nominal = nominal_standard(robot)
     loads = [np.zeros_like(s.q) if p is None else payload_torque(y, payload_standard(robot, p))
-             for s, y, p in zip(samples, y_full, pays, strict=True)]
+             for s, y, p in zip(data.samples, data.y_full, pays, strict=True)]
     has_payload = any(p is not None for p in pays)
-    k, k_source, prior = joint_prior(robot, samples, y_full, nominal, target, gains)
-    k_std = np.full(robot.dof, np.inf if k_source.startswith("absorbed") else np.nan)
+    k, k_source, prior = joint_prior(robot, data.samples, data.y_full, nominal, target, gains)
+    drive = _Drive(k, k_source, np.full(robot.dof, np.inf if k_source.startswith("absorbed") else np.nan))
     if target == "current" and has_payload:
-        phi, y, joint, _ = _stack(samples, y_full, relations.independent, np.ones(robot.dof),
-                                  [np.zeros_like(x) for x in loads])
-        est = estimate_drive_gains(phi, y, np.concatenate([x.reshape(-1) for x in loads]), joint,
-                                   robot.joint_names)
-        # the prior's drive and friction terms were fitted in the units of the absorbed gains
-        for j in range(robot.dof):
-            prior[PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)] *= est.gains[j] / k[j]
-        k, k_source, k_std = est.gains, "payload", est.std
+        drive = _payload_gains(robot, data, loads, drive, prior)
     if friction == "none":
         prior = without_friction(prior)
-    phi, y, joint, blocks = _stack(samples, y_full, relations.independent, k, loads)
-    theta0 = relations.to_base(prior)
+    return drive, prior, loads
+
+
+def _payload_gains(robot: Robot, data: _Prepared, loads: list[np.ndarray], drive: _Drive,
+                   prior: np.ndarray) -> _Drive:
+    """Drive gains (n,), N m / A, estimated from runs with and without a payload.
+
+    ``loads`` (N_k, n) is the payload torque of each recording, N m. The drive and friction
+    terms of ``prior`` (15 n,), fitted in the units of ``drive.k``, are rescaled in place to the
+    estimated gains.
+    """
+    k = drive.k
+    phi, y, joint, _ = _stack(data.samples, data.y_full, data.relations.independent, np.ones(robot.dof),
+                              [np.zeros_like(x) for x in loads])
+    est = estimate_drive_gains(phi, y, np.concatenate([x.reshape(-1) for x in loads]), joint,
+                               robot.joint_names)
+    # the prior's drive and friction terms were fitted in the units of the absorbed gains
+    for j in range(robot.dof):
+        prior[PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)] *= est.gains[j] / k[j]
+    return _Drive(est.gains, "payload", est.std)
+
+
+def _linear_step(robot: Robot, data: _Prepared, k: np.ndarray, loads: list[np.ndarray],
+                 prior: np.ndarray, method: str, regularization: float | str | None, weights: str,
+                 state_noise: Any) -> _LinearStep:
+    """The stacked problem and its (weighted) least-squares fit toward ``prior`` (steps 4 and 6).
+
+    ``k`` (n,) are the drive gains, N m / A, ``loads`` (N_k, n) the payload torques, N m, and
+    ``prior`` (15 n,) the standard parameters of the prior.
+    """
+    phi, y, joint, blocks = _stack(data.samples, data.y_full, data.relations.independent, k, loads)
+    theta0 = data.relations.to_base(prior)
     lin_method = "ols" if method == "ols" else "wls"
     fit = fit_linear(phi, y, theta0, joint, blocks, method=lin_method, regularization=regularization)
+    step = _LinearStep(phi, y, joint, blocks, theta0, fit)
     if weights == "state-noise":
-        noise = state_noise_std(state_noise, robot.dof)
-        first = _complete(relations, fit.theta, prior)
-        var = np.concatenate([torque_variance(model, s.q, s.qd, s.qdd, *noise, standard=first)
-                              for s in samples]).reshape(-1)
-        # sigma_meas^2: what the propagated variance leaves of each joint's residual variance
-        prop = np.array([np.mean(var[joint == j]) for j in range(robot.dof)])
-        meas = np.maximum(fit.sigma**2 - prop, MEAS_FLOOR * fit.sigma**2)
-        fit = fit_linear(phi, y, theta0, joint, blocks, regularization=regularization,
-                         row_sigma=np.sqrt(meas[joint] + var))
+        step = replace(step, fit=_state_noise_fit(robot, data, step, prior, regularization, state_noise))
+    return step
+
+
+def _state_noise_fit(robot: Robot, data: _Prepared, step: _LinearStep, prior: np.ndarray,
+                     regularization: float | str | None, state_noise: Any) -> LinearFit:
+    """The fit again with row weights ``1 / sigma_tau`` (m,) from the first fit ``step.fit``.
+
+    ``sigma_tau^2`` (N m^2) is the state noise propagated through the first fit's model plus the
+    measurement variance of each joint, floored at ``MEAS_FLOOR`` times its residual variance.
+    """
+    noise = state_noise_std(state_noise, robot.dof)
+    first = _complete(data.relations, step.fit.theta, prior)
+    var = np.concatenate([torque_variance(data.model, s.q, s.qd, s.qdd, *noise, standard=first)
+                          for s in data.samples]).reshape(-1)
+    # sigma_meas^2: what the propagated variance leaves of each joint's residual variance
+    prop = np.array([np.mean(var[step.joint == j]) for j in range(robot.dof)])
+    meas = np.maximum(step.fit.sigma**2 - prop, MEAS_FLOOR * step.fit.sigma**2)
+    return fit_linear(step.phi, step.y, step.theta0, step.joint, step.blocks,
+                      regularization=regularization, row_sigma=np.sqrt(meas[step.joint] + var))
+
+
+def _estimate_standard(robot: Robot, relations: BaseRelations, step: _LinearStep, prior: np.ndarray,
+                       method: str, bounds: dict[str, tuple[float, float]] | None
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """Base parameters (b,) and the full standard set (15 n,) of the estimate (steps 6 and 7).
+
+    ``method="consistent"``: the physically consistent standard set; otherwise the linear fit
+    completed with ``prior`` (15 n,) for the dependent parameters.
+    """
     if method == "consistent":
         from robodyn.identify.consistent import consistent_standard
 
-        standard = consistent_standard(robot, relations, phi, y, joint, fit, prior, bounds)
-        theta = relations.to_base(standard)
-    else:
-        theta = fit.theta
-        standard = _complete(relations, theta, prior)
-    table = _table(relations, theta, fit, theta0)
-    ident_robot = robot_with_parameters(robot, standard, k if target == "current" else None,
+        standard = consistent_standard(robot, relations, step.phi, step.y, step.joint, step.fit, prior,
+                                       bounds)
+        return relations.to_base(standard), standard
+    theta = step.fit.theta
+    return theta, _complete(relations, theta, prior)
+
+
+def _identification(robot: Robot, data: _Prepared, step: _LinearStep, theta: np.ndarray,
+                    standard: np.ndarray, drive: _Drive, target: str, method: str) -> Identification:
+    """The :class:`Identification` of base parameters ``theta`` (b,) and standard set (15 n,)."""
+    table = _table(data.relations, theta, step.fit, step.theta0)
+    ident_robot = robot_with_parameters(robot, standard, drive.k if target == "current" else None,
                                         source=f"identified ({method}) from {robot.source}")
-    s = fit.singular_values
-    weak = fit.directions[:, s < UNEXCITED_RTOL * s[0]]
-    result = Identification(
-        robot=ident_robot, base_parameters=table, standard=standard, preprocess=settings,
-        target=target, method=method, gains=k, gains_source=k_source, gains_std=k_std,
-        regularization=fit.lam,
-        condition=fit.condition, singular_values=s, unexcited_directions=weak,
-        residual_std=fit.sigma / k, samples=count, relations=relations,
-        _model=model)
-    if friction in NONLINEAR:
-        result = replace(result, friction_fit=fit_friction_samples(result, samples, y_full, friction))
-    return result
+    s = step.fit.singular_values
+    weak = step.fit.directions[:, s < UNEXCITED_RTOL * s[0]]
+    return Identification(
+        robot=ident_robot, base_parameters=table, standard=standard, preprocess=data.settings,
+        target=target, method=method, gains=drive.k, gains_source=drive.source, gains_std=drive.std,
+        regularization=step.fit.lam,
+        condition=step.fit.condition, singular_values=s, unexcited_directions=weak,
+        residual_std=step.fit.sigma / drive.k, samples=data.count, relations=data.relations,
+        _model=data.model)
 
 
 def _check_payloads(payloads: Any, count: int) -> list[Payload | None]:
