@@ -205,6 +205,50 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         :class:`~robodyn.robot.errors.SingularMassMatrixError` when the mass matrix is singular.
     """
     n = model.dof
+    q0, qd0, batch = _initial_states(q0, qd0, n)
+    count = len(q0) if batch else 1
+    dt, duration, steps, decimate = _step_count(duration, dt, decimate)
+    _check_samples(steps, decimate, count, n, duration, dt, max_samples, batch)
+    _check_options(method, control, substeps, controller)
+    limit = _torque_limit(tau_limit, controller, n)
+    own = _controller_model(controller, model)
+    model, rows = _run_parameters(model, parameters, count, batch)
+    if batch:
+        _check_batch(method, control, substeps, controller, own)
+    if own is not None:
+        # the law with the controller's own model, stepped in Python
+        controller = _with_own_model(controller, own)
+    t = dt * np.arange(0, steps + 1, decimate)
+    if batch:
+        x0 = np.concatenate([q0, qd0], axis=1)
+        x, tau, evals = _run_batch(model, x0, steps, dt, decimate, method, controller, limit,
+                                   threads, rows, control)
+        return _result(model, t, x, tau, method, dt, controller, evals, decimate, rows)
+    x0 = np.concatenate([q0, qd0])
+    x, tau, evals = _run_single(model, x0, t, steps, dt, decimate, method, controller, limit,
+                                control, substeps, max_samples, rtol, atol)
+    return _result(model, t, x, tau, method, dt, controller, evals, decimate)
+
+
+def _initial_states(q0: np.ndarray, qd0: np.ndarray | None,
+                    n: int) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The checked initial state and whether it is a batch.
+
+    Parameters
+    ----------
+    q0 : (n,) or (N, n) array_like
+        Initial joint positions (rad, m).
+    qd0 : (n,) or (N, n) array_like or None
+        Initial velocities (None: at rest).
+    n : int
+        Degrees of freedom.
+
+    Returns
+    -------
+    q0, qd0 : (n,) or (N, n) ndarray
+    batch : bool
+        True when ``q0`` is (N, n).
+    """
     batch = np.ndim(q0) == 2
     if batch:
         q0 = _states(q0, n, "q0")
@@ -212,7 +256,14 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
     else:
         q0 = _vector(q0, n, "q0")
         qd0 = np.zeros(n) if qd0 is None else _vector(qd0, n, "qd0")
-    count = len(q0) if batch else 1
+    return q0, qd0, batch
+
+
+def _step_count(duration: float, dt: float, decimate: int) -> tuple[float, float, int, int]:
+    """The checked ``dt`` (s), ``duration`` (s), number of steps and ``decimate``.
+
+    Raises ValueError unless ``duration`` is a whole number of ``decimate * dt``.
+    """
     dt = _positive(dt, "dt")
     duration = _positive(duration, "duration")
     steps = round(duration / dt)
@@ -224,6 +275,15 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
     if steps % decimate:
         raise ValueError(f"simulate: duration {duration:g} s is {steps} steps of {dt:g} s, not a "
                          f"whole number of decimate = {decimate} steps")
+    return dt, duration, steps, decimate
+
+
+def _check_samples(steps: int, decimate: int, count: int, n: int, duration: float, dt: float,
+                   max_samples: int | None, batch: bool) -> None:
+    """Refuse a run of ``count`` trajectories keeping more than ``max_samples`` samples in all.
+
+    ``duration`` and ``dt`` (s) only word the error message.
+    """
     samples = steps // decimate + 1
     if max_samples is not None and count * samples > max_samples:
         # a batch keeps its samples for every trajectory
@@ -235,6 +295,10 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
             f"{output_bytes(count * samples, n) / 1e6:,.0f} MB of arrays), above max_samples = "
             f"{max_samples:,}; keep every k-th step with decimate=k (k >= {k_min}), shorten the "
             f"run{', split the batch' if batch else ''}, or raise max_samples")
+
+
+def _check_options(method: str, control: str, substeps: int, controller: ControllerLike) -> None:
+    """Refuse an unknown or inconsistent ``substeps``, ``method``, ``control`` or controller."""
     if isinstance(substeps, bool) or not isinstance(substeps, int | np.integer) or substeps < 1:
         raise ValueError(f"simulate: substeps must be a positive integer, got {substeps!r}")
     if substeps > 1 and (control != "sampled" or method not in FIXED_STEP):
@@ -251,10 +315,31 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
     if controller is not None and not callable(controller):
         raise TypeError(f"controller must be a built-in controller, a callable (t, q, qd) -> tau or "
                         f"None, got {type(controller).__name__}")
+
+
+def _torque_limit(tau_limit: float | np.ndarray | None, controller: ControllerLike,
+                  n: int) -> np.ndarray | None:
+    """The actuator limits of the run, (n,) N m (N): ``tau_limit``, else the controller's own.
+
+    None when neither gives one.
+    """
     limit = _tau_limit(tau_limit, n) if tau_limit is not None else None
     if limit is None and isinstance(controller, Controller) and controller.tau_limit is not None:
         limit = _tau_limit(controller.tau_limit, n)
-    own = _controller_model(controller, model)
+    return limit
+
+
+def _run_parameters(model: Model, parameters: ParameterValues, count: int,
+                    batch: bool) -> tuple[Model, np.ndarray | None]:
+    """The plant and the runtime parameter rows of the run.
+
+    Returns
+    -------
+    model : Model
+        ``model``, or for one set of values on a single run the model with those defaults.
+    rows : (N, P) ndarray or None
+        One row per trajectory of a batch; None for the model's own values.
+    """
     rows = None
     if parameters is not None:
         rows = model.parameter_input(parameters, (count,) if batch else (), "simulate")
@@ -265,30 +350,46 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
             model = model.with_parameters(dict(zip(model.runtime_parameters, rows.tolist(),
                                                    strict=True)))
             rows = None
-    if batch:
-        _check_batch(method, control, substeps, controller, own)
-    if own is not None:
-        # the law with the controller's own model, stepped in Python
-        ctrl = controller
+    return model, rows
 
-        def with_own_model(tk: float, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-            return ctrl.law(own, tk, np.concatenate([q, qd]), None)
 
-        with_own_model.__name__ = controller.name
-        controller = with_own_model
-    t = dt * np.arange(0, steps + 1, decimate)
-    x0 = np.concatenate([q0, qd0])
+def _with_own_model(controller: Controller,
+                    own: Model) -> Callable[[float, np.ndarray, np.ndarray], np.ndarray]:
+    """``controller``'s law on its own model ``own``, as a ``(t, q, qd) -> tau`` callable."""
+    ctrl = controller
+
+    def with_own_model(tk: float, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        return ctrl.law(own, tk, np.concatenate([q, qd]), None)
+
+    with_own_model.__name__ = controller.name
+    return with_own_model
+
+
+def _run_batch(model: Model, x0: np.ndarray, steps: int, dt: float, decimate: int, method: str,
+               controller: Controller | None, limit: np.ndarray | None, threads: int,
+               rows: np.ndarray | None, control: str) -> tuple[np.ndarray, np.ndarray, int]:
+    """The batch from ``x0`` (N, 2 n), a blow-up diagnosed on its trajectory.
+
+    Returns ``x`` (N, S, 2 n), ``tau`` (N, S, n) and the evaluations per trajectory.
+    """
+    try:
+        return _fixed_step_batch(model, x0, steps, dt, decimate, method, controller, limit,
+                                 threads, rows)
+    except SimulationError as exc:
+        i = getattr(exc, "trajectory", 0)
+        raise _diagnosed(exc, _member_model(model, rows, i), x0[i], dt, method,
+                         control) from None
+
+
+def _run_single(model: Model, x0: np.ndarray, t: np.ndarray, steps: int, dt: float,
+                decimate: int, method: str, controller: ControllerLike,
+                limit: np.ndarray | None, control: str, substeps: int, max_samples: int | None,
+                rtol: float, atol: float) -> tuple[np.ndarray, np.ndarray, int]:
+    """One run from ``x0`` (2 n,) by ``method``, a fixed-step blow-up diagnosed.
+
+    Returns ``x`` (S, 2 n), ``tau`` (S, n) and the evaluations, ``t`` (S,) s being the samples.
+    """
     continuous = control == "continuous"
-    if batch:
-        x0 = np.concatenate([q0, qd0], axis=1)
-        try:
-            x, tau, evals = _fixed_step_batch(model, x0, steps, dt, decimate, method, controller,
-                                              limit, threads, rows)
-        except SimulationError as exc:
-            i = getattr(exc, "trajectory", 0)
-            raise _diagnosed(exc, _member_model(model, rows, i), x0[i], dt, method,
-                             control) from None
-        return _result(model, t, x, tau, method, dt, controller, evals, decimate, rows)
     try:
         if method in FIXED_STEP and substeps == 1 and (controller is None
                                                        or isinstance(controller, Controller)):
@@ -301,8 +402,7 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         raise _diagnosed(exc, model, x0, dt / substeps, method, control) from None
     if method in ADAPTIVE:
         x, tau, evals = _adaptive(model, x0, t, method, controller, limit, rtol, atol)
-    return _result(model, t, x, tau, method, dt, controller, evals, decimate)
-
+    return x, tau, evals
 
 def output_bytes(samples: int, n: int) -> int:
     """Bytes of the arrays of a :class:`Trajectory` of ``samples`` rows and ``n`` joints."""
