@@ -594,3 +594,33 @@ def test_oversized_description_file_is_refused_before_reading(tmp_path: Path) ->
     pattern = rf"^{re.escape(str(path))}: 4,194,305 bytes is too large for a robot description"
     with pytest.raises(DescriptionError, match=pattern):
         load_yaml_file(path)
+
+
+def test_libyaml_loader_gives_the_pure_python_result() -> None:
+    # descriptions are read by libyaml when PyYAML has it (10-20x faster; CLI start-up), with the
+    # same checks: the data must be exactly what PyYAML's own pure-Python SafeLoader reads
+    import yaml
+
+    from robodyn.robot import yaml_loader
+
+    assert yaml.__with_libyaml__, "PyYAML without libyaml: the fast loader is not exercised"
+    library = Path(yaml_loader.__file__).parent / "library"
+    texts = [p.read_text(encoding="utf-8") for p in sorted(library.glob("*.yaml"))]
+    assert len(texts) >= 9
+    for text in texts:
+        expected = yaml.load(text, Loader=yaml.SafeLoader)  # noqa: S506 - PyYAML's safe loader
+        assert yaml_loader._parse_yaml(text, "t.yaml") == expected
+        assert yaml.load(text, Loader=yaml_loader._CUniqueKeyLoader) == expected  # noqa: S506
+
+
+def test_libyaml_path_keeps_the_duplicate_key_check() -> None:
+    import yaml
+
+    from robodyn.robot import yaml_loader
+
+    with pytest.raises(yaml.constructor.ConstructorError, match="found duplicate key 'name'"):
+        yaml.load("name: a\nname: b\n", Loader=yaml_loader._CUniqueKeyLoader)  # noqa: S506
+    with pytest.raises(yaml.MarkedYAMLError, match=r"YAML alias \*x is not allowed"):
+        yaml_loader._c_events_checked("a: &x [1]\nb: *x\n")
+    with pytest.raises(yaml.MarkedYAMLError, match="nested more than 32 levels deep"):
+        yaml_loader._c_events_checked("a: " + "[" * 33 + "]" * 33 + "\n")
