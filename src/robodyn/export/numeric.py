@@ -15,7 +15,6 @@ from pathlib import Path
 
 import numpy as np
 import sympy as sp
-from scipy.spatial.transform import Rotation
 
 from robodyn.robot.model import Robot
 from robodyn.robot.yaml_writer import matrix_to_rpy
@@ -154,6 +153,8 @@ def rpy(rotation: np.ndarray) -> tuple[float, float, float]:
 
 def quaternion(rotation: np.ndarray) -> np.ndarray:
     """Unit quaternion ``(w, x, y, z)`` of a rotation matrix, shape (3, 3) -> (4,), ``w >= 0``."""
+    from scipy.spatial.transform import Rotation  # scipy.spatial: 0.3 s, MJCF only
+
     x, y, z, w = Rotation.from_matrix(np.asarray(rotation, dtype=float)).as_quat()
     quat = np.array([w, x, y, z])
     return -quat if w < 0 else quat
