@@ -546,10 +546,10 @@ def _check_pose_count(robot: Robot, em: ErrorModel, model: str, unid: Sequence[U
     ``q`` is (N, n); each pose gives 3 equations per target (``k_count`` of them) and 3 more
     with a measured orientation.
     """
-    rows = q.shape[0] * (3 * k_count + (3 if oriented else 0))
+    per = 3 * k_count + (3 if oriented else 0)
+    rows = q.shape[0] * per
     n_struct = em.n_params - sum(u.kind == "structural" for u in unid)
     if rows <= n_struct:
-        per = 3 * k_count + (3 if oriented else 0)
         raise ValueError(
             f"too few poses: {len(q)} poses give {rows} equations for {n_struct} identifiable "
             f"parameters of the {model} model of {robot.name}; at least {n_struct // per + 1} poses "

@@ -357,19 +357,19 @@ def _gains_and_prior(robot: Robot, data: _Prepared, pays: list[Payload | None], 
     k, k_source, prior = joint_prior(robot, data.samples, data.y_full, nominal, target, gains)
     drive = _Drive(k, k_source, np.full(robot.dof, np.inf if k_source.startswith("absorbed") else np.nan))
     if target == "current" and has_payload:
-        drive = _payload_gains(robot, data, loads, drive, prior)
+        drive, prior = _payload_gains(robot, data, loads, drive, prior)
     if friction == "none":
         prior = without_friction(prior)
     return drive, prior, loads
 
 
 def _payload_gains(robot: Robot, data: _Prepared, loads: list[np.ndarray], drive: _Drive,
-                   prior: np.ndarray) -> _Drive:
+                   prior: np.ndarray) -> tuple[_Drive, np.ndarray]:
     """Drive gains (n,), N m / A, estimated from runs with and without a payload.
 
-    ``loads`` (N_k, n) is the payload torque of each recording, N m. The drive and friction
-    terms of ``prior`` (15 n,), fitted in the units of ``drive.k``, are rescaled in place to the
-    estimated gains.
+    ``loads`` (N_k, n) is the payload torque of each recording, N m. Returns the gains and a
+    copy of ``prior`` (15 n,) whose drive and friction terms, fitted in the units of
+    ``drive.k``, are rescaled to the estimated gains.
     """
     k = drive.k
     phi, y, joint, _ = _stack(data.samples, data.y_full, data.relations.independent, np.ones(robot.dof),
@@ -377,9 +377,10 @@ def _payload_gains(robot: Robot, data: _Prepared, loads: list[np.ndarray], drive
     est = estimate_drive_gains(phi, y, np.concatenate([x.reshape(-1) for x in loads]), joint,
                                robot.joint_names)
     # the prior's drive and friction terms were fitted in the units of the absorbed gains
+    prior = prior.copy()
     for j in range(robot.dof):
         prior[PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)] *= est.gains[j] / k[j]
-    return _Drive(est.gains, "payload", est.std)
+    return _Drive(est.gains, "payload", est.std), prior
 
 
 def _linear_step(robot: Robot, data: _Prepared, k: np.ndarray, loads: list[np.ndarray],
