@@ -128,8 +128,7 @@ class CPrinter(Printer):
 
     def signature(self, kernel: Kernel, batch: bool = False, threads: bool = False) -> str:
         """The C prototype (without the trailing semicolon)."""
-        args = [f"const double *restrict {a.name}" for a in kernel.inputs]
-        args += [f"double *restrict {a.name}" for a in kernel.outputs]
+        args = _parameters(kernel)
         if batch and threads:
             return (f"void {self.prefix}{kernel.name}_batch_threads(long count, int threads, "
                     f"{', '.join(args)})")
@@ -210,8 +209,7 @@ class CPrinter(Printer):
         """
         direct = direct or {}
         inline = f"{self.prefix.upper()}NOINLINE " if noinline else ""
-        args = [f"const double *restrict {a.name}" for a in core.inputs]
-        args += [f"double *restrict {a.name}" for a in core.outputs]
+        args = _parameters(core)
         used: set[sp.Basic] = set()
         for _, e in core.body:
             used |= e.free_symbols
@@ -279,8 +277,7 @@ class CPrinter(Printer):
                      "            const long j_ = k0_ + k_;",
                      *gather,
                      "        }"] if gather else []
-        params = ", ".join(f"const double *restrict {a.name}" for a in kernel.inputs)
-        params += ", " + ", ".join(f"double *restrict {a.name}" for a in kernel.outputs)
+        params = ", ".join(_parameters(kernel))
         stream = (f"count >= {-(-STREAM_MIN_BYTES // out.staged_bytes)}L" if out.staged_bytes
                   else "(void)count, 0")
         return "\n".join([
@@ -337,8 +334,7 @@ class CPrinter(Printer):
         names = ", ".join(_names(kernel))
         rng = f"{self.prefix}{kernel.name}_range"
         inner = f"{self.prefix}{kernel.name}_threads_"
-        params = ", ".join([f"const double *restrict {a.name}" for a in kernel.inputs]
-                           + [f"double *restrict {a.name}" for a in kernel.outputs])
+        params = ", ".join(_parameters(kernel))
         lines = [
             f"/* {kernel.name} for count states on `threads` threads (OpenMP; one without). */",
             f"static void {inner}(long count, int threads, int stream, {params}) {{",
@@ -374,8 +370,7 @@ class CPrinter(Printer):
 
     def stream_signature(self, kernel: Kernel) -> str:
         """The C prototype of ``PREFIXk_batch_stream`` (without the trailing semicolon)."""
-        args = [f"const double *restrict {a.name}" for a in kernel.inputs]
-        args += [f"double *restrict {a.name}" for a in kernel.outputs]
+        args = _parameters(kernel)
         return (f"void {self.prefix}{kernel.name}_batch_stream(long count, int threads, int stream, "
                 f"{', '.join(args)})")
 
@@ -448,6 +443,12 @@ def _steps(kernel: Kernel) -> list[sp.Piecewise]:
     for e in [e for _, e in kernel.body] + [sp.sympify(e) for a in kernel.outputs for e in a.entries]:
         found |= {p for p in e.atoms(sp.Piecewise) if p.free_symbols <= inputs}
     return sorted(found, key=sp.default_sort_key)
+
+
+def _parameters(kernel: Kernel) -> list[str]:
+    """C parameter declarations of ``kernel``'s arrays: its inputs (const), then its outputs."""
+    return ([f"const double *restrict {a.name}" for a in kernel.inputs]
+            + [f"double *restrict {a.name}" for a in kernel.outputs])
 
 
 def _arg(name: str, symbols: list[sp.Symbol]) -> Argument:
