@@ -17,6 +17,7 @@ from robodyn.measure.excitation import (
     _null_bases,
     _Problem,
     base_columns,
+    condition_number,
     excitation,
     excitation_limits,
     random_fourier,
@@ -110,14 +111,31 @@ def test_excitation_gradient_analytic_equals_finite_differences(puma, criterion)
         assert slope == pytest.approx(g_a[i], rel=1e-4, abs=1e-6 * scale)
 
 
-def test_design_with_analytic_gradient_no_worse(puma):
-    kwargs = {"harmonics": 4, "seed": 3, "starts": 2, "max_iterations": 25}
-    a = excitation(puma, gradient="analytic", **kwargs)
-    f = excitation(puma, gradient="finite_difference", **kwargs)
-    print(f"PUMA design cond: analytic gradient {a.condition_number:.3f}, "
-          f"finite differences {f.condition_number:.3f}")
-    # the same optimiser from the same starts: the same optimum, or a better one
-    assert a.condition_number <= f.condition_number * (1 + 1e-3)
+def test_design_with_analytic_gradient_improves_on_its_starts(puma):
+    # No optimiser guarantees that one gradient ends at least as low as another from the same
+    # starts (that depends on the path, and so on the CPU's rounding). What holds on any CPU: the
+    # design keeps the best feasible point it visits, the starts included, so its criterion is
+    # at most the best start's (up to the final shrink onto the limits on a finer grid), and it
+    # stays within the limits. The gradient itself is checked against differences above.
+    harmonics, seed, starts = 4, 3, 2
+    a = excitation(puma, gradient="analytic", harmonics=harmonics, seed=seed, starts=starts,
+                   max_iterations=25)
+    # the same random starts, drawn independently of the optimiser
+    rng = np.random.default_rng(seed)
+    cols = base_columns(puma, rng)
+    assert cols == a.columns
+    lim = excitation_limits(puma.robot)
+    k = a.design_samples
+    f = 1.0 / a.series.period
+    t_d = np.arange(k) / (k * f)
+    start_conds = []
+    for _ in range(starts):
+        start = random_fourier(lim, harmonics, f, rng, samples=k)
+        start_conds.append(condition_number(puma, *start.evaluate(t_d), cols))
+    print(f"PUMA design cond: starts {start_conds}, analytic-gradient design {a.condition_number:.3f}")
+    assert np.isfinite(a.condition_number)
+    assert a.condition_number <= min(start_conds) * (1 + 1e-2)
+    assert lim.violation(a.q, a.qd, a.qdd) <= 1e-9
 
 
 def test_unknown_gradient_is_refused(planar):
