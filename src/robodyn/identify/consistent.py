@@ -140,8 +140,37 @@ def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray,
                                   f"status {problem.status!r}")
     out = np.asarray(p.value, dtype=float)
     for j in range(n):
+        _project_link(out, j)
         _check_link(out, j, robot)
     return out
+
+
+def _project_link(p: np.ndarray, j: int) -> None:
+    """Put link ``j``'s pseudo-inertia of ``p`` (15 n,) back into ``J >= EPS I`` in place.
+
+    The interior-point solver meets the LMI only to its own tolerance: a link whose optimum
+    lies on the boundary (a point mass: inertia about the centre of mass near zero) can come
+    back with principal moments of -1e-7 kg m^2. Clipping the eigenvalues of
+    ``J = [[Sigma, h], [h^T, m]]`` (``Sigma = tr(I)/2 1 - I``) at ``EPS`` moves the parameters by
+    at most the solver's tolerance and makes the link exactly consistent.
+    """
+    b = PER_JOINT * j
+    xx, xy, xz, yy, yz, zz, mx, my, mz, m = p[b:b + 10]
+    i_o = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    pseudo = np.zeros((4, 4))
+    # Sigma = tr(I)/2 1 - I,  J = [[Sigma, h], [h^T, m]]
+    pseudo[:3, :3] = 0.5 * np.trace(i_o) * np.eye(3) - i_o
+    pseudo[:3, 3] = pseudo[3, :3] = (mx, my, mz)
+    pseudo[3, 3] = m
+    lam, vec = np.linalg.eigh(pseudo)
+    if lam[0] >= EPS:
+        return
+    pseudo = (vec * np.maximum(lam, EPS)) @ vec.T
+    sigma = 0.5 * (pseudo[:3, :3] + pseudo[:3, :3].T)
+    # I = tr(Sigma) 1 - Sigma
+    i_new = np.trace(sigma) * np.eye(3) - sigma
+    p[b:b + 10] = (i_new[0, 0], i_new[0, 1], i_new[0, 2], i_new[1, 1], i_new[1, 2], i_new[2, 2],
+                   *pseudo[:3, 3], pseudo[3, 3])
 
 
 def _check_link(p: np.ndarray, j: int, robot: Robot) -> None:
