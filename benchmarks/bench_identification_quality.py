@@ -45,7 +45,9 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent))
 import textbook  # noqa: E402
-from tests.identify.kinova import DATA as KINOVA, JOINTWISE_FILES, WHOLE_ARM, WHOLE_ARM_FILES, read, split  # noqa: E402
+
+from tests.identify.kinova import DATA as KINOVA  # noqa: E402
+from tests.identify.kinova import JOINTWISE_FILES, WHOLE_ARM, WHOLE_ARM_FILES, read, split  # noqa: E402
 
 KUKA = KINOVA.parent / "kuka-lwr4"
 
@@ -193,7 +195,7 @@ def run_case(case: Case, rows: list[list[str]]) -> None:
             continue
         times[label] = time.perf_counter() - start
         results[label] = _score(case, ident.predict)
-        if label == "robodyn default" and getattr(ident, "choices", None) is not None:
+        if label == "robodyn default" and ident.choices is not None:
             print(f"  {case.name}: default chose {ident.choices.summary()}")
     floor = results["textbook"][2]
     for label, res in results.items():

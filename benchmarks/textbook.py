@@ -122,5 +122,6 @@ def pinocchio_model_of(robot):
 
     model = pin.buildModelFromXML(export(robot, "urdf"))
     if tuple(model.names[1:]) != tuple(robot.joint_names):
-        raise ValueError(f"{robot.name}: joints {list(model.names[1:])} differ from {list(robot.joint_names)}")
+        raise ValueError(f"{robot.name}: joints {list(model.names[1:])} differ from "
+                         f"{list(robot.joint_names)}")
     return model

@@ -31,6 +31,8 @@ __all__ = ["BaseRelations", "base_relations", "random_states"]
 RANK_RTOL = 1e-8
 #: Coefficients below this (relative to 1) are exact zeros.
 BETA_ZERO = 1e-10
+#: Fraction of the random joint velocities set exactly to zero (see :func:`random_states`).
+ZERO_VELOCITY_FRACTION = 0.2
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,18 +107,28 @@ def _nice(value: float) -> sp.Expr:
     return sp.Float(float(f"{value:.10g}"), 10)
 
 
-def random_states(model: Model, samples: int, rng: np.random.Generator
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def random_states(model: Model, samples: int, rng: np.random.Generator,
+                  at_rest: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Random ``(q, qd, qdd)``, each (samples, n): positions uniform within the joint limits
-    (``+-pi`` when none), velocities and accelerations standard normal."""
+    (``+-pi`` when none), velocities and accelerations standard normal.
+
+    ``at_rest`` (n,) bool: joints whose velocity is exactly zero in ``ZERO_VELOCITY_FRACTION`` of
+    the states (a joint at rest, or within the Coulomb dead band of
+    :mod:`robodyn.identify.preprocess`): there the Coulomb columns vanish and the friction
+    offset ``Fo`` acts alone, so it becomes a base parameter of its own instead of regrouping
+    into ``Fcp``/``Fcn``. Default: none."""
     n = model.dof
     lo = np.array([-np.pi if j.lower is None else float(j.lower) for j in model.robot.joints])
     hi = np.array([np.pi if j.upper is None else float(j.upper) for j in model.robot.joints])
     q = rng.uniform(lo, hi, (samples, n))
-    return q, rng.standard_normal((samples, n)), rng.standard_normal((samples, n))
+    qd = rng.standard_normal((samples, n))
+    if at_rest is not None:
+        qd[(rng.random((samples, n)) < ZERO_VELOCITY_FRACTION) & np.asarray(at_rest, bool)[None, :]] = 0.0
+    return q, qd, rng.standard_normal((samples, n))
 
 
-def base_relations(model: Model, *, samples: int | None = None, seed: int = 0) -> BaseRelations:
+def base_relations(model: Model, *, samples: int | None = None, seed: int = 0,
+                   at_rest: np.ndarray | None = None) -> BaseRelations:
     """Base parameters of a compiled model by QR with column pivoting on random states.
 
     Parameters
@@ -128,6 +140,10 @@ def base_relations(model: Model, *, samples: int | None = None, seed: int = 0) -
         number of columns).
     seed : int
         Seed of the random states (the result does not depend on it beyond round-off).
+    at_rest : numpy.ndarray of bool, shape (n,), optional
+        Joints seen at rest in the data (:func:`random_states`): their friction offset ``Fo`` is
+        a base parameter of its own. Default: none (``Fo`` regroups into the Coulomb levels,
+        which is all that data without rest can tell).
 
     Returns
     -------
@@ -137,7 +153,7 @@ def base_relations(model: Model, *, samples: int | None = None, seed: int = 0) -
     names = parameter_names(n)
     rng = np.random.default_rng(seed)
     count = samples if samples is not None else max(60, 30 * n)
-    q, qd, qdd = random_states(model, count, rng)
+    q, qd, qdd = random_states(model, count, rng, at_rest)
     w = model.regressor(q, qd, qdd).reshape(count * n, -1)
     norms = np.linalg.norm(w, axis=0)
     used = np.flatnonzero(norms > BETA_ZERO * max(1.0, float(norms.max())))

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["FOLDS", "LAMBDA_GRID", "RANK_RTOL", "LinearFit", "fit_linear"]
+__all__ = ["FOLDS", "LAMBDA_GRID", "RANK_RTOL", "LinearFit", "cv_errors_unweighted", "fit_linear"]
 
 RANK_RTOL = 1e-9
 FOLDS = 5
@@ -98,15 +98,35 @@ def _solve(a: np.ndarray, b: np.ndarray, z0: np.ndarray, lams: np.ndarray
     return z0[None, :] + (gain * c[None, :]) @ vt, u, s, vt
 
 
-def _cv_errors(a: np.ndarray, b: np.ndarray, z0: np.ndarray, blocks: np.ndarray) -> np.ndarray:
-    err = np.zeros(LAMBDA_GRID.size)
+def _cv_block_errors(a: np.ndarray, b: np.ndarray, z0: np.ndarray, blocks: np.ndarray,
+                     a_test: np.ndarray | None = None) -> np.ndarray:
+    """Held-out squared error of each block (K, len(LAMBDA_GRID)) for each grid weight; the
+    held-out rows are predicted with ``a_test`` (same shape as ``a``; default ``a``)."""
+    a_test = a if a_test is None else a_test
+    out = []
     for k in np.unique(blocks):
         test = blocks == k
         if test.all():
             continue
         z, *_ = _solve(a[~test], b[~test], z0, LAMBDA_GRID)
-        err += np.sum((b[test][None, :] - z @ a[test].T) ** 2, axis=1)
-    return err
+        out.append(np.sum((b[test][None, :] - z @ a_test[test].T) ** 2, axis=1))
+    return np.array(out).reshape(-1, LAMBDA_GRID.size)
+
+
+def _cv_errors(a: np.ndarray, b: np.ndarray, z0: np.ndarray, blocks: np.ndarray) -> np.ndarray:
+    return _cv_block_errors(a, b, z0, blocks).sum(axis=0)
+
+
+def cv_errors_unweighted(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, blocks: np.ndarray,
+                         phi_test: np.ndarray | None = None) -> np.ndarray:
+    """Held-out squared error of each time block (K, len(LAMBDA_GRID)) of the rows ``phi``
+    (m, p), ``y`` (m,) with blocks (m,), columns scaled to unit norm, rows unweighted, toward
+    ``theta0`` (p,), for each grid weight; held-out rows predicted with ``phi_test`` (m, p)
+    (default ``phi``)."""
+    norms = np.linalg.norm(phi, axis=0)
+    scale = np.where(norms > 0, norms, 1.0)
+    a_test = None if phi_test is None else phi_test / scale[None, :]
+    return _cv_block_errors(phi / scale[None, :], y, theta0 * scale, blocks, a_test)
 
 
 def _one(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, joint: np.ndarray, blocks: np.ndarray,

@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
-from robodyn.identify.preprocess import Samples, preprocess
+from robodyn.identify.preprocess import Samples, preprocess, regressor_rows
 from robodyn.robot.errors import IdentificationError
 from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
 
@@ -108,7 +108,7 @@ def _start(model: str, linear: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray
 def fit_friction_samples(ident: Any, samples: Sequence[Samples], y_full: Sequence[np.ndarray],
                          model: str) -> FrictionFit:
     """Step 2 on already processed, decimated samples and their (filtered) full regressors
-    (:func:`robodyn.identify.pipeline.filtered_regressor`); see :func:`fit_friction`."""
+    (:func:`robodyn.identify.preprocess.regressor_rows`); see :func:`fit_friction`."""
     if model not in NONLINEAR:
         raise IdentificationError(f"friction: expected one of {FRICTION_MODELS}, got {model!r}")
     p_nf = without_friction(ident.standard)
@@ -150,14 +150,12 @@ def fit_friction(ident: Any, recordings: Any, model: str = "stribeck") -> Any:
         ``ident`` with :attr:`~Identification.friction_fit` set; its :meth:`predict` then uses
         the nonlinear law in place of the linear friction.
     """
-    from robodyn.identify.pipeline import filtered_regressor
-
     recs = [recordings] if hasattr(recordings, "q") else list(recordings)
     d = ident.preprocess.decimate
     samples, y_full = [], []
     for r in recs:
         s = preprocess(r, ident.preprocess, ident.target)
-        y_full.append(filtered_regressor(ident._model, s, ident.preprocess))
+        y_full.append(regressor_rows(ident._model, s, ident.preprocess))
         samples.append(Samples(s.t[::d], s.q[::d], s.qd[::d], s.qdd[::d], s.y[::d], s.source))
     return replace(ident, friction_fit=fit_friction_samples(ident, samples, y_full, model))
 

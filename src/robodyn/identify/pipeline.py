@@ -27,16 +27,24 @@ import numpy as np
 import sympy as sp
 
 from robodyn.identify.base import BaseRelations, base_relations
+from robodyn.identify.choices import Candidate, Choices, candidates, choose
 from robodyn.identify.drive_gains import estimate_drive_gains
 from robodyn.identify.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identify.friction import FRICTION_MODELS, NONLINEAR, fit_friction_samples, without_friction
 from robodyn.identify.payload import Payload, payload_standard, payload_torque
-from robodyn.identify.preprocess import Preprocess, Samples, preprocess, resolve_preprocess
+from robodyn.identify.preprocess import (
+    DEAD_BAND,
+    Preprocess,
+    Samples,
+    prediction_rows,
+    preprocess,
+    regressor_rows,
+    resolve_preprocess,
+)
 from robodyn.identify.prior import joint_prior
 from robodyn.identify.result import BaseParameters, Identification
 from robodyn.identify.state_noise import state_noise_std, torque_variance
 from robodyn.identify.to_robot import robot_with_parameters
-from robodyn.measure.filtering import lowpass
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
@@ -49,8 +57,8 @@ METHODS = ("ols", "wls", "consistent")
 WEIGHTS = ("residual", "state-noise")
 #: Floor of the measurement variance, as a fraction of the first fit's residual variance.
 MEAS_FLOOR = 0.01
-#: Samples per cut-off period kept for the parallel filtering of the regressor.
-MID_RATE = 100
+#: Fraction of a joint's samples at rest from which its friction offset is its own base parameter.
+REST_FRACTION = 0.01
 #: Unit directions whose singular value is below this fraction of the largest are reported.
 UNEXCITED_RTOL = 1e-6
 
@@ -133,7 +141,7 @@ def _stack(samples: Sequence[Samples], y_full: Sequence[np.ndarray], columns: np
 def identify(robot: Robot, recordings: Any, target: str | None = None, method: str = "wls", *,
              friction: str = "linear", regularization: float | str | None = "auto",
              cutoff: float | str | None = "auto", decimate: int | str = "auto",
-             velocity: str = "position", gains: str = "auto",
+             velocity: str = "auto", dead_band: float | str = 0.0, gains: str = "auto",
              bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None,
              payloads: Sequence[Payload | None] | None = None, weights: str = "residual",
              state_noise: Any = None) -> Identification:
@@ -162,8 +170,15 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     cutoff : "auto", float or None
         Zero-phase low-pass cut-off, Hz (:mod:`robodyn.identify.preprocess`); None: none.
     decimate : "auto" or int
-    velocity : {"position", "measured"}
-        Joint velocities from the filtered positions (default) or the filtered measured ones.
+    velocity : {"auto", "position", "measured"}
+        Joint velocities from the filtered positions or the filtered measured ones; "auto":
+        chosen by time-block cross-validation (:mod:`robodyn.identify.choices`) between the two
+        when every recording has a measured velocity, else "position".
+    dead_band : "auto" or float
+        Coulomb dead band, rad/s (m/s): where a joint's processed velocity is below it, its
+        Coulomb columns are zero and only the friction offset acts, in the fit and in
+        :meth:`Identification.predict` alike (:mod:`robodyn.identify.preprocess`); 0: none;
+        "auto": 0 or ``DEAD_BAND`` (1e-3), chosen by time-block cross-validation.
     gains : {"auto", "description", "absorbed"}
         Drive gains for ``target="current"`` (:func:`robodyn.identify.prior.joint_prior`).
     bounds : dict of str to (float, float), optional
@@ -197,13 +212,31 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         parameters, an unknown option, an infeasible or failed semidefinite program.
     """
     recs, target, pays = _checked_inputs(robot, recordings, target, method, friction, weights,
-                                         state_noise, gains, payloads)
-    data = _prepared(robot, recs, target, friction, cutoff, decimate, velocity, model)
-    drive, prior, loads = _gains_and_prior(robot, data, pays, target, gains, friction)
+                                         state_noise, gains, velocity, dead_band, payloads)
+    model = model if model is not None else compile_model(robot)
+    measured = all(r.qd is not None and "qd" not in getattr(r, "estimated", frozenset()) for r in recs)
+
+    def stacked(c: Candidate) -> tuple[Any, ...]:
+        data = _prepared(robot, recs, target, friction, cutoff, decimate, c.velocity, c.dead_band,
+                         model)
+        drive, prior, loads = _gains_and_prior(robot, data, pays, target, gains, friction)
+        cols = data.relations.independent
+        phi, y, _, blocks = _stack(data.samples, data.y_full, cols, drive.k, loads)
+        test = np.vstack([prediction_rows(model, s, data.settings)[:, :, cols].reshape(-1, cols.size)
+                          for s in data.samples])
+        return phi, y, data.relations.to_base(prior), blocks, test, data, drive, prior, loads
+
+    best, problem, scored = choose(candidates(velocity, dead_band, measured, DEAD_BAND), stacked)
+    data, drive, prior, loads = problem[5:]
     step = _linear_step(robot, data, drive.k, loads, prior, method, regularization, weights,
                         state_noise)
     theta, standard = _estimate_standard(robot, data.relations, step, prior, method, bounds)
     result = _identification(robot, data, step, theta, standard, drive, target, method)
+    reason = (f"held-out time blocks ({FOLDS} per recording), {len(scored)} candidates: the plain "
+              "processing unless another is better by more than one standard error"
+              if len(scored) > 1 else "as given")
+    result = replace(result, choices=Choices(best.velocity, best.dead_band, data.settings.cutoff,
+                                             step.fit.lam, tuple(scored), reason))
     if friction in NONLINEAR:
         result = replace(result, friction_fit=fit_friction_samples(result, data.samples, data.y_full,
                                                                     friction))
@@ -286,7 +319,7 @@ class _LinearStep:
 
 
 def _checked_inputs(robot: Robot, recordings: Any, target: str | None, method: str, friction: str,
-                    weights: str, state_noise: Any, gains: str,
+                    weights: str, state_noise: Any, gains: str, velocity: str, dead_band: Any,
                     payloads: Sequence[Payload | None] | None
                     ) -> tuple[list[Any], str, list[Payload | None]]:
     """The recordings as a list, the resolved target and one payload per recording (step 1).
@@ -311,6 +344,10 @@ def _checked_inputs(robot: Robot, recordings: Any, target: str | None, method: s
     if weights == "state-noise" and state_noise is None:
         raise IdentificationError("state_noise: weights='state-noise' needs the state noise "
                                   "(s_q, s_qd, s_qdd) in rad, rad/s, rad/s^2")
+    if velocity not in ("auto", "position", "measured"):
+        raise IdentificationError(f"velocity: expected 'auto', 'position' or 'measured', got {velocity!r}")
+    if isinstance(dead_band, str) and dead_band != "auto":
+        raise IdentificationError(f"dead_band: expected a velocity in rad/s or 'auto', got {dead_band!r}")
     if gains not in ("auto", "description", "absorbed"):
         raise IdentificationError(f"gains: expected 'auto', 'description' or 'absorbed', got {gains!r}")
     for i, rec in enumerate(recs):
@@ -319,20 +356,19 @@ def _checked_inputs(robot: Robot, recordings: Any, target: str | None, method: s
 
 
 def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff: float | str | None,
-              decimate: int | str, velocity: str, model: Model | None) -> _Prepared:
+              decimate: int | str, velocity: str, dead_band: float, model: Model) -> _Prepared:
     """Preprocessed samples, filtered regressors and base relations of ``recs`` (steps 2 and 3).
 
-    ``model`` is compiled from ``robot`` when None. Raises :class:`IdentificationError` when the
+    Raises :class:`IdentificationError` when the
     ``sum N_k n`` equations left after decimation are fewer than twice the ``b`` base parameters.
     """
-    settings = resolve_preprocess(recs, cutoff, decimate, velocity)
-    model = model if model is not None else compile_model(robot)
-    relations = base_relations(model)
-    if friction == "none":
-        relations = _without_friction_columns(relations)
+    settings = resolve_preprocess(recs, cutoff, decimate, velocity, dead_band=dead_band)
     full = [preprocess(r, settings, target) for r in recs]
     y_full = [filtered_regressor(model, s, settings) for s in full]
     samples = [_decimated(s, settings) for s in full]
+    relations = base_relations(model, at_rest=_at_rest(samples, settings.dead_band))
+    if friction == "none":
+        relations = _without_friction_columns(relations)
     count = sum(s.q.shape[0] for s in samples)
     b = relations.independent.size
     if count * robot.dof < 2 * b:
@@ -341,6 +377,14 @@ def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff:
             f"= {count * robot.dof} equations after decimation by {settings.decimate} for {b} base "
             f"parameters (at least {2 * b} needed; record longer or pass decimate=1)")
     return _Prepared(settings, model, relations, samples, y_full, count)
+
+
+def _at_rest(samples: Sequence[Samples], band: float) -> np.ndarray:
+    """Joints (n,) bool with at least ``REST_FRACTION`` of their fitted samples at rest
+    (``|qd| < band``, or exactly 0: a joint held still): their offset ``Fo`` is then seen alone."""
+    qd = np.abs(np.vstack([s.qd for s in samples]))
+    rest = (qd < band) | (qd == 0.0)
+    return np.mean(rest, axis=0) >= REST_FRACTION
 
 
 def _gains_and_prior(robot: Robot, data: _Prepared, pays: list[Payload | None], target: str,
@@ -479,26 +523,9 @@ def _without_friction_columns(relations: BaseRelations) -> BaseRelations:
 
 
 def filtered_regressor(model: Model, s: Samples, settings: Preprocess) -> np.ndarray:
-    """Full regressor (N / decimate, n, 15 n) of processed samples, low-passed column by column
-    with the target's filter before decimation (parallel filtering, Gautier 1997): the filter is
-    linear, so ``H(Y p) = H(Y) p`` holds exactly, and the fit of the filtered target is not biased
-    by terms the filter smooths (Coulomb steps at velocity reversals).
-
-    To bound memory and time on long fast logs, ``Y`` is evaluated and filtered on every
-    ``m``-th sample, ``m`` the largest divisor of the decimation factor with at least
-    ``MID_RATE`` samples per cut-off period left (the filtered states are smooth there; only the
-    timing of a Coulomb step moves, by less than ``1 / (MID_RATE cutoff)``)."""
-    d = settings.decimate
-    if settings.cutoff is None:
-        return model.regressor(s.q[::d], s.qd[::d], s.qdd[::d])
-    fs = 1.0 / float(np.median(np.diff(s.t)))
-    limit = max(1, int(fs / (MID_RATE * settings.cutoff)))
-    m = max(k for k in range(1, d + 1) if d % k == 0 and k <= limit)
-    y = model.regressor(s.q[::m], s.qd[::m], s.qdd[::m])
-    count = y.shape[0]
-    # H Y: the same zero-phase low-pass as the target, along time
-    y = lowpass(s.t[::m], y.reshape(count, -1), settings.cutoff, order=settings.order).reshape(y.shape)
-    return y[::d // m]
+    """The fit's regressor rows (N / decimate, n, 15 n)
+    (:func:`robodyn.identify.preprocess.regressor_rows`)."""
+    return regressor_rows(model, s, settings)
 
 
 def _decimated(s: Samples, settings: Preprocess) -> Samples:

@@ -15,6 +15,16 @@ prediction processes a new recording exactly as the fit processed its data:
   ``decimate``-th sample), which thins the strongly correlated neighbouring rows the filter
   leaves; :meth:`Identification.predict` returns every sample.
 
+The regressor rows of a prediction (:func:`prediction_rows`) are the compiled regressor of the
+processed states with its Coulomb columns set to zero wherever ``|qd_j|`` is below the dead band
+(``dead_band``, 0 or ``DEAD_BAND`` = 1e-3 rad/s chosen from the data: a joint at rest, or
+creeping within its velocity noise, carries no Coulomb step and only the friction offset ``Fo``,
+a base parameter of its own, :mod:`robodyn.identify.base`); the fit's rows
+(:func:`regressor_rows`) are the same rows low-passed column by column with the target's filter
+(parallel filtering), so that the fit of the filtered target estimates the parameters of the
+unfiltered model ``Y p`` that ``predict`` returns: the Coulomb sign is handled the same way in
+both.
+
 ``cutoff=None`` turns all filtering off: the recording's own ``qd`` and ``qdd`` (measured or
 estimated when the recording was built) and its raw target are used (simulated data).
 
@@ -36,11 +46,16 @@ import numpy as np
 from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass
 from robodyn.robot.errors import IdentificationError
 
-__all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "Preprocess", "Samples", "preprocess", "resolve_preprocess"]
+__all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "DEAD_BAND", "MID_RATE", "Preprocess", "Samples",
+           "coulomb_dead_band", "prediction_rows", "preprocess", "regressor_rows", "resolve_preprocess"]
 
 AUTO_MIN_HZ = 2.0
 AUTO_MAX_HZ = 5.0
 _MOVING_RAD = 1e-3  # a joint whose position spans less than this never moves (rad or m)
+#: Coulomb dead band, rad/s (m/s): below it a joint's Coulomb columns are zero.
+DEAD_BAND = 1e-3
+#: Samples per cut-off period kept for the parallel filtering of the regressor.
+MID_RATE = 100
 
 
 @dataclass(frozen=True)
@@ -57,12 +72,15 @@ class Preprocess:
         Keep every ``decimate``-th filtered sample for fitting (1: all).
     velocity : {"position", "measured"}
         Whether ``qd`` is the derivative of the filtered positions or the filtered measured one.
+    dead_band : float
+        Coulomb dead band, rad/s (m/s); 0: the sign of ``qd`` everywhere.
     """
 
     cutoff: float | None
     order: int = 4
     decimate: int = 1
     velocity: Literal["position", "measured"] = "position"
+    dead_band: float = DEAD_BAND
 
 
 @dataclass(frozen=True, eq=False)
@@ -97,10 +115,13 @@ def target_signal(rec: Any, target: str) -> np.ndarray | None:
 
 
 def resolve_preprocess(recordings: list[Any], cutoff: float | str | None, decimate: int | str,
-                       velocity: str = "position", order: int = 4) -> Preprocess:
+                       velocity: str = "position", order: int = 4,
+                       dead_band: float = DEAD_BAND) -> Preprocess:
     """Settings for these recordings: the ``"auto"`` rules of the module docstring resolved."""
     if velocity not in ("position", "measured"):
         raise IdentificationError(f"velocity: expected 'position' or 'measured', got {velocity!r}")
+    if not (isinstance(dead_band, (int, float)) and np.isfinite(dead_band) and 0 <= dead_band < 1e3):
+        raise IdentificationError(f"dead_band: expected a velocity in [0, 1000) rad/s, got {dead_band!r}")
     fs = min(1.0 / float(np.median(np.diff(np.asarray(r.t, float)))) for r in recordings)
     if isinstance(cutoff, str):
         if cutoff != "auto":
@@ -129,7 +150,8 @@ def resolve_preprocess(recordings: list[Any], cutoff: float | str | None, decima
         dec = int(decimate)
         if dec < 1 or dec != decimate:
             raise IdentificationError(f"decimate: expected a positive integer, got {decimate!r}")
-    return Preprocess(cutoff=cut, order=order, decimate=dec, velocity=velocity)  # type: ignore[arg-type]
+    return Preprocess(cutoff=cut, order=order, decimate=dec, velocity=velocity,  # type: ignore[arg-type]
+                      dead_band=float(dead_band))
 
 
 def preprocess(rec: Any, settings: Preprocess, target: str | None) -> Samples:
@@ -169,3 +191,52 @@ def preprocess(rec: Any, settings: Preprocess, target: str | None) -> Samples:
     qdd[:, held] = 0.0
     y_f = None if y is None else lowpass(t, y, cut, order=order)  # the same H on the target
     return Samples(t, q_f, qd, qdd, y_f, _source(rec))
+
+
+def coulomb_dead_band(y: np.ndarray, qd: np.ndarray, band: float) -> np.ndarray:
+    """The regressor ``y`` (N, n, 15 n) with joint j's Coulomb columns (``Fcp``, ``Fcn``) zero
+    wherever ``|qd_j| < band`` (``qd`` (N, n), rad/s); ``y`` is changed in place and returned."""
+    from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
+
+    if band <= 0:
+        return y
+    for j in range(qd.shape[1]):
+        still = np.abs(qd[:, j]) < band
+        if np.any(still):
+            c = PER_JOINT * j + len(INERTIAL_NAMES) + 2  # Fcp, then Fcn
+            y[still, j, c:c + 2] = 0.0
+    return y
+
+
+def prediction_rows(model: Any, s: Samples, settings: Preprocess) -> np.ndarray:
+    """Regressor (N, n, 15 n) of processed samples for a prediction: the compiled regressor of
+    ``model`` at ``(s.q, s.qd, s.qdd)`` with the Coulomb dead band (:func:`coulomb_dead_band`)."""
+    return coulomb_dead_band(model.regressor(s.q, s.qd, s.qdd), s.qd, settings.dead_band)
+
+
+def regressor_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool = True) -> np.ndarray:
+    """Full regressor (N / decimate, n, 15 n) of processed samples for a fit or a prediction.
+
+    The compiled regressor of ``model`` at ``(s.q, s.qd, s.qdd)`` with the Coulomb dead band
+    (:func:`coulomb_dead_band`), low-passed column by column with the target's filter before
+    decimation (parallel filtering, Gautier 1997): the filter is linear, so ``H(Y p) = H(Y) p``
+    holds exactly, and the fit of the filtered target is not biased by terms the filter smooths
+    (Coulomb steps at velocity reversals). ``decimate=False``: every sample (a prediction).
+
+    To bound memory and time on long fast logs, ``Y`` is evaluated and filtered on every
+    ``m``-th sample, ``m`` the largest divisor of the decimation factor with at least
+    ``MID_RATE`` samples per cut-off period left (the filtered states are smooth there; only the
+    timing of a Coulomb step moves, by less than ``1 / (MID_RATE cutoff)``).
+    """
+    d = settings.decimate if decimate else 1
+    band = settings.dead_band
+    if settings.cutoff is None:
+        return coulomb_dead_band(model.regressor(s.q[::d], s.qd[::d], s.qdd[::d]), s.qd[::d], band)
+    fs = 1.0 / float(np.median(np.diff(s.t)))
+    limit = max(1, int(fs / (MID_RATE * settings.cutoff)))
+    m = max(k for k in range(1, d + 1) if d % k == 0 and k <= limit)
+    y = coulomb_dead_band(model.regressor(s.q[::m], s.qd[::m], s.qdd[::m]), s.qd[::m], band)
+    count = y.shape[0]
+    # H Y: the same zero-phase low-pass as the target, along time
+    y = lowpass(s.t[::m], y.reshape(count, -1), settings.cutoff, order=settings.order).reshape(y.shape)
+    return y[::d // m]

@@ -10,8 +10,9 @@ import numpy as np
 import sympy as sp
 
 from robodyn.identify.base import BaseRelations
+from robodyn.identify.choices import Choices
 from robodyn.identify.friction import FrictionFit, without_friction
-from robodyn.identify.preprocess import Preprocess, preprocess
+from robodyn.identify.preprocess import Preprocess, prediction_rows, preprocess
 from robodyn.numeric.model import Model
 from robodyn.robot.model import Robot
 
@@ -123,6 +124,10 @@ class Identification:
         A nonlinear friction law fitted after the linear step
         (:func:`robodyn.identify.friction.fit_friction`); :meth:`predict` then uses it in place
         of the linear friction.
+    choices : Choices or None
+        The preprocessing chosen from the data (velocity source, Coulomb dead band, cut-off,
+        regularisation) with every candidate's cross-validated score
+        (:mod:`robodyn.identify.choices`).
     """
 
     robot: Robot
@@ -143,6 +148,7 @@ class Identification:
     _model: Model
     friction_fit: FrictionFit | None = None
     gains_std: np.ndarray | None = None
+    choices: Choices | None = None
 
     @property
     def gains_identified(self) -> bool:
@@ -152,8 +158,10 @@ class Identification:
     def predict(self, recording: Any, payload: Any = None) -> np.ndarray:
         """Predicted target at the recording's own samples.
 
-        The raw recording is processed as the identification data were (same filter cut-off
-        and order, same derivative estimates, no decimation).
+        The raw recording is processed as the identification data were, by the same functions
+        (same filter cut-off and order, same derivative estimates, the same Coulomb dead band),
+        without decimation; the prediction is the model's effort ``Y(q, qd, qdd) p`` at the
+        processed states (:func:`robodyn.identify.preprocess.prediction_rows`).
 
         Parameters
         ----------
@@ -171,7 +179,7 @@ class Identification:
 
         check_recording(self.robot, recording, 0, None)
         s = preprocess(recording, self.preprocess, None)
-        y = self._model.regressor(s.q, s.qd, s.qdd)
+        y = prediction_rows(self._model, s, self.preprocess)
         if self.friction_fit is None:
             tau = y @ self.standard  # tau = Y(q, qd, qdd) p
         else:
