@@ -155,14 +155,7 @@ def _project_link(p: np.ndarray, j: int) -> None:
     at most the solver's tolerance and makes the link exactly consistent.
     """
     b = PER_JOINT * j
-    xx, xy, xz, yy, yz, zz, mx, my, mz, m = p[b:b + 10]
-    i_o = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
-    pseudo = np.zeros((4, 4))
-    # Sigma = tr(I)/2 1 - I,  J = [[Sigma, h], [h^T, m]]
-    pseudo[:3, :3] = 0.5 * np.trace(i_o) * np.eye(3) - i_o
-    pseudo[:3, 3] = pseudo[3, :3] = (mx, my, mz)
-    pseudo[3, 3] = m
-    lam, vec = np.linalg.eigh(pseudo)
+    lam, vec = np.linalg.eigh(pseudo_inertia(p, j))
     if lam[0] >= EPS:
         return
     pseudo = (vec * np.maximum(lam, EPS)) @ vec.T

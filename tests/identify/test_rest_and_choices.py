@@ -1,0 +1,185 @@
+"""The friction offset at rest, the Coulomb dead band and the cross-validated preprocessing choices.
+
+Simulated data with known truth: the torque is built in the test from a true standard parameter
+vector that differs from the description (the prior) in the friction terms, so a parameter
+left at its prior shows up as a wrong prediction.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robodyn as rd
+from robodyn.identify.consistent import EPS, _project_link, pseudo_inertia
+from robodyn.identify.pipeline import nominal_standard
+from robodyn.robot.errors import IdentificationError
+from robodyn.robot.validation import inertia_problems
+from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
+from tests.identify.helpers import fourier, load_quiet
+
+FO = len(INERTIAL_NAMES) + 4  # offset within a joint's 15 parameters (Ia, Fv, Fcp, Fcn, Fo)
+
+
+@pytest.fixture(scope="module")
+def planar():
+    robot = load_quiet("planar_2r")
+    return robot, rd.compile_model(robot)
+
+
+def _truth(robot) -> np.ndarray:
+    """The description's standard parameters with every friction offset moved by 0.7 N m."""
+    p = nominal_standard(robot).copy()
+    for j in range(robot.dof):
+        p[PER_JOINT * j + FO] += 0.7
+    return p
+
+
+def _held_run(model, seconds: float, dt: float, seed: int, held: int) -> tuple[np.ndarray, ...]:
+    """Fourier motion of every joint but ``held``, which stands still at its start position."""
+    t = np.arange(0.0, seconds, dt)
+    q, qd, qdd = fourier(t, model.dof, np.random.default_rng(seed))
+    q[:, held] = q[0, held]
+    qd[:, held] = 0.0
+    qdd[:, held] = 0.0
+    return t, q, qd, qdd
+
+
+def _recording(model, t, q, qd, qdd, tau, source):
+    return rd.Recording(t=t, q=q, qd=qd, qdd=qdd, tau=tau, joint_names=model.robot.joint_names,
+                        source=source)
+
+
+def test_offset_of_a_joint_held_still_is_identified(planar):
+    robot, model = planar
+    p_true = _truth(robot)
+    runs = []
+    for seed, held in ((1, None), (2, 1)):
+        t = np.arange(0.0, 20.0, 0.01)
+        if held is None:
+            q, qd, qdd = fourier(t, 2, np.random.default_rng(seed))
+        else:
+            t, q, qd, qdd = _held_run(model, 20.0, 0.01, seed, held)
+        tau = model.regressor(q, qd, qdd) @ p_true
+        runs.append(_recording(model, t, q, qd, qdd, tau, f"run{seed}"))
+    ident = rd.identify(robot, runs, method="ols", cutoff=None, regularization=None, model=model)
+    # joint 2 was at rest in half the data: its offset is a base parameter of its own
+    assert "Fo2" in ident.relations.names
+    # a new jointwise run: joint 1 moves, joint 2 is held; at rest the friction torque is the
+    # true offset alone (Heaviside(0) = 0 in both Coulomb terms), so the held joint's torque is
+    # its nominal rigid-body torque plus the true offset: nominal offset + 0.7 N m
+    t, q, qd, qdd = _held_run(model, 5.0, 0.01, 3, 1)
+    pred = ident.predict(_recording(model, t, q, qd, qdd, None, "check"))
+    nominal = model.inverse_dynamics(q, qd, qdd)
+    np.testing.assert_allclose(pred[:, 1] - nominal[:, 1], 0.7, atol=1e-8)
+
+
+def test_offset_regroups_when_no_joint_rests(planar):
+    robot, model = planar
+    t = np.arange(0.0, 10.0, 0.01)
+    q, qd, qdd = fourier(t, 2, np.random.default_rng(4))
+    rec = _recording(model, t, q, qd, qdd, model.inverse_dynamics(q, qd, qdd), "moving")
+    ident = rd.identify(robot, rec, method="ols", cutoff=None, regularization=None, model=model)
+    # without samples at rest Fcp, Fcn and Fo cannot be told apart: Fo regroups into them
+    assert not any(name.startswith("Fo") for name in ident.relations.names)
+    assert ident.base_parameters.identifiable.all()
+
+
+def test_dead_band_is_applied_alike_in_fit_and_prediction(planar):
+    robot, model = planar
+    p_true = _truth(robot)
+    for j, level in enumerate((1.5, 0.8)):  # Coulomb levels Fcp = Fcn, N m
+        c = PER_JOINT * j + len(INERTIAL_NAMES) + 2
+        p_true[c:c + 2] = level
+    band = 0.05
+    t = np.arange(0.0, 20.0, 0.01)
+    q, qd, qdd = fourier(t, 2, np.random.default_rng(5), amplitude=0.3)
+    # the plant: Coulomb friction only outside the dead band (written here with a mask)
+    y = model.regressor(q, qd, qdd)
+    for j in range(2):
+        c = PER_JOINT * j + len(INERTIAL_NAMES) + 2
+        y[np.abs(qd[:, j]) < band, j, c:c + 2] = 0.0
+    tau = y @ p_true
+    assert np.mean(np.abs(qd) < band) > 0.02  # the band is visited
+    rec = _recording(model, t, q, qd, qdd, tau, "band")
+    ident = rd.identify(robot, rec, method="ols", cutoff=None, regularization=None, model=model,
+                        dead_band=band)
+    assert ident.preprocess.dead_band == band
+    np.testing.assert_allclose(ident.predict(rec), tau, rtol=0, atol=1e-8 * np.abs(tau).max())
+    # without the dead band the same data cannot be reproduced
+    plain = rd.identify(robot, rec, method="ols", cutoff=None, regularization=None, model=model)
+    assert np.max(np.abs(plain.predict(rec) - tau)) > 1e-3 * np.abs(tau).max()
+
+
+@pytest.mark.parametrize("bad", [-1e-3, float("nan"), "wide"])
+def test_bad_dead_band_is_refused(planar, bad):
+    robot, model = planar
+    t = np.arange(0.0, 2.0, 0.01)
+    q, qd, qdd = fourier(t, 2, np.random.default_rng(6))
+    rec = _recording(model, t, q, qd, qdd, model.inverse_dynamics(q, qd, qdd), "r")
+    with pytest.raises(IdentificationError, match="dead_band"):
+        rd.identify(robot, rec, cutoff=None, model=model, dead_band=bad)
+
+
+def _velocity_case(model, seed: int, quantum: float, qd_noise: float) -> rd.Recording:
+    """200 Hz recording: positions quantised to ``quantum`` rad, measured velocity with white
+    noise of ``qd_noise`` rad/s, exact torque."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 30.0, 0.005)
+    q, qd, qdd = fourier(t, 2, rng, f0=0.1)
+    tau = model.inverse_dynamics(q, qd, qdd)
+    q_meas = np.round(q / quantum) * quantum if quantum else q
+    return rd.Recording(t=t, q=q_meas, qd=qd + qd_noise * rng.standard_normal(qd.shape), tau=tau,
+                        joint_names=model.robot.joint_names, source=f"v{seed}")
+
+
+def test_velocity_source_chosen_by_held_out_blocks(planar):
+    robot, model = planar
+    # coarse encoder, clean tachometer: the measured velocity predicts better
+    coarse = _velocity_case(model, 7, quantum=0.02, qd_noise=0.0)
+    ident = rd.identify(robot, coarse, model=model, velocity="auto")
+    assert ident.choices.velocity == "measured"
+    assert ident.preprocess.velocity == "measured"
+    assert len(ident.choices.candidates) == 2
+    # fine encoder, very noisy tachometer: position differences
+    noisy = _velocity_case(model, 8, quantum=0.0, qd_noise=2.0)
+    ident = rd.identify(robot, noisy, model=model, velocity="auto")
+    assert ident.choices.velocity == "position"
+    scores = {c.velocity: c.score for c in ident.choices.candidates}
+    assert scores["position"] < scores["measured"]
+    assert "held-out" in ident.choices.summary()
+
+
+def test_a_fixed_setting_is_reported_as_given(planar):
+    robot, model = planar
+    rec = _velocity_case(model, 9, quantum=0.0, qd_noise=0.0)
+    ident = rd.identify(robot, rec, model=model, velocity="position")
+    assert ident.choices.reason == "as given"
+    assert len(ident.choices.candidates) == 1
+    assert ident.choices.regularization == ident.regularization
+    assert ident.choices.cutoff == ident.preprocess.cutoff
+
+
+def test_boundary_link_is_projected_into_the_consistent_set():
+    # a point mass of 28 kg at (0.1, 0, 0.2) whose inertia about its centre came back from the
+    # solver at -1e-7 kg m^2: J = m [c; 1][c; 1]^T, then Sigma nudged off the boundary
+    m, c = 28.0, np.array([0.1, 0.0, 0.2])
+    sigma = m * np.outer(c, c) - 1e-7 * np.eye(3)
+    inertia = np.trace(sigma) * np.eye(3) - sigma  # I = tr(Sigma) 1 - Sigma, about the origin
+    p = np.zeros(PER_JOINT)
+    p[:10] = (inertia[0, 0], inertia[0, 1], inertia[0, 2], inertia[1, 1], inertia[1, 2],
+              inertia[2, 2], *(m * c), m)
+    before = p.copy()
+    _project_link(p, 0)
+    assert np.linalg.eigvalsh(pseudo_inertia(p, 0)).min() >= 0.99 * EPS
+    i_c = _inertia_about_com(p)
+    assert inertia_problems(i_c) == []
+    assert np.max(np.abs(p - before)) <= 1e-5  # moved by the solver's tolerance, not more
+
+
+def _inertia_about_com(p: np.ndarray) -> np.ndarray:
+    xx, xy, xz, yy, yz, zz, mx, my, mz, m = p[:10]
+    c = np.array([mx, my, mz]) / m
+    i_o = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    # parallel-axis theorem: I_c = I_o - m (|c|^2 1 - c c^T)
+    return i_o - m * (float(c @ c) * np.eye(3) - np.outer(c, c))
