@@ -12,6 +12,7 @@ import csv
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -123,7 +124,9 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     with progress(f"identifying {robot.name} ({args.method}, {len(recs) + len(loaded)} "
                   "recording(s))"):
         ident = rd.identify(robot, recs + loaded, target=args.target, method=args.method,
-                            friction=args.friction, **extra)
+                            friction=args.friction, velocity=args.velocity,
+                            dead_band=args.dead_band, cutoff=args.cutoff,
+                            regularization=args.regularization, decimate=args.decimate, **extra)
     stem = f"{robot.name}_identified"
     paths = {"yaml": out / f"{stem}.yaml", "urdf": out / f"{stem}.urdf",
              "parameters": out / "parameters.csv"}
@@ -144,12 +147,14 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                                                                       strict=True))
         print(f"drive gains from the payload run(s), N m/A: {gain_text}")
     paths["metrics"] = _write_metrics([v for _, v in vals], out / "validation.csv")
-    with progress("writing the report and its figures"):
-        paths["report"] = identification_html(ident, vals, out, [r.source for r in recs])
+    if not args.no_report:
+        with progress("writing the report and its figures"):
+            paths["report"] = identification_html(ident, vals, out, [r.source for r in recs])
     table = _held_out_table([(kind, v) for (kind, _), (_, v) in zip(jobs, vals, strict=True)])
     print(f"identified {len(ident.base_parameters)} base parameters of {robot.name} "
           f"({args.method}, target {ident.target}); condition number {ident.condition:.3g}, "
           f"Tikhonov weight {ident.regularization:.3g}")
+    print(f"choices: {ident.choices.summary()}")
     print(ident.base_parameters)
     for head, v in vals:
         print(f"\n{head}")
@@ -299,8 +304,51 @@ def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
                    help="friction model: linear (viscous, Coulomb +/-, offset, in the linear fit), "
                         "none, or a nonlinear law fitted after the linear step (default: "
                         "%(default)s)")
+    _preprocessing(p)
     _common(p)
     p.set_defaults(func=_cmd_identify)
+
+
+def _auto_or(kind: type, *, none: bool = False) -> Any:
+    """An argparse type: "auto", optionally "none", or a number of ``kind``."""
+    def parse(text: str) -> Any:
+        if text == "auto":
+            return "auto"
+        if none and text == "none":
+            return None
+        try:
+            value = kind(text)
+        except ValueError:
+            words = "'auto', 'none' or " if none else "'auto' or "
+            raise argparse.ArgumentTypeError(f"expected {words}a number, got {text!r}") from None
+        if not np.isfinite(value):
+            raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+        return value
+    return parse
+
+
+def _preprocessing(p: argparse.ArgumentParser) -> None:
+    """The identification's preprocessing options (rd.identify's keywords of the same names)."""
+    p.add_argument("--velocity", choices=("auto", "position", "measured"), default="auto",
+                   help="joint velocity source: differences of the filtered positions, the "
+                        "filtered measured velocity, or auto: chosen by held-out time blocks "
+                        "(printed under 'choices') (default: %(default)s)")
+    p.add_argument("--dead-band", type=_auto_or(float), default=0.0, metavar="RAD_S",
+                   help="Coulomb dead band in rad/s, in the fit and the prediction alike (below "
+                        "it a joint carries only its friction offset), or auto: 0 or 1e-3 chosen "
+                        "by held-out time blocks (default: %(default)s)")
+    p.add_argument("--cutoff", type=_auto_or(float, none=True), default="auto", metavar="HZ",
+                   help="zero-phase low-pass cut-off in Hz, none (the recording's own "
+                        "velocities and accelerations), or auto: the motion's bandwidth within "
+                        "2-5 Hz (default: %(default)s)")
+    p.add_argument("--regularization", type=_auto_or(float, none=True), default="auto",
+                   metavar="W", help="Tikhonov weight toward the description, none, or auto: "
+                                     "chosen by held-out time blocks (default: %(default)s)")
+    p.add_argument("--decimate", type=_auto_or(int), default="auto", metavar="K",
+                   help="keep every K-th filtered sample for the fit, or auto: about five per "
+                        "cut-off period (default: %(default)s)")
+    p.add_argument("--no-report", action="store_true",
+                   help="skip report.html and its figures (every other output is written)")
 
 
 def _validate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:

@@ -123,3 +123,27 @@ def test_identify_gains_set_the_drives_and_are_checked(files, tmp_path, capsys):
     rc = main(["identify", "puma560", "--data", str(train), "--gains", "1,2", "-o", str(tmp_path)])
     assert rc == 2
     assert "--gains: expected 1 or 6" in capsys.readouterr().err
+
+
+def test_identify_preprocessing_options_and_no_report(files, tmp_path, capsys):
+    train, _ = files
+    rc = main(["identify", "puma560", "--data", str(train), "--method", "ols", "--velocity", "position",
+               "--dead-band", "0.002", "--cutoff", "none", "--regularization", "none",
+               "--decimate", "1", "--no-report", "-o", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert rc in (0, 1)  # 1: an unconstrained estimate that does not load (tested above)
+    assert "choices: velocity position, Coulomb dead band 0.002 rad/s, cut-off none, " \
+           "regularization 0: as given" in out
+    assert not (tmp_path / "report.html").exists()
+    assert (tmp_path / "parameters.csv").exists() and (tmp_path / "validation.csv").exists()
+    assert "wrote report" not in out
+
+
+@pytest.mark.parametrize("option, value", [("--cutoff", "fast"), ("--regularization", "inf"),
+                                           ("--dead-band", "wide"), ("--decimate", "2.5")])
+def test_identify_bad_preprocessing_option_is_refused(files, tmp_path, capsys, option, value):
+    train, _ = files
+    with pytest.raises(SystemExit) as exc:
+        main(["identify", "puma560", "--data", str(train), option, value, "-o", str(tmp_path)])
+    assert exc.value.code == 2
+    assert option in capsys.readouterr().err

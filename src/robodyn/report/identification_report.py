@@ -137,6 +137,7 @@ def identification_html(ident: Any, validations: Sequence[tuple[str, Validation]
 {ident.condition:.3g}; Tikhonov weight toward the description {ident.regularization:.3g};
 drive gains ({html.escape(ident.gains_source)}): {gains} N m/A; filter cut-off
 {_cutoff(ident)}.</p>
+{_choices_html(ident)}
 <h2>Base parameters</h2>
 <p>Standard deviations from the residual variance; parameters the data do not excite keep the
 description's value (std inf).</p>
@@ -156,6 +157,23 @@ def validation_html(val: Validation, out: Path, name: str = "validation.html") -
     path = out / name
     path.write_text(page(f"robodyn validation: {val.robot}", body), encoding="utf-8")
     return path
+
+
+def _choices_html(ident: Any) -> str:
+    """The preprocessing chosen from the data and every candidate's held-out score."""
+    ch = getattr(ident, "choices", None)
+    if ch is None:
+        return ""
+    rows = "".join(f"<tr><td>{html.escape(c.velocity)}</td><td>{c.dead_band:g}</td>"
+                   f"<td>{c.score:.4f}</td><td>{c.lam:g}</td>"
+                   f"<td>{'chosen' if (c.velocity, c.dead_band) == (ch.velocity, ch.dead_band) else ''}"
+                   "</td></tr>" for c in ch.candidates)
+    table = ("<table><tr><th>velocity</th><th>dead band, rad/s</th><th>held-out blocks, "
+             "relative</th><th>best weight</th><th></th></tr>" + rows + "</table>"
+             if len(ch.candidates) > 1 else "")
+    return (f"<h2>Choices</h2>\n<p>Velocity <b>{html.escape(ch.velocity)}</b>, Coulomb dead band "
+            f"<b>{ch.dead_band:g} rad/s</b>, cut-off {_cutoff(ident)}, Tikhonov weight "
+            f"{ch.regularization:.3g}: {html.escape(ch.reason)}.</p>\n{table}")
 
 
 def _cutoff(ident: Any) -> str:
