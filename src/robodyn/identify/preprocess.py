@@ -146,6 +146,10 @@ def resolve_preprocess(recordings: list[Any], cutoff: float | str | None, decima
         if decimate != "auto":
             raise IdentificationError(f"decimate: expected a positive integer or 'auto', got {decimate!r}")
         dec = 1 if cut is None else max(1, int(np.floor(fs / (5.0 * cut))))
+        if cut is not None:
+            # a multiple of the step at which regressor_rows evaluates and filters the regressor
+            step = max(1, int(fs / (MID_RATE * cut)))
+            dec = max(dec // step * step, 1)
     else:
         dec = int(decimate)
         if dec < 1 or dec != decimate:
@@ -237,6 +241,12 @@ def regressor_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool 
     m = max(k for k in range(1, d + 1) if d % k == 0 and k <= limit)
     y = coulomb_dead_band(model.regressor(s.q[::m], s.qd[::m], s.qdd[::m]), s.qd[::m], band)
     count = y.shape[0]
-    # H Y: the same zero-phase low-pass as the target, along time
-    y = lowpass(s.t[::m], y.reshape(count, -1), settings.cutoff, order=settings.order).reshape(y.shape)
-    return y[::d // m]
+    flat = y.reshape(count, -1)
+    # H Y: the same zero-phase low-pass as the target, along time, on the columns that vary (a
+    # constant column, most of them structural zeros, is its own low-pass)
+    varying = np.flatnonzero(np.ptp(flat, axis=0) > 0)
+    out = flat[::d // m].copy()
+    if varying.size:
+        out[:, varying] = lowpass(s.t[::m], flat[:, varying], settings.cutoff,
+                                  order=settings.order)[::d // m]
+    return out.reshape((-1,) + y.shape[1:])

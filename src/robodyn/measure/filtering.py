@@ -133,7 +133,10 @@ def _filter(tu: np.ndarray, xu: np.ndarray, cutoff: float, order: int, method: s
         sos = signal.butter(order, cutoff, btype="low", fs=fs, output="sos")
         # odd extension over ~3 filter time constants keeps value and slope at the ends
         padlen = min(xu.shape[0] - 1, int(3 * fs / cutoff) + 3 * (2 * sos.shape[0] + 1))
-        y = signal.sosfiltfilt(sos, xu, axis=0, padlen=padlen)
+        # along the last axis of a copy that is contiguous in time (a strided axis-0 filter of a
+        # wide array copies every column through a buffer: about 3x slower)
+        xt = np.ascontiguousarray(np.moveaxis(xu, 0, -1))
+        y = np.moveaxis(signal.sosfiltfilt(sos, xt, axis=-1, padlen=padlen), -1, 0)
         out = [y]
         for _ in range(derivs):
             out.append(np.gradient(out[-1], dt, axis=0, edge_order=2))  # central differences
