@@ -183,3 +183,48 @@ def _inertia_about_com(p: np.ndarray) -> np.ndarray:
     i_o = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
     # parallel-axis theorem: I_c = I_o - m (|c|^2 1 - c c^T)
     return i_o - m * (float(c @ c) * np.eye(3) - np.outer(c, c))
+
+
+def _thermal_run(model, seed: int, temp: float, cv: np.ndarray, cc: np.ndarray, t_ref: np.ndarray):
+    """A run at drive temperature ``temp`` whose friction changes by (T - T_ref)(cv qd + cc sgn qd)."""
+    t = np.arange(0.0, 15.0, 0.01)
+    q, qd, qdd = fourier(t, 2, np.random.default_rng(seed))
+    temps = np.full(q.shape, temp) + 0.1 * np.sin(0.3 * t)[:, None]  # a slow drift
+    # the thermal torque, written out here
+    tau = model.inverse_dynamics(q, qd, qdd) + (temps - t_ref) * (cv * qd + cc * np.sign(qd))
+    return rd.Recording(t=t, q=q, qd=qd, qdd=qdd, tau=tau, temperature=temps,
+                        joint_names=model.robot.joint_names, source=f"T{temp:g}"), tau
+
+
+def test_thermal_friction_recovered_and_predicted_at_another_temperature(planar):
+    robot, model = planar
+    cv, cc = np.array([-0.02, -0.01]), np.array([-0.03, 0.015])
+    t = np.arange(0.0, 15.0, 0.01)
+    # T_ref is the mean temperature of the identification data: runs at 25 and 40 deg C
+    t_ref = np.full(2, np.mean([25.0 + 0.1 * np.sin(0.3 * t), 40.0 + 0.1 * np.sin(0.3 * t)]))
+    runs = [_thermal_run(model, seed, temp, cv, cc, t_ref)[0] for seed, temp in ((11, 25.0), (12, 40.0))]
+    ident = rd.identify(robot, runs, method="ols", cutoff=None, regularization=None, model=model,
+                        thermal=True)
+    fit = ident.thermal_fit
+    np.testing.assert_allclose(fit.t_ref, t_ref, rtol=1e-12)
+    np.testing.assert_allclose(fit.viscous, cv, atol=1e-9)
+    np.testing.assert_allclose(fit.coulomb, cc, atol=1e-9)
+    assert ident.choices.thermal
+    # a third run at 32 deg C: predicted exactly, and not without the thermal term
+    rec, tau = _thermal_run(model, 13, 32.0, cv, cc, t_ref)
+    np.testing.assert_allclose(ident.predict(rec), tau, rtol=0, atol=1e-8 * np.abs(tau).max())
+    plain = rd.identify(robot, runs, method="ols", cutoff=None, regularization=None, model=model)
+    assert np.max(np.abs(plain.predict(rec) - tau)) > 1e-3
+
+
+def test_thermal_friction_needs_temperatures(planar):
+    robot, model = planar
+    t = np.arange(0.0, 5.0, 0.01)
+    q, qd, qdd = fourier(t, 2, np.random.default_rng(14))
+    rec = _recording(model, t, q, qd, qdd, model.inverse_dynamics(q, qd, qdd), "cold.csv")
+    with pytest.raises(IdentificationError, match=r"cold.csv: temperature: thermal friction needs"):
+        rd.identify(robot, rec, cutoff=None, model=model, thermal=True)
+    # "auto" without temperatures: the plain candidate only
+    assert not rd.identify(robot, rec, cutoff=None, model=model, thermal="auto").choices.thermal
+    with pytest.raises(IdentificationError, match="thermal: expected"):
+        rd.identify(robot, rec, cutoff=None, model=model, thermal="yes")

@@ -50,17 +50,26 @@ class Candidate:
         Relative held-out error over the time blocks (best Tikhonov weight); NaN: not scored.
     lam : float
         The Tikhonov weight of that best held-out error.
+    thermal : bool
+        With temperature-dependent friction (:mod:`robodyn.identify.thermal`).
     """
 
     velocity: str
     dead_band: float
     score: float = float("nan")
     lam: float = float("nan")
+    thermal: bool = False
+
+    @property
+    def key(self) -> tuple[str, float, bool]:
+        """What identifies the candidate: (velocity, dead_band, thermal)."""
+        return (self.velocity, self.dead_band, self.thermal)
 
     @property
     def label(self) -> str:
-        """``velocity=..., dead_band=...`` as printed."""
-        return f"velocity={self.velocity}, dead_band={self.dead_band:g} rad/s"
+        """``velocity=..., dead_band=..., thermal=...`` as printed."""
+        return (f"velocity={self.velocity}, dead_band={self.dead_band:g} rad/s"
+                + (", thermal friction" if self.thermal else ""))
 
 
 @dataclass(frozen=True)
@@ -82,6 +91,8 @@ class Choices:
         Every candidate tried with its score (one when nothing was left to choose).
     reason : str
         One sentence: how the winner was chosen.
+    thermal : bool
+        Whether temperature-dependent friction was used.
     """
 
     velocity: str
@@ -90,30 +101,35 @@ class Choices:
     regularization: float
     candidates: tuple[Candidate, ...]
     reason: str
+    thermal: bool = False
 
     def summary(self) -> str:
         """A few lines for the terminal and the report."""
         cut = "none" if self.cutoff is None else f"{self.cutoff:g} Hz"
         lines = [f"velocity {self.velocity}, Coulomb dead band {self.dead_band:g} rad/s, cut-off "
-                 f"{cut}, regularization {self.regularization:g}: {self.reason}"]
+                 f"{cut}, regularization {self.regularization:g}"
+                 + (", thermal friction" if self.thermal else "") + f": {self.reason}"]
         if len(self.candidates) > 1:
             for c in self.candidates:
-                mark = "*" if (c.velocity, c.dead_band) == (self.velocity, self.dead_band) else " "
+                mark = "*" if c.key == (self.velocity, self.dead_band, self.thermal) else " "
                 lines.append(f"  {mark} {c.label}: held-out blocks {c.score:.4f} (lambda {c.lam:g})")
         return "\n".join(lines)
 
 
-def candidates(velocity: str, dead_band: float | str, measured_available: bool,
-               default_band: float) -> list[Candidate]:
+def candidates(velocity: str, dead_band: float | str, thermal: bool | str, measured_available: bool,
+               temperatures_available: bool, default_band: float) -> list[Candidate]:
     """The candidates of the ``"auto"`` settings (a fixed setting is its only candidate).
 
     ``velocity="auto"``: position differences, and the measured velocity when every recording
-    has one (not estimated); ``dead_band="auto"``: none and ``default_band``.
+    has one (not estimated); ``dead_band="auto"``: none and ``default_band``;
+    ``thermal="auto"``: without, and with when every recording has temperatures.
     """
     vels = (["position", "measured"] if measured_available else ["position"]) \
         if velocity == "auto" else [velocity]
     bands = [0.0, float(default_band)] if dead_band == "auto" else [float(dead_band)]
-    return [Candidate(v, b) for v in vels for b in bands]
+    therms = ([False, True] if temperatures_available else [False]) if thermal == "auto" \
+        else [bool(thermal)]
+    return [Candidate(v, b, thermal=th) for th in therms for v in vels for b in bands]
 
 
 def choose(cands: Sequence[Candidate], stacked: Callable[[Candidate], tuple[Any, ...]]
@@ -143,7 +159,7 @@ def choose(cands: Sequence[Candidate], stacked: Callable[[Candidate], tuple[Any,
         k = int(np.argmin(per_block.sum(axis=0)))
         scored.append(Candidate(cand.velocity, cand.dead_band,
                                 float(np.sqrt(per_block[:, k].sum() / max(float(y @ y), 1e-300))),
-                                float(LAMBDA_GRID[k])))
+                                float(LAMBDA_GRID[k]), cand.thermal))
         blocks_err.append(per_block[:, k])
         problems.append(problem)
     best = 0

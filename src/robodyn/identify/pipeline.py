@@ -44,6 +44,7 @@ from robodyn.identify.preprocess import (
 from robodyn.identify.prior import joint_prior
 from robodyn.identify.result import BaseParameters, Identification
 from robodyn.identify.state_noise import state_noise_std, torque_variance
+from robodyn.identify.thermal import ThermalData, ThermalFit, thermal_data
 from robodyn.identify.to_robot import robot_with_parameters
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import IdentificationError
@@ -124,14 +125,19 @@ def _description_gains(robot: Robot) -> np.ndarray:
 
 
 def _stack(samples: Sequence[Samples], y_full: Sequence[np.ndarray], columns: np.ndarray,
-           gains: np.ndarray, loads: Sequence[np.ndarray]
+           gains: np.ndarray, loads: Sequence[np.ndarray],
+           extra: Sequence[np.ndarray] | None = None
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``Phi`` (m, b), ``y`` (m,), joint of each row, CV block of each row (m = sum N_k n);
-    ``loads`` (N_k, n): the known payload torque of each recording, taken off the target."""
+    """``Phi`` (m, b + e), ``y`` (m,), joint of each row, CV block of each row (m = sum N_k n);
+    ``loads`` (N_k, n): the known payload torque of each recording, taken off the target;
+    ``extra`` (N_k, n, e): further columns appended after the base columns (thermal friction)."""
     phis, ys, joints, blocks = [], [], [], []
-    for s, y, load in zip(samples, y_full, loads, strict=True):
+    for i, (s, y, load) in enumerate(zip(samples, y_full, loads, strict=True)):
         count, n = s.q.shape
-        phis.append(y[:, :, columns].reshape(count * n, -1))
+        rows = y[:, :, columns].reshape(count * n, -1)
+        if extra is not None:
+            rows = np.hstack([rows, extra[i].reshape(count * n, -1)])
+        phis.append(rows)
         ys.append((s.y * gains[None, :] - load).reshape(-1))  # K_j i_j - P_j (or tau_j - P_j)
         joints.append(np.tile(np.arange(n), count))
         blocks.append(np.repeat(np.arange(count) * FOLDS // count, n))
@@ -144,7 +150,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
              velocity: str = "auto", dead_band: float | str = 0.0, gains: str = "auto",
              bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None,
              payloads: Sequence[Payload | None] | None = None, weights: str = "residual",
-             state_noise: Any = None) -> Identification:
+             state_noise: Any = None, thermal: bool | str = False) -> Identification:
     """Identify the base inertial, drive and friction parameters of a robot from recordings.
 
     Parameters
@@ -200,6 +206,10 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     state_noise : (s_q, s_qd, s_qdd), optional
         Standard deviations of the processed states' noise (rad, rad/s, rad/s^2; scalars or
         (n,)), required by ``weights="state-noise"``.
+    thermal : bool or "auto"
+        Temperature-dependent viscous and Coulomb friction (:mod:`robodyn.identify.thermal`;
+        needs the recordings' ``temperature``); "auto": with and without, chosen by time-block
+        cross-validation when every recording has temperatures.
 
     Returns
     -------
@@ -212,31 +222,40 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         parameters, an unknown option, an infeasible or failed semidefinite program.
     """
     recs, target, pays = _checked_inputs(robot, recordings, target, method, friction, weights,
-                                         state_noise, gains, velocity, dead_band, payloads)
+                                         state_noise, gains, velocity, dead_band, thermal,
+                                         payloads)
     model = model if model is not None else compile_model(robot)
     measured = all(r.qd is not None and "qd" not in getattr(r, "estimated", frozenset()) for r in recs)
+    temps = all(getattr(r, "temperature", None) is not None for r in recs)
 
     def stacked(c: Candidate) -> tuple[Any, ...]:
         data = _prepared(robot, recs, target, friction, cutoff, decimate, c.velocity, c.dead_band,
-                         model)
+                         model, c.thermal)
         drive, prior, loads = _gains_and_prior(robot, data, pays, target, gains, friction)
         cols = data.relations.independent
-        phi, y, _, blocks = _stack(data.samples, data.y_full, cols, drive.k, loads)
-        test = np.vstack([prediction_rows(model, s, data.settings)[:, :, cols].reshape(-1, cols.size)
-                          for s in data.samples])
-        return phi, y, data.relations.to_base(prior), blocks, test, data, drive, prior, loads
+        th = data.thermal
+        phi, y, _, blocks = _stack(data.samples, data.y_full, cols, drive.k, loads,
+                                   None if th is None else th.fit_rows)
+        test = [prediction_rows(model, s, data.settings)[:, :, cols] for s in data.samples]
+        if th is not None:
+            test = [np.concatenate([a, b], axis=2) for a, b in zip(test, th.test_rows, strict=True)]
+        theta0 = np.concatenate([data.relations.to_base(prior), np.zeros(phi.shape[1] - cols.size)])
+        return (phi, y, theta0, blocks, np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), data,
+                drive, prior, loads)
 
-    best, problem, scored = choose(candidates(velocity, dead_band, measured, DEAD_BAND), stacked)
+    best, problem, scored = choose(candidates(velocity, dead_band, thermal, measured, temps,
+                                              DEAD_BAND), stacked)
     data, drive, prior, loads = problem[5:]
-    step = _linear_step(robot, data, drive.k, loads, prior, method, regularization, weights,
-                        state_noise)
+    step, thermal_fit = _linear_step(robot, data, drive.k, loads, prior, method, regularization,
+                                     weights, state_noise)
     theta, standard = _estimate_standard(robot, data.relations, step, prior, method, bounds)
     result = _identification(robot, data, step, theta, standard, drive, target, method)
     reason = (f"held-out time blocks ({FOLDS} per recording), {len(scored)} candidates: the plain "
               "processing unless another is better by more than one standard error"
               if len(scored) > 1 else "as given")
     result = replace(result, choices=Choices(best.velocity, best.dead_band, data.settings.cutoff,
-                                             step.fit.lam, tuple(scored), reason))
+                                             step.fit.lam, tuple(scored), reason, best.thermal),
+                     thermal_fit=thermal_fit)
     if friction in NONLINEAR:
         result = replace(result, friction_fit=fit_friction_samples(result, data.samples, data.y_full,
                                                                     friction))
@@ -261,6 +280,8 @@ class _Prepared:
         Filtered and decimated full regressor of each recording, (N_k, n, 15 n).
     count : int
         Total number of samples ``sum N_k`` after decimation.
+    thermal : ThermalData or None
+        The thermal friction columns (``thermal=True``).
     """
 
     settings: Preprocess
@@ -269,6 +290,7 @@ class _Prepared:
     samples: list[Samples]
     y_full: list[np.ndarray]
     count: int
+    thermal: ThermalData | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -320,6 +342,7 @@ class _LinearStep:
 
 def _checked_inputs(robot: Robot, recordings: Any, target: str | None, method: str, friction: str,
                     weights: str, state_noise: Any, gains: str, velocity: str, dead_band: Any,
+                    thermal: Any,
                     payloads: Sequence[Payload | None] | None
                     ) -> tuple[list[Any], str, list[Payload | None]]:
     """The recordings as a list, the resolved target and one payload per recording (step 1).
@@ -346,6 +369,8 @@ def _checked_inputs(robot: Robot, recordings: Any, target: str | None, method: s
                                   "(s_q, s_qd, s_qdd) in rad, rad/s, rad/s^2")
     if velocity not in ("auto", "position", "measured"):
         raise IdentificationError(f"velocity: expected 'auto', 'position' or 'measured', got {velocity!r}")
+    if thermal not in (False, True, "auto"):
+        raise IdentificationError(f"thermal: expected False, True or 'auto', got {thermal!r}")
     if isinstance(dead_band, str) and dead_band != "auto":
         raise IdentificationError(f"dead_band: expected a velocity in rad/s or 'auto', got {dead_band!r}")
     if gains not in ("auto", "description", "absorbed"):
@@ -356,7 +381,8 @@ def _checked_inputs(robot: Robot, recordings: Any, target: str | None, method: s
 
 
 def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff: float | str | None,
-              decimate: int | str, velocity: str, dead_band: float, model: Model) -> _Prepared:
+              decimate: int | str, velocity: str, dead_band: float, model: Model,
+              thermal: bool = False) -> _Prepared:
     """Preprocessed samples, filtered regressors and base relations of ``recs`` (steps 2 and 3).
 
     Raises :class:`IdentificationError` when the
@@ -376,7 +402,8 @@ def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff:
             f"recordings: too few samples for the parameters: {count} samples x {robot.dof} joints "
             f"= {count * robot.dof} equations after decimation by {settings.decimate} for {b} base "
             f"parameters (at least {2 * b} needed; record longer or pass decimate=1)")
-    return _Prepared(settings, model, relations, samples, y_full, count)
+    return _Prepared(settings, model, relations, samples, y_full, count,
+                     thermal_data(recs, full, settings) if thermal else None)
 
 
 def _at_rest(samples: Sequence[Samples], band: float) -> np.ndarray:
@@ -429,20 +456,48 @@ def _payload_gains(robot: Robot, data: _Prepared, loads: list[np.ndarray], drive
 
 def _linear_step(robot: Robot, data: _Prepared, k: np.ndarray, loads: list[np.ndarray],
                  prior: np.ndarray, method: str, regularization: float | str | None, weights: str,
-                 state_noise: Any) -> _LinearStep:
-    """The stacked problem and its (weighted) least-squares fit toward ``prior`` (steps 4 and 6).
+                 state_noise: Any) -> tuple[_LinearStep, ThermalFit | None]:
+    """The stacked problem and its (weighted) least-squares fit toward ``prior`` (steps 4 and 6),
+    and the thermal friction fit (None without ``data.thermal``).
 
     ``k`` (n,) are the drive gains, N m / A, ``loads`` (N_k, n) the payload torques, N m, and
-    ``prior`` (15 n,) the standard parameters of the prior.
+    ``prior`` (15 n,) the standard parameters of the prior. With thermal columns the thermal
+    coefficients are estimated together with the base parameters (toward 0), their torque is
+    then taken off the target and the base parameters fitted again alone, so that every later
+    step (weights, the consistent program) sees the base columns only.
     """
     phi, y, joint, blocks = _stack(data.samples, data.y_full, data.relations.independent, k, loads)
     theta0 = data.relations.to_base(prior)
     lin_method = "ols" if method == "ols" else "wls"
+    thermal_fit = None
+    if data.thermal is not None:
+        extra = np.vstack([r.reshape(-1, r.shape[2]) for r in data.thermal.fit_rows])
+        coef = _thermal_coefficients(phi, y, theta0, joint, blocks, extra, lin_method, regularization)
+        y = y - extra @ coef  # tau - (T - T_ref)(cv qd + cc sign qd)
+        thermal_fit = ThermalFit(data.thermal.t_ref, coef[0::2], coef[1::2])
     fit = fit_linear(phi, y, theta0, joint, blocks, method=lin_method, regularization=regularization)
     step = _LinearStep(phi, y, joint, blocks, theta0, fit)
     if weights == "state-noise":
         step = replace(step, fit=_state_noise_fit(robot, data, step, prior, regularization, state_noise))
-    return step
+    return step, thermal_fit
+
+
+def _thermal_coefficients(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, joint: np.ndarray,
+                          blocks: np.ndarray, extra: np.ndarray, method: str,
+                          regularization: float | str | None) -> np.ndarray:
+    """Thermal coefficients (e,) of the columns ``extra`` (m, e), not regularised.
+
+    ``min |y - Phi theta - E c|^2 + lam |theta - theta0|^2`` (Tikhonov on the base parameters
+    only: a weight chosen for them would pull the small thermal columns to zero): for any
+    ``theta`` the best ``c`` is ``E^+ (y - Phi theta)``, so ``theta`` is the usual fit of the
+    rows projected off the thermal columns, ``P = 1 - Q Q^T`` with ``E = Q R``.
+    """
+    q, _ = np.linalg.qr(extra)
+    # P Phi, P y: the base problem with the thermal columns projected out
+    fit = fit_linear(phi - q @ (q.T @ phi), y - q @ (q.T @ y), theta0, joint, blocks, method=method,
+                     regularization=regularization)
+    # c = E^+ (y - Phi theta)
+    return np.linalg.lstsq(extra, y - phi @ fit.theta, rcond=None)[0]
 
 
 def _state_noise_fit(robot: Robot, data: _Prepared, step: _LinearStep, prior: np.ndarray,

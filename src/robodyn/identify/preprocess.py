@@ -47,7 +47,8 @@ from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass
 from robodyn.robot.errors import IdentificationError
 
 __all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "DEAD_BAND", "MID_RATE", "Preprocess", "Samples",
-           "coulomb_dead_band", "prediction_rows", "preprocess", "regressor_rows", "resolve_preprocess"]
+           "coulomb_dead_band", "evaluation_step", "filtered_rows", "prediction_rows", "preprocess",
+           "regressor_rows", "resolve_preprocess"]
 
 AUTO_MIN_HZ = 2.0
 AUTO_MAX_HZ = 5.0
@@ -236,17 +237,32 @@ def regressor_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool 
     band = settings.dead_band
     if settings.cutoff is None:
         return coulomb_dead_band(model.regressor(s.q[::d], s.qd[::d], s.qdd[::d]), s.qd[::d], band)
-    fs = 1.0 / float(np.median(np.diff(s.t)))
-    limit = max(1, int(fs / (MID_RATE * settings.cutoff)))
-    m = max(k for k in range(1, d + 1) if d % k == 0 and k <= limit)
+    m = evaluation_step(s.t, settings, d)
     y = coulomb_dead_band(model.regressor(s.q[::m], s.qd[::m], s.qdd[::m]), s.qd[::m], band)
+    return filtered_rows(s.t[::m], y, settings, d // m)
+
+
+def evaluation_step(t: np.ndarray, settings: Preprocess, d: int) -> int:
+    """The step ``m`` (a divisor of the decimation ``d``) at which rows are evaluated and filtered:
+    the largest with at least ``MID_RATE`` samples per cut-off period (:func:`regressor_rows`)."""
+    if settings.cutoff is None:
+        return d
+    fs = 1.0 / float(np.median(np.diff(t)))
+    limit = max(1, int(fs / (MID_RATE * settings.cutoff)))
+    return max(k for k in range(1, d + 1) if d % k == 0 and k <= limit)
+
+
+def filtered_rows(t: np.ndarray, y: np.ndarray, settings: Preprocess, keep: int) -> np.ndarray:
+    """Rows ``y`` (N, ...) at times ``t`` (N,) low-passed along time with the target's filter,
+    then every ``keep``-th kept (N / keep, ...)."""
     count = y.shape[0]
     flat = y.reshape(count, -1)
+    if settings.cutoff is None:
+        return flat[::keep].reshape((-1,) + y.shape[1:])
     # H Y: the same zero-phase low-pass as the target, along time, on the columns that vary (a
     # constant column, most of them structural zeros, is its own low-pass)
     varying = np.flatnonzero(np.ptp(flat, axis=0) > 0)
-    out = flat[::d // m].copy()
+    out = flat[::keep].copy()
     if varying.size:
-        out[:, varying] = lowpass(s.t[::m], flat[:, varying], settings.cutoff,
-                                  order=settings.order)[::d // m]
+        out[:, varying] = lowpass(t, flat[:, varying], settings.cutoff, order=settings.order)[::keep]
     return out.reshape((-1,) + y.shape[1:])

@@ -13,6 +13,7 @@ from robodyn.identify.base import BaseRelations
 from robodyn.identify.choices import Choices
 from robodyn.identify.friction import FrictionFit, without_friction
 from robodyn.identify.preprocess import Preprocess, prediction_rows, preprocess
+from robodyn.identify.thermal import ThermalFit, temperatures
 from robodyn.numeric.model import Model
 from robodyn.robot.model import Robot
 
@@ -128,6 +129,10 @@ class Identification:
         The preprocessing chosen from the data (velocity source, Coulomb dead band, cut-off,
         regularisation) with every candidate's cross-validated score
         (:mod:`robodyn.identify.choices`).
+    thermal_fit : ThermalFit or None
+        Temperature coefficients of the friction (``thermal=True``,
+        :mod:`robodyn.identify.thermal`): :meth:`predict` adds their torque (the recording then
+        needs temperatures); ``robot`` carries the friction at the reference temperature.
     """
 
     robot: Robot
@@ -149,6 +154,7 @@ class Identification:
     friction_fit: FrictionFit | None = None
     gains_std: np.ndarray | None = None
     choices: Choices | None = None
+    thermal_fit: ThermalFit | None = None
 
     @property
     def gains_identified(self) -> bool:
@@ -180,11 +186,16 @@ class Identification:
         check_recording(self.robot, recording, 0, None)
         s = preprocess(recording, self.preprocess, None)
         y = prediction_rows(self._model, s, self.preprocess)
+        thermal = 0.0
+        if self.thermal_fit is not None:
+            temp = temperatures(recording, 0, self.robot.dof)
+            thermal = self.thermal_fit.torque(s.qd, temp, self.preprocess.dead_band)
         if self.friction_fit is None:
             tau = y @ self.standard  # tau = Y(q, qd, qdd) p
         else:
             load = y @ without_friction(self.standard)  # rigid body and rotor inertia
             tau = load + self.friction_fit.torque(s.qd, load)
+        tau = tau + thermal  # (T - T_ref)(cv qd + cc sign qd)
         if payload is not None:
             from robodyn.identify.payload import payload_standard, payload_torque
 
