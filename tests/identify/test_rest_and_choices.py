@@ -137,13 +137,13 @@ def test_velocity_source_chosen_by_held_out_blocks(planar):
     robot, model = planar
     # coarse encoder, clean tachometer: the measured velocity predicts better
     coarse = _velocity_case(model, 7, quantum=0.02, qd_noise=0.0)
-    ident = rd.identify(robot, coarse, model=model, velocity="auto")
+    ident = rd.identify(robot, coarse, model=model, velocity="auto", cutoff=5.0)
     assert ident.choices.velocity == "measured"
     assert ident.preprocess.velocity == "measured"
     assert len(ident.choices.candidates) == 2
     # fine encoder, very noisy tachometer: position differences
     noisy = _velocity_case(model, 8, quantum=0.0, qd_noise=2.0)
-    ident = rd.identify(robot, noisy, model=model, velocity="auto")
+    ident = rd.identify(robot, noisy, model=model, velocity="auto", cutoff=5.0)
     assert ident.choices.velocity == "position"
     scores = {c.velocity: c.score for c in ident.choices.candidates}
     assert scores["position"] < scores["measured"]
@@ -153,7 +153,7 @@ def test_velocity_source_chosen_by_held_out_blocks(planar):
 def test_a_fixed_setting_is_reported_as_given(planar):
     robot, model = planar
     rec = _velocity_case(model, 9, quantum=0.0, qd_noise=0.0)
-    ident = rd.identify(robot, rec, model=model, velocity="position")
+    ident = rd.identify(robot, rec, model=model, velocity="position", cutoff=4.0)
     assert ident.choices.reason == "as given"
     assert len(ident.choices.candidates) == 1
     assert ident.choices.regularization == ident.regularization
@@ -228,3 +228,42 @@ def test_thermal_friction_needs_temperatures(planar):
     assert not rd.identify(robot, rec, cutoff=None, model=model, thermal="auto").choices.thermal
     with pytest.raises(IdentificationError, match="thermal: expected"):
         rd.identify(robot, rec, cutoff=None, model=model, thermal="yes")
+
+
+def test_cutoff_candidates_are_the_rule_and_a_wider_one(planar):
+    from robodyn.identify.pipeline import CUTOFF_WIDER, _cutoff_candidates
+    from robodyn.identify.preprocess import resolve_preprocess
+
+    robot, model = planar
+    rec = _velocity_case(model, 10, quantum=0.0, qd_noise=0.0)
+    rule = resolve_preprocess([rec], "auto", "auto").cutoff
+    assert _cutoff_candidates([rec], "auto") == ("auto", CUTOFF_WIDER * rule)
+    assert _cutoff_candidates([rec], 3.0) == (3.0,)
+    ident = rd.identify(robot, rec, model=model, velocity="position")
+    labels = [c.label for c in ident.choices.candidates]
+    assert len(labels) == 2 and "cutoff=auto" in labels[0]
+    # exact positions: the wider filter distorts the motion less, and wins
+    assert ident.preprocess.cutoff == CUTOFF_WIDER * rule
+    # a coarse encoder (0.02 rad steps): its differentiated noise grows with the cut-off, the
+    # rule's cut-off stays
+    coarse = _velocity_case(model, 10, quantum=0.02, qd_noise=0.0)
+    ident = rd.identify(robot, coarse, model=model, velocity="position")
+    assert ident.preprocess.cutoff == resolve_preprocess([coarse], "auto", "auto").cutoff
+
+
+def test_current_running_against_the_torque_gets_a_negative_gain(planar):
+    # a motor-side current sensor on a drive turning against its joint (gear_ratio < 0 in a
+    # description) logs I = tau / (-|K|): the identification takes the sense from the data
+    robot, model = planar
+    t = np.arange(0.0, 20.0, 0.01)
+    q, qd, qdd = fourier(t, 2, np.random.default_rng(15))
+    tau = model.inverse_dynamics(q, qd, qdd)
+    k_true = np.array([-4.0, 2.5])
+    rec = rd.Recording(t=t, q=q, qd=qd, qdd=qdd, current=tau / k_true,
+                       joint_names=robot.joint_names, source="reversed")
+    ident = rd.identify(robot, rec, target="current", method="ols", cutoff=None,
+                        regularization=None, model=model)
+    assert "current reversed: q1" in ident.gains_source and "q2" not in ident.gains_source.split(":")[-1]
+    assert ident.gains[0] < 0 < ident.gains[1]
+    np.testing.assert_allclose(ident.predict(rec), rec.current, rtol=0,
+                               atol=1e-8 * np.abs(rec.current).max())

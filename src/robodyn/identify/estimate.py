@@ -30,7 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["FOLDS", "LAMBDA_GRID", "RANK_RTOL", "LinearFit", "cv_errors_unweighted", "fit_linear"]
+__all__ = ["FOLDS", "LAMBDA_GRID", "RANK_RTOL", "LinearFit", "cv_errors_unweighted", "fit_linear",
+           "joint_weights"]
 
 RANK_RTOL = 1e-9
 FOLDS = 5
@@ -99,17 +100,19 @@ def _solve(a: np.ndarray, b: np.ndarray, z0: np.ndarray, lams: np.ndarray
 
 
 def _cv_block_errors(a: np.ndarray, b: np.ndarray, z0: np.ndarray, blocks: np.ndarray,
-                     a_test: np.ndarray | None = None) -> np.ndarray:
+                     a_test: np.ndarray | None = None, b_test: np.ndarray | None = None) -> np.ndarray:
     """Held-out squared error of each block (K, len(LAMBDA_GRID)) for each grid weight; the
-    held-out rows are predicted with ``a_test`` (same shape as ``a``; default ``a``)."""
+    held-out rows are predicted with ``a_test`` (same shape as ``a``; default ``a``) and
+    compared with ``b_test`` (default ``b``)."""
     a_test = a if a_test is None else a_test
+    b_test = b if b_test is None else b_test
     out = []
     for k in np.unique(blocks):
         test = blocks == k
         if test.all():
             continue
         z, *_ = _solve(a[~test], b[~test], z0, LAMBDA_GRID)
-        out.append(np.sum((b[test][None, :] - z @ a_test[test].T) ** 2, axis=1))
+        out.append(np.sum((b_test[test][None, :] - z @ a_test[test].T) ** 2, axis=1))
     return np.array(out).reshape(-1, LAMBDA_GRID.size)
 
 
@@ -118,15 +121,28 @@ def _cv_errors(a: np.ndarray, b: np.ndarray, z0: np.ndarray, blocks: np.ndarray)
 
 
 def cv_errors_unweighted(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, blocks: np.ndarray,
-                         phi_test: np.ndarray | None = None) -> np.ndarray:
+                         phi_test: np.ndarray | None = None, y_test: np.ndarray | None = None,
+                         rows: np.ndarray | None = None) -> np.ndarray:
     """Held-out squared error of each time block (K, len(LAMBDA_GRID)) of the rows ``phi``
-    (m, p), ``y`` (m,) with blocks (m,), columns scaled to unit norm, rows unweighted, toward
-    ``theta0`` (p,), for each grid weight; held-out rows predicted with ``phi_test`` (m, p)
-    (default ``phi``)."""
-    norms = np.linalg.norm(phi, axis=0)
+    (m, p), ``y`` (m,) with blocks (m,), columns scaled to unit norm, toward ``theta0`` (p,),
+    for each grid weight. The fit weights its rows by ``rows`` (m,) (default 1); the held-out
+    rows, predicted with ``phi_test`` (m, p) (default ``phi``), are compared unweighted with
+    ``y_test`` (m,) (default ``y``)."""
+    w = np.ones(y.size) if rows is None else np.asarray(rows, dtype=float)
+    a = phi * w[:, None]
+    norms = np.linalg.norm(a, axis=0)
     scale = np.where(norms > 0, norms, 1.0)
-    a_test = None if phi_test is None else phi_test / scale[None, :]
-    return _cv_block_errors(phi / scale[None, :], y, theta0 * scale, blocks, a_test)
+    a_test = (phi if phi_test is None else phi_test) / scale[None, :]
+    return _cv_block_errors(a / scale[None, :], y * w, theta0 * scale, blocks, a_test,
+                            y if y_test is None else y_test)
+
+
+def joint_weights(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, joint: np.ndarray,
+                  blocks: np.ndarray) -> np.ndarray:
+    """Row weights (m,) of weighted least squares: ``1 / sigma_j`` of each row's joint, from the
+    residuals of an ordinary fit (the first step of :func:`fit_linear` with ``method="wls"``)."""
+    first = fit_linear(phi, y, theta0, joint, blocks, method="wls", regularization="auto")
+    return first.weights[joint]
 
 
 def _one(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, joint: np.ndarray, blocks: np.ndarray,

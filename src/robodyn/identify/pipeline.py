@@ -27,7 +27,7 @@ import numpy as np
 import sympy as sp
 
 from robodyn.identify.base import BaseRelations, base_relations
-from robodyn.identify.choices import Candidate, Choices, candidates, choose
+from robodyn.identify.choices import Candidate, Choices, Problem, candidates, choose
 from robodyn.identify.drive_gains import estimate_drive_gains
 from robodyn.identify.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identify.friction import FRICTION_MODELS, NONLINEAR, fit_friction_samples, without_friction
@@ -46,6 +46,7 @@ from robodyn.identify.result import BaseParameters, Identification
 from robodyn.identify.state_noise import state_noise_std, torque_variance
 from robodyn.identify.thermal import ThermalData, ThermalFit, thermal_data
 from robodyn.identify.to_robot import robot_with_parameters
+from robodyn.measure.filtering import lowpass
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
@@ -58,6 +59,8 @@ METHODS = ("ols", "wls", "consistent")
 WEIGHTS = ("residual", "state-noise")
 #: Floor of the measurement variance, as a fraction of the first fit's residual variance.
 MEAS_FLOOR = 0.01
+#: The wider cut-off tried by cross-validation, as a multiple of the rule's (cutoff="auto").
+CUTOFF_WIDER = 2.5
 #: Fraction of a joint's samples at rest from which its friction offset is its own base parameter.
 REST_FRACTION = 0.01
 #: Unit directions whose singular value is below this fraction of the largest are reported.
@@ -228,24 +231,31 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     measured = all(r.qd is not None and "qd" not in getattr(r, "estimated", frozenset()) for r in recs)
     temps = all(getattr(r, "temperature", None) is not None for r in recs)
 
-    def stacked(c: Candidate) -> tuple[Any, ...]:
-        data = _prepared(robot, recs, target, friction, cutoff, decimate, c.velocity, c.dead_band,
+    def stacked(c: Candidate) -> Problem:
+        data = _prepared(robot, recs, target, friction, c.cutoff, decimate, c.velocity, c.dead_band,
                          model, c.thermal)
         drive, prior, loads = _gains_and_prior(robot, data, pays, target, gains, friction)
         cols = data.relations.independent
         th = data.thermal
-        phi, y, _, blocks = _stack(data.samples, data.y_full, cols, drive.k, loads,
-                                   None if th is None else th.fit_rows)
+        phi, y, joint, blocks = _stack(data.samples, data.y_full, cols, drive.k, loads,
+                                       None if th is None else th.fit_rows)
         test = [prediction_rows(model, s, data.settings)[:, :, cols] for s in data.samples]
         if th is not None:
             test = [np.concatenate([a, b], axis=2) for a, b in zip(test, th.test_rows, strict=True)]
         theta0 = np.concatenate([data.relations.to_base(prior), np.zeros(phi.shape[1] - cols.size)])
-        return (phi, y, theta0, blocks, np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), data,
-                drive, prior, loads)
+        d = data.settings.decimate
+        # the common held-out target at the same samples, torque units, payload torque taken off
+        held = np.concatenate([(ref[::d] * drive.k - load).reshape(-1)
+                               for ref, load in zip(reference, loads, strict=True)])
+        return Problem(phi, y, theta0, joint, blocks,
+                       np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), held,
+                       (data, drive, prior, loads))
 
-    best, problem, scored = choose(candidates(velocity, dead_band, thermal, measured, temps,
-                                              DEAD_BAND), stacked)
-    data, drive, prior, loads = problem[5:]
+    cutoffs = _cutoff_candidates(recs, cutoff)
+    reference = _reference_targets(recs, target, cutoffs[0])
+    cands = candidates(velocity, dead_band, thermal, measured, temps, DEAD_BAND, cutoffs)
+    best, problem, scored = choose(cands, stacked)
+    data, drive, prior, loads = problem.payload
     step, thermal_fit = _linear_step(robot, data, drive.k, loads, prior, method, regularization,
                                      weights, state_noise)
     theta, standard = _estimate_standard(robot, data.relations, step, prior, method, bounds)
@@ -254,7 +264,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
               "processing unless another is better by more than one standard error"
               if len(scored) > 1 else "as given")
     result = replace(result, choices=Choices(best.velocity, best.dead_band, data.settings.cutoff,
-                                             step.fit.lam, tuple(scored), reason, best.thermal),
+                                             step.fit.lam, tuple(scored), reason, best.thermal, best),
                      thermal_fit=thermal_fit)
     if friction in NONLINEAR:
         result = replace(result, friction_fit=fit_friction_samples(result, data.samples, data.y_full,
@@ -404,6 +414,31 @@ def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff:
             f"parameters (at least {2 * b} needed; record longer or pass decimate=1)")
     return _Prepared(settings, model, relations, samples, y_full, count,
                      thermal_data(recs, full, settings) if thermal else None)
+
+
+def _cutoff_candidates(recs: list[Any], cutoff: float | str | None) -> tuple[float | str | None, ...]:
+    """The cut-offs to try: a given one alone; for "auto" its rule's value and ``CUTOFF_WIDER``
+    times it (below 0.2 x the slowest sampling rate), for a record whose torque holds more above
+    the motion's own bandwidth (a stiff controller, a fast excitation) than its noise."""
+    if cutoff != "auto":
+        return (cutoff,)
+    rule = resolve_preprocess(recs, "auto", "auto").cutoff
+    fs = min(1.0 / float(np.median(np.diff(np.asarray(r.t, float)))) for r in recs)
+    wide = min(CUTOFF_WIDER * rule, 0.2 * fs)
+    return ("auto", wide) if wide > 1.01 * rule else ("auto",)
+
+
+def _reference_targets(recs: list[Any], target: str, cutoff: float | str | None) -> list[np.ndarray]:
+    """The held-out target of the cross-validated choices, (N_k, n) per recording: each
+    recording's target low-passed at the first (plain) candidate's cut-off, the same for every
+    candidate, so that a wider cut-off wins only by better parameters, not by following the
+    target's noise (the raw target when the plain candidate has no filter)."""
+    cut = resolve_preprocess(recs, cutoff, 1).cutoff
+    out = []
+    for r in recs:
+        y = np.asarray(getattr(r, target), float)
+        out.append(y if cut is None else lowpass(np.asarray(r.t, float), y, cut, order=4))
+    return out
 
 
 def _at_rest(samples: Sequence[Samples], band: float) -> np.ndarray:

@@ -37,7 +37,11 @@ from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
 from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
 
-__all__ = ["GAIN_MODES", "IdentificationWarning", "description_gains", "joint_prior"]
+__all__ = ["GAIN_MODES", "REVERSED_CORRELATION", "IdentificationWarning", "current_directions",
+           "description_gains", "joint_prior"]
+
+#: A joint's current whose correlation with the nominal torque is below minus this runs reversed.
+REVERSED_CORRELATION = 0.5
 
 GAIN_MODES = ("auto", "description", "absorbed")
 
@@ -78,8 +82,10 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
     Returns
     -------
     gains : numpy.ndarray, shape (n,)
-        ``K_j`` (ones for torque targets).
+        ``K_j`` (ones for torque targets); negative for a joint whose current runs against its
+        torque (:func:`current_directions`).
     source : {"none", "description", "absorbed"}
+        With " (current reversed: ...)" naming such joints.
     prior : numpy.ndarray, shape (15 n,)
     """
     n = robot.dof
@@ -101,11 +107,12 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
     gains = np.ones(n) if fixed is None else fixed.copy()
     prior = rigid.copy()
     failed = []
+    flip = current_directions(samples, y_full, nominal) if target == "current" else np.ones(n)
 
     def fit(j: int, gain: float | None) -> bool:
         tau_nom = np.concatenate([y[:, j, :] @ rigid for y in y_full])
         cols = np.vstack([_joint_columns(y, j) for y in y_full])
-        b = np.concatenate([s.y[:, j] for s in samples])
+        b = np.concatenate([s.y[:, j] for s in samples]) * flip[j]  # current in the torque's sense
         a = np.column_stack([tau_nom, cols]) if gain is None else cols
         if gain is not None:
             b = b - tau_nom / gain
@@ -141,4 +148,25 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
             gains[j] = float(np.exp(np.mean(np.log(gains[ok]))))
             fit(j, gains[j])
         source = "absorbed (" + ", ".join(robot.joint_names[j] for j in failed) + ": mean of the others)"
-    return gains, source, prior
+    if np.any(flip < 0):
+        reversed_ = ", ".join(robot.joint_names[j] for j in np.flatnonzero(flip < 0))
+        source += f" (current reversed: {reversed_})"
+    return gains * flip, source, prior
+
+
+def current_directions(samples: Sequence[Samples], y_full: Sequence[np.ndarray], nominal: np.ndarray
+                       ) -> np.ndarray:
+    """Sense (n,) of each joint's current relative to its torque: -1 where the current is
+    strongly anti-correlated with the description's joint torque ``Y p_nominal`` (rigid body,
+    rotor inertia and friction; correlation below
+    ``-REVERSED_CORRELATION``: a motor-side current sensor on a drive turning against the
+    joint, or a log's sign convention), else +1. A weak correlation (a joint whose torque the
+    description barely explains) keeps +1."""
+    n = samples[0].q.shape[1]
+    out = np.ones(n)
+    for j in range(n):
+        tau = np.concatenate([y[:, j, :] @ nominal for y in y_full])
+        cur = np.concatenate([s.y[:, j] for s in samples])
+        if np.std(tau) > 0 and np.std(cur) > 0 and np.corrcoef(tau, cur)[0, 1] < -REVERSED_CORRELATION:
+            out[j] = -1.0
+    return out

@@ -164,12 +164,11 @@ def _choices_html(ident: Any) -> str:
     ch = getattr(ident, "choices", None)
     if ch is None:
         return ""
-    chosen = (ch.velocity, ch.dead_band, ch.thermal)
-    rows = "".join(f"<tr><td>{html.escape(c.velocity)}</td><td>{c.dead_band:g}</td>"
-                   f"<td>{'yes' if c.thermal else 'no'}</td><td>{c.score:.4f}</td><td>{c.lam:g}</td>"
+    chosen = None if ch.chosen is None else ch.chosen.key
+    rows = "".join(f"<tr><td>{html.escape(c.label)}</td><td>{c.score:.4f}</td><td>{c.lam:g}</td>"
                    f"<td>{'chosen' if c.key == chosen else ''}</td></tr>" for c in ch.candidates)
-    table = ("<table><tr><th>velocity</th><th>dead band, rad/s</th><th>thermal friction</th>"
-             "<th>held-out blocks, relative</th><th>best weight</th><th></th></tr>" + rows + "</table>"
+    table = ("<table><tr><th>candidate</th><th>held-out blocks, relative</th><th>best weight</th>"
+             "<th></th></tr>" + rows + "</table>"
              if len(ch.candidates) > 1 else "")
     return (f"<h2>Choices</h2>\n<p>Velocity <b>{html.escape(ch.velocity)}</b>, Coulomb dead band "
             f"<b>{ch.dead_band:g} rad/s</b>, cut-off {_cutoff(ident)}, Tikhonov weight "
