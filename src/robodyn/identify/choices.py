@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from robodyn.identify.estimate import LAMBDA_GRID, cv_errors_unweighted, joint_weights
+from robodyn.identify.estimate import LAMBDA_GRID, candidate_cv_errors
 
 __all__ = ["Candidate", "Choices", "Problem", "candidates", "choose"]
 
@@ -203,9 +203,8 @@ def choose(cands: Sequence[Candidate], stacked: Callable[[Candidate], Problem]
         # the estimator's own row weights (per joint, from a first fit), the raw target held out;
         # squared error of each held-out block (K, L) relative to the whole target: candidates
         # with another decimation (another cut-off) have other rows, the same blocks of time
-        rows = joint_weights(pr.phi, pr.y, pr.theta0, pr.joint, pr.blocks)
-        per_block = cv_errors_unweighted(pr.phi, pr.y, pr.theta0, pr.blocks, pr.phi_test, pr.y_test,
-                                         rows)
+        per_block = candidate_cv_errors(pr.phi, pr.y, pr.theta0, pr.joint, pr.blocks, pr.phi_test,
+                                        pr.y_test)
         per_block = per_block / max(float(pr.y_test @ pr.y_test), 1e-300)
         k = int(np.argmin(per_block.sum(axis=0)))
         scored.append(replace(cand, score=float(np.sqrt(per_block[:, k].sum())),
