@@ -126,7 +126,8 @@ def _cmd_identify(args: argparse.Namespace) -> int:
         ident = rd.identify(robot, recs + loaded, target=args.target, method=args.method,
                             friction=args.friction, velocity=args.velocity,
                             dead_band=args.dead_band, cutoff=args.cutoff,
-                            regularization=args.regularization, decimate=args.decimate, **extra)
+                            regularization=args.regularization, decimate=args.decimate,
+                            sensor=args.sensor, **extra)
     stem = f"{robot.name}_identified"
     paths = {"yaml": out / f"{stem}.yaml", "urdf": out / f"{stem}.urdf",
              "parameters": out / "parameters.csv"}
@@ -191,13 +192,15 @@ def _with_gains(robot: rd.Robot, gains: np.ndarray) -> rd.Robot:
 
 
 def _check_loadable(path: Path) -> int:
-    """0 when the identified description loads again, else 1 with the loader's reason."""
+    """0 when the identified description loads again with physical values (strict: every link's
+    inertia positive semi-definite and within the triangle inequality, a regular mass matrix),
+    else 1 with the loader's reason, as ``--help`` promises."""
     from robodyn.robot.errors import DescriptionError
 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            rd.load(str(path))
+            rd.load(str(path), strict=True)
     except DescriptionError as exc:
         err(f"robodyn: warning: the identified description does not load: {' '.join(str(exc).split())}"
             " (an unconstrained estimate can be non-physical; try --method consistent)")
@@ -347,6 +350,10 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
     p.add_argument("--decimate", type=_auto_or(int), default="auto", metavar="K",
                    help="keep every K-th filtered sample for the fit, or auto: about five per "
                         "cut-off period (default: %(default)s)")
+    p.add_argument("--sensor", choices=("motor", "link"), default="motor",
+                   help="where the effort is measured: motor (current, or a torque that includes "
+                        "the drive) or link (a joint torque sensor after the gear: the rotor "
+                        "inertia is not identified; --target tau) (default: %(default)s)")
     p.add_argument("--no-report", action="store_true",
                    help="skip report.html and its figures (every other output is written)")
 

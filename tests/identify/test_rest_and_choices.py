@@ -315,3 +315,26 @@ def test_irregular_stamps_with_gaps_and_quantised_values(puma, decimals):
                                             joint_names=robot.joint_names), model=model)
     wrong = naive.predict(rd.Recording(t=uniform, q=check.q, joint_names=robot.joint_names))
     assert np.linalg.norm(wrong - exact) / np.linalg.norm(exact) > 2 * rel
+
+
+def test_link_side_torque_sensor_drops_the_rotor_inertia(puma):
+    # a joint torque sensor after the gear does not see the rotor: the plant's measured torque
+    # has no reflected rotor inertia although the description has drives
+    robot, model = puma
+    p_true = nominal_standard(robot).copy()
+    ia = p_true[len(INERTIAL_NAMES)::PER_JOINT].copy()
+    assert np.all(ia > 0)  # the PUMA 560's description carries rotor inertia
+    p_true[len(INERTIAL_NAMES)::PER_JOINT] = 0.0
+    t = np.arange(0.0, 20.0, 0.01)
+    q, qd, qdd = fourier(t, 6, np.random.default_rng(16))
+    tau = model.regressor(q, qd, qdd) @ p_true
+    rec = _recording(model, t, q, qd, qdd, tau, "link_sensor")
+    ident = rd.identify(robot, rec, method="ols", cutoff=None, regularization=None, model=model,
+                        sensor="link")
+    assert not any(name.startswith("Ia") for name in ident.relations.names)
+    np.testing.assert_array_equal(ident.standard[len(INERTIAL_NAMES)::PER_JOINT], 0.0)
+    np.testing.assert_allclose(ident.predict(rec), tau, rtol=0, atol=1e-8 * np.abs(tau).max())
+    with pytest.raises(IdentificationError, match="sensor: 'link'.*needs target='tau'"):
+        rd.identify(robot, rd.Recording(t=t, q=q, qd=qd, qdd=qdd, current=tau,
+                                        joint_names=robot.joint_names), target="current",
+                    model=model, sensor="link")

@@ -57,7 +57,7 @@ def test_identify_command_writes_a_loadable_robot_and_tables(files, tmp_path, ca
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            from_yaml = rd.load(str(yaml_path))
+            from_yaml = rd.load(str(yaml_path), strict=True)
     except DescriptionError as exc:
         # a non-physical unconstrained estimate: exit 1 with the loader's reason, files written
         assert rc == 1
@@ -129,7 +129,7 @@ def test_identify_preprocessing_options_and_no_report(files, tmp_path, capsys):
     train, _ = files
     rc = main(["identify", "puma560", "--data", str(train), "--method", "ols", "--velocity", "position",
                "--dead-band", "0.002", "--cutoff", "none", "--regularization", "none",
-               "--decimate", "1", "--no-report", "-o", str(tmp_path)])
+               "--decimate", "1", "--sensor", "link", "--no-report", "-o", str(tmp_path)])
     out = capsys.readouterr().out
     assert rc in (0, 1)  # 1: an unconstrained estimate that does not load (tested above)
     assert "choices: velocity position, Coulomb dead band 0.002 rad/s, cut-off none, " \
@@ -137,6 +137,8 @@ def test_identify_preprocessing_options_and_no_report(files, tmp_path, capsys):
     assert not (tmp_path / "report.html").exists()
     assert (tmp_path / "parameters.csv").exists() and (tmp_path / "validation.csv").exists()
     assert "wrote report" not in out
+    # --sensor link: no rotor inertia in the written description
+    assert "Ia" not in {r["name"][:2] for r in _rows(tmp_path / "parameters.csv")}
 
 
 @pytest.mark.parametrize("option, value", [("--cutoff", "fast"), ("--regularization", "inf"),
@@ -147,3 +149,26 @@ def test_identify_bad_preprocessing_option_is_refused(files, tmp_path, capsys, o
         main(["identify", "puma560", "--data", str(train), option, value, "-o", str(tmp_path)])
     assert exc.value.code == 2
     assert option in capsys.readouterr().err
+
+
+def test_identified_description_with_non_physical_inertia_exits_1(tmp_path, capsys):
+    # --help promises exit 1 when the written description does not load again with physical
+    # values: a link whose principal moments (1, 1, 5) violate the triangle inequality
+    import dataclasses
+
+    import sympy as sp
+
+    from robodyn.cli_identify import _check_loadable
+    from robodyn.robot.yaml_writer import dump_yaml
+
+    robot = rd.load("planar_2r")
+    links = list(robot.links)
+    links[1] = dataclasses.replace(links[1], inertia=sp.ImmutableMatrix(sp.diag(1, 1, 5)))
+    bad = dataclasses.replace(robot, links=tuple(links), description_hash="")
+    path = tmp_path / "bad.yaml"
+    path.write_text(dump_yaml(bad), encoding="utf-8")
+    assert _check_loadable(path) == 1
+    assert "triangle inequality" in capsys.readouterr().err
+    good = tmp_path / "good.yaml"
+    good.write_text(dump_yaml(robot), encoding="utf-8")
+    assert _check_loadable(good) == 0

@@ -128,7 +128,8 @@ def random_states(model: Model, samples: int, rng: np.random.Generator,
 
 
 def base_relations(model: Model, *, samples: int | None = None, seed: int = 0,
-                   at_rest: np.ndarray | None = None) -> BaseRelations:
+                   at_rest: np.ndarray | None = None, unseen: np.ndarray | None = None
+                   ) -> BaseRelations:
     """Base parameters of a compiled model by QR with column pivoting on random states.
 
     Parameters
@@ -144,6 +145,10 @@ def base_relations(model: Model, *, samples: int | None = None, seed: int = 0,
         Joints seen at rest in the data (:func:`random_states`): their friction offset ``Fo`` is
         a base parameter of its own. Default: none (``Fo`` regroups into the Coulomb levels,
         which is all that data without rest can tell).
+    unseen : numpy.ndarray of int, optional
+        Standard columns the measurement does not see (the rotor inertia ``Ia`` behind a
+        link-side torque sensor): treated as identically zero, so they are no base parameter
+        and nothing regroups into them.
 
     Returns
     -------
@@ -155,6 +160,8 @@ def base_relations(model: Model, *, samples: int | None = None, seed: int = 0,
     count = samples if samples is not None else max(60, 30 * n)
     q, qd, qdd = random_states(model, count, rng, at_rest)
     w = model.regressor(q, qd, qdd).reshape(count * n, -1)
+    if unseen is not None:
+        w[:, np.asarray(unseen, dtype=int)] = 0.0
     norms = np.linalg.norm(w, axis=0)
     used = np.flatnonzero(norms > BETA_ZERO * max(1.0, float(norms.max())))
     zero = np.setdiff1d(np.arange(w.shape[1]), used)

@@ -118,7 +118,7 @@ def identify_joint(robot: Robot, recording: Any, joint: int | str | None = None,
         The requested joint never moves in the recording (its parameters are unidentifiable
         from it), no single joint moves, or the recording does not fit the robot.
     """
-    from robodyn.identify.pipeline import check_recording
+    from robodyn.identify.inputs import check_recording
 
     check_recording(robot, recording, 0, target)
     src = str(getattr(recording, "source", "") or "recording")

@@ -30,7 +30,8 @@ from robodyn.identify.base import BaseRelations, base_relations
 from robodyn.identify.choices import Candidate, Choices, Problem, candidates, choose
 from robodyn.identify.drive_gains import estimate_drive_gains
 from robodyn.identify.estimate import FOLDS, LinearFit, fit_linear
-from robodyn.identify.friction import FRICTION_MODELS, NONLINEAR, fit_friction_samples, without_friction
+from robodyn.identify.friction import NONLINEAR, fit_friction_samples, without_friction
+from robodyn.identify.inputs import check_recording, checked_inputs
 from robodyn.identify.payload import Payload, payload_standard, payload_torque
 from robodyn.identify.preprocess import (
     DEAD_BAND,
@@ -54,9 +55,6 @@ from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT, parameter_valu
 
 __all__ = ["check_recording", "identify", "nominal_standard"]
 
-TARGETS = ("tau", "current")
-METHODS = ("ols", "wls", "consistent")
-WEIGHTS = ("residual", "state-noise")
 #: Floor of the measurement variance, as a fraction of the first fit's residual variance.
 MEAS_FLOOR = 0.01
 #: The wider cut-off tried by cross-validation, as a multiple of the rule's (cutoff="auto").
@@ -65,54 +63,6 @@ CUTOFF_WIDER = 2.5
 REST_FRACTION = 0.01
 #: Unit directions whose singular value is below this fraction of the largest are reported.
 UNEXCITED_RTOL = 1e-6
-
-
-def _src(rec: Any, index: int) -> str:
-    return str(getattr(rec, "source", "") or f"recordings[{index}]")
-
-
-def _first_bad(a: np.ndarray) -> tuple[int, int]:
-    rows, cols = np.nonzero(~np.isfinite(a))
-    return int(rows[0]), int(cols[0])
-
-
-def check_recording(robot: Robot, rec: Any, index: int, target: str | None) -> None:
-    """Raise :class:`IdentificationError` when ``rec`` cannot be used with ``robot``.
-
-    Checks: joint names equal the robot's (same order), ``q`` (N, n), finite ``t``/``q``/target
-    (the first bad row and column named), and the target signal present.
-    """
-    src = _src(rec, index)
-    names = getattr(rec, "joint_names", None)
-    n = robot.dof
-    q = np.asarray(rec.q, dtype=float)
-    if q.ndim != 2 or q.shape[1] != n:
-        raise IdentificationError(f"{src}: q: expected shape (N, {n}) for robot {robot.name!r} "
-                                  f"({n} joints), got {q.shape}")
-    if names is not None and tuple(names) != tuple(f"q{j + 1}" for j in range(n)) \
-            and tuple(names) != robot.joint_names:
-        missing = [j for j in robot.joint_names if j not in names]
-        extra = [j for j in names if j not in robot.joint_names]
-        why = (f"missing {missing}, unknown {extra}" if missing or extra
-               else f"order {list(names)} is not the chain order {list(robot.joint_names)}")
-        raise IdentificationError(f"{src}: joint_names do not match robot {robot.name!r}: {why} "
-                                  f"(use rec.select(robot.joint_names))")
-    fields = [("t", np.asarray(rec.t, dtype=float).reshape(-1, 1)), ("q", q)]
-    if target is not None:
-        y = getattr(rec, target, None)
-        if y is None:
-            raise IdentificationError(f"{src}: {target}: the recording has no {target!r} signal to "
-                                      f"fit (target={target!r})")
-        y = np.asarray(y, dtype=float)
-        if y.shape != q.shape:
-            raise IdentificationError(f"{src}: {target}: shape {y.shape} differs from q {q.shape}")
-        fields.append((target, y))
-    for name, a in fields:
-        if not np.all(np.isfinite(a)):
-            row, col = _first_bad(a)
-            column = "" if name == "t" else f", column {col} ({robot.joint_names[col]})"
-            raise IdentificationError(f"{src}: {name}: value {a[row, col]} is not finite at row "
-                                      f"{row}{column}")
 
 
 def nominal_standard(robot: Robot) -> np.ndarray:
@@ -153,7 +103,8 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
              velocity: str = "auto", dead_band: float | str = 0.0, gains: str = "auto",
              bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None,
              payloads: Sequence[Payload | None] | None = None, weights: str = "residual",
-             state_noise: Any = None, thermal: bool | str = False) -> Identification:
+             state_noise: Any = None, thermal: bool | str = False, sensor: str = "motor"
+             ) -> Identification:
     """Identify the base inertial, drive and friction parameters of a robot from recordings.
 
     Parameters
@@ -209,6 +160,11 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     state_noise : (s_q, s_qd, s_qdd), optional
         Standard deviations of the processed states' noise (rad, rad/s, rad/s^2; scalars or
         (n,)), required by ``weights="state-noise"``.
+    sensor : {"motor", "link"}
+        Where the effort is measured: "motor" (motor current, or a torque that includes the
+        drive: the reflected rotor inertia ``Ia`` is identified), or "link" (a joint torque
+        sensor after the gear, which does not see the rotor: the ``Ia`` columns are dropped and
+        ``Ia = 0`` in the prior and the result; ``target="tau"`` only).
     thermal : bool or "auto"
         Temperature-dependent viscous and Coulomb friction (:mod:`robodyn.identify.thermal`;
         needs the recordings' ``temperature``); "auto": with and without, chosen by time-block
@@ -224,17 +180,17 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         Joints not matching the robot, NaN, a missing target, too few samples for the
         parameters, an unknown option, an infeasible or failed semidefinite program.
     """
-    recs, target, pays = _checked_inputs(robot, recordings, target, method, friction, weights,
+    recs, target, pays = checked_inputs(robot, recordings, target, method, friction, weights,
                                          state_noise, gains, velocity, dead_band, thermal,
-                                         payloads)
+                                         sensor, payloads)
     model = model if model is not None else compile_model(robot)
     measured = all(r.qd is not None and "qd" not in getattr(r, "estimated", frozenset()) for r in recs)
     temps = all(getattr(r, "temperature", None) is not None for r in recs)
 
     def stacked(c: Candidate) -> Problem:
         data = _prepared(robot, recs, target, friction, c.cutoff, decimate, c.velocity, c.dead_band,
-                         model, c.thermal)
-        drive, prior, loads = _gains_and_prior(robot, data, pays, target, gains, friction)
+                         model, c.thermal, sensor)
+        drive, prior, loads = _gains_and_prior(robot, data, pays, target, gains, friction, sensor)
         cols = data.relations.independent
         th = data.thermal
         phi, y, joint, blocks = _stack(data.samples, data.y_full, cols, drive.k, loads,
@@ -350,49 +306,9 @@ class _LinearStep:
     fit: LinearFit
 
 
-def _checked_inputs(robot: Robot, recordings: Any, target: str | None, method: str, friction: str,
-                    weights: str, state_noise: Any, gains: str, velocity: str, dead_band: Any,
-                    thermal: Any,
-                    payloads: Sequence[Payload | None] | None
-                    ) -> tuple[list[Any], str, list[Payload | None]]:
-    """The recordings as a list, the resolved target and one payload per recording (step 1).
-
-    Raises :class:`IdentificationError` on no recordings, an unknown option, missing state
-    noise for ``weights="state-noise"``, a recording that does not fit ``robot``
-    (:func:`check_recording`) or malformed payloads.
-    """
-    recs = [recordings] if hasattr(recordings, "q") else list(recordings)
-    if not recs:
-        raise IdentificationError("recordings: none given")
-    if target is None:
-        target = "tau" if all(getattr(r, "tau", None) is not None for r in recs) else "current"
-    if target not in TARGETS:
-        raise IdentificationError(f"target: expected one of {TARGETS}, got {target!r}")
-    if method not in METHODS:
-        raise IdentificationError(f"method: expected one of {METHODS}, got {method!r}")
-    if friction not in FRICTION_MODELS:
-        raise IdentificationError(f"friction: expected one of {FRICTION_MODELS}, got {friction!r}")
-    if weights not in WEIGHTS:
-        raise IdentificationError(f"weights: expected one of {WEIGHTS}, got {weights!r}")
-    if weights == "state-noise" and state_noise is None:
-        raise IdentificationError("state_noise: weights='state-noise' needs the state noise "
-                                  "(s_q, s_qd, s_qdd) in rad, rad/s, rad/s^2")
-    if velocity not in ("auto", "position", "measured"):
-        raise IdentificationError(f"velocity: expected 'auto', 'position' or 'measured', got {velocity!r}")
-    if thermal not in (False, True, "auto"):
-        raise IdentificationError(f"thermal: expected False, True or 'auto', got {thermal!r}")
-    if isinstance(dead_band, str) and dead_band != "auto":
-        raise IdentificationError(f"dead_band: expected a velocity in rad/s or 'auto', got {dead_band!r}")
-    if gains not in ("auto", "description", "absorbed"):
-        raise IdentificationError(f"gains: expected 'auto', 'description' or 'absorbed', got {gains!r}")
-    for i, rec in enumerate(recs):
-        check_recording(robot, rec, i, target)
-    return recs, target, _check_payloads(payloads, len(recs))
-
-
 def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff: float | str | None,
               decimate: int | str, velocity: str, dead_band: float, model: Model,
-              thermal: bool = False) -> _Prepared:
+              thermal: bool = False, sensor: str = "motor") -> _Prepared:
     """Preprocessed samples, filtered regressors and base relations of ``recs`` (steps 2 and 3).
 
     Raises :class:`IdentificationError` when the
@@ -402,7 +318,9 @@ def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff:
     full = [preprocess(r, settings, target) for r in recs]
     y_full = [filtered_regressor(model, s, settings) for s in full]
     samples = [_decimated(s, settings) for s in full]
-    relations = base_relations(model, at_rest=_at_rest(samples, settings.dead_band))
+    rotor = np.arange(robot.dof) * PER_JOINT + len(INERTIAL_NAMES)
+    relations = base_relations(model, at_rest=_at_rest(samples, settings.dead_band),
+                               unseen=rotor if sensor == "link" else None)
     if friction == "none":
         relations = _without_friction_columns(relations)
     count = sum(s.q.shape[0] for s in samples)
@@ -450,7 +368,8 @@ def _at_rest(samples: Sequence[Samples], band: float) -> np.ndarray:
 
 
 def _gains_and_prior(robot: Robot, data: _Prepared, pays: list[Payload | None], target: str,
-                     gains: str, friction: str) -> tuple[_Drive, np.ndarray, list[np.ndarray]]:
+                     gains: str, friction: str, sensor: str = "motor"
+                     ) -> tuple[_Drive, np.ndarray, list[np.ndarray]]:
     """Drive gains, the prior (15 n,) and the payload torque (N_k, n), N m, of each recording (step 5).
 
     With ``target="current"`` and a payload in some recording, the gains are estimated from the
@@ -466,6 +385,9 @@ def _gains_and_prior(robot: Robot, data: _Prepared, pays: list[Payload | None], 
         drive, prior = _payload_gains(robot, data, loads, drive, prior)
     if friction == "none":
         prior = without_friction(prior)
+    if sensor == "link":
+        prior = prior.copy()
+        prior[len(INERTIAL_NAMES)::PER_JOINT] = 0.0  # Ia: the sensor does not see the rotor
     return drive, prior, loads
 
 
@@ -586,23 +508,6 @@ def _identification(robot: Robot, data: _Prepared, step: _LinearStep, theta: np.
         condition=step.fit.condition, singular_values=s, unexcited_directions=weak,
         residual_std=step.fit.sigma / drive.k, samples=data.count, relations=data.relations,
         _model=data.model)
-
-
-def _check_payloads(payloads: Any, count: int) -> list[Payload | None]:
-    """One ``Payload`` or None per recording (an error naming the entry otherwise)."""
-    if payloads is None:
-        return [None] * count
-    if isinstance(payloads, Payload):
-        raise IdentificationError("payloads: expected a sequence with one Payload or None per "
-                                  "recording, got a single Payload")
-    pays = list(payloads)
-    if len(pays) != count:
-        raise IdentificationError(f"payloads: expected one per recording ({count}), got {len(pays)}")
-    for i, p in enumerate(pays):
-        if p is not None and not isinstance(p, Payload):
-            raise IdentificationError(f"payloads[{i}]: expected a Payload or None, got "
-                                      f"{type(p).__name__}")
-    return pays
 
 
 def _without_friction_columns(relations: BaseRelations) -> BaseRelations:

@@ -181,7 +181,7 @@ class Identification:
         numpy.ndarray, shape (N, n)
             N m (N) for ``target="tau"``, A for ``target="current"``.
         """
-        from robodyn.identify.pipeline import check_recording
+        from robodyn.identify.inputs import check_recording
 
         check_recording(self.robot, recording, 0, None)
         s = preprocess(recording, self.preprocess, None)
