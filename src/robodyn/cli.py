@@ -253,7 +253,8 @@ def _parser() -> argparse.ArgumentParser:
     add_sweep_parser(sub, fmt)
     add_underwater_parser(sub, fmt)
     _add_demo_parser(sub, fmt)
-    for command in ("show", "derive", "check", "codegen", "export", "simulate", "calibrate"):
+    for command in ("show", "derive", "check", "codegen", "export", "simulate", "calibrate",
+                    "identify", "validate"):
         sub.choices[command].add_argument(
             "--tool", metavar="LINK",
             help="URDF only: the link whose frame is the end effector, e.g. tool0 or flange "

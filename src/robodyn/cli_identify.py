@@ -108,7 +108,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     from robodyn.report.identification_report import identification_html
     from robodyn.robot.yaml_writer import dump_yaml
 
-    robot = rd.load(args.robot)
+    robot = rd.load(args.robot, tool=args.tool)
     gains = _gains(args.gains, robot.dof)
     if gains is not None:
         robot = _with_gains(robot, gains)
@@ -216,7 +216,7 @@ def _check_loadable(path: Path) -> int:
 def _cmd_validate(args: argparse.Namespace) -> int:
     from robodyn.report.identification_report import validation_html
 
-    robot = rd.load(args.robot)
+    robot = rd.load(args.robot, tool=args.tool)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
     recs = _read(args.data, args.spec, robot, "data")

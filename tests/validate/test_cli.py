@@ -172,3 +172,12 @@ def test_identified_description_with_non_physical_inertia_exits_1(tmp_path, caps
     good = tmp_path / "good.yaml"
     good.write_text(dump_yaml(robot), encoding="utf-8")
     assert _check_loadable(good) == 0
+
+
+@pytest.mark.parametrize("command", ["identify", "validate"])
+def test_identify_and_validate_accept_tool(command):
+    from robodyn.cli import _parser
+
+    args = _parser().parse_args([command, "arm.urdf", "--data", "run.csv", "--tool", "flange",
+                                 "-o", "out"])
+    assert args.tool == "flange"
