@@ -15,6 +15,7 @@ from robodyn.measure.conversions import (
 )
 from robodyn.measure.csv_io import write_csv
 from robodyn.measure.filtering import differentiate
+from robodyn.robot.errors import RecordingError
 
 DATA = Path(__file__).resolve().parents[3] / "shared" / "data" / "kinova-gen3"
 if not DATA.is_dir():
@@ -69,6 +70,31 @@ def test_spec_encoder_volts_torque_hand_computed(tmp_path):
     assert np.allclose(rec.tau[:, 0], current * 100 * 0.05, atol=1e-12)  # tau = N k_t I
     assert np.allclose(rec.tau[:, 1], 0.0)
     assert np.allclose(rec.t, 0.004 * np.arange(n))
+
+
+def test_headerless_whitespace_log(tmp_path):
+    # a controller's text log: no header, fields aligned with runs of spaces and tabs
+    t = 0.002 * np.arange(12)
+    q = np.column_stack([np.linspace(0.1, 0.6, 12), np.linspace(-1.0, -0.5, 12)])
+    amps = np.column_stack([np.linspace(0.5, 1.0, 12), np.linspace(2.0, 1.5, 12)])
+    lines = [f"  {t[k]:.3f}\t {q[k, 0]:.4f}   {q[k, 1]:.4f} \t{amps[k, 0]:.3f}  {amps[k, 1]:.3f}"
+             for k in range(12)]
+    path = tmp_path / "robot.log"
+    path.write_text("\n".join(lines) + "\n")
+    spec = {"delimiter": "whitespace", "header": False, "joints": 2,
+            "time": {"column": 0, "unit": "s"},
+            "position": {"columns": [1, 2], "unit": "rad"},
+            "current": {"columns": [3, 4], "unit": "A"}}
+    rec = rd.read_recording(path, spec=spec)
+    np.testing.assert_allclose(rec.t, t, atol=1e-12)
+    np.testing.assert_allclose(rec.q, np.round(q, 4), atol=1e-12)
+    np.testing.assert_allclose(rec.current, np.round(amps, 3), atol=1e-12)
+    # a row with a missing field is named by its line
+    path.write_text("\n".join(lines[:3] + ["  0.006  0.4000  -0.7000  0.800"] + lines[4:]) + "\n")
+    with pytest.raises(RecordingError, match=r"robot.log: line 4: 4 fields, but the first row"):
+        rd.read_recording(path, spec=spec)
+    with pytest.raises(RecordingError, match=r"delimiter: expected one character or 'whitespace'"):
+        rd.read_recording(path, spec={**spec, "delimiter": "spaces"})
 
 
 def test_period_estimate_recovers_known_period():

@@ -55,9 +55,13 @@ _TOOL = ("tool_t", "tool_x", "tool_y", "tool_z")
 # the table: lines, field counts, numbers
 # ----------------------------------------------------------------------------------------------
 
+#: The ``delimiter`` of a recording spec for fields separated by runs of spaces or tabs.
+WHITESPACE = "whitespace"
+
 
 class _Table:
-    """The data rows of a delimited text file, with the file's line number of every row."""
+    """The data rows of a delimited text file, with the file's line number of every row
+    (``delimiter=WHITESPACE``: fields separated by runs of spaces or tabs)."""
 
     def __init__(self, path: Path, delimiter: str | None, header: bool, comment: str | None):
         self.name = path.name
@@ -81,10 +85,13 @@ class _Table:
         if header and len(keep) == 1:
             raise RecordingError(f"{self.name}: header only, no data rows (line {keep[0] + 1})")
         kept = [lines[k] for k in keep]
+        spaces = delimiter == WHITESPACE
+        if spaces:
+            kept = [line.strip() for line in kept]  # a run of spaces or tabs separates fields
         # every row has as many fields as the first (header) row
         if '"' not in text:
-            counts = np.fromiter((line.count(delimiter) for line in kept), dtype=np.int64,
-                                 count=len(kept))
+            counts = np.fromiter((len(line.split()) - 1 if spaces else line.count(delimiter)
+                                  for line in kept), dtype=np.int64, count=len(kept))
             bad = np.nonzero(counts != counts[0])[0]
             if bad.size:
                 k = int(bad[0])
@@ -92,7 +99,7 @@ class _Table:
                 raise RecordingError(f"{self.name}: line {keep[k] + 1}: {counts[k] + 1} fields, but the "
                                      f"{first} (line {keep[0] + 1}) has {counts[0] + 1}")
         try:
-            frame = pd.read_csv(io.StringIO("\n".join(kept)), sep=delimiter,
+            frame = pd.read_csv(io.StringIO("\n".join(kept)), sep=r"\s+" if spaces else delimiter,
                                 header=0 if header else None, skip_blank_lines=False,
                                 engine="c", low_memory=False, keep_default_na=False)
         except (pd.errors.ParserError, ValueError) as exc:

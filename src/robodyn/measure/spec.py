@@ -265,8 +265,10 @@ def _parse(data: dict[str, Any], name: str) -> RecordingSpec:
     if not isinstance(header, bool):
         raise RecordingError(f"{name}: header: expected true or false, got {header!r}")
     delimiter = data.get("delimiter")
-    if delimiter is not None and (not isinstance(delimiter, str) or len(delimiter) != 1):
-        raise RecordingError(f"{name}: delimiter: expected one character, got {delimiter!r}")
+    if delimiter is not None and delimiter != "whitespace" and (not isinstance(delimiter, str)
+                                                                 or len(delimiter) != 1):
+        raise RecordingError(f"{name}: delimiter: expected one character or 'whitespace', got "
+                             f"{delimiter!r}")
     comment = data.get("comment")
     if comment is not None and (not isinstance(comment, str) or len(comment) != 1):
         raise RecordingError(f"{name}: comment: expected one character, got {comment!r}")
