@@ -28,6 +28,8 @@ from robodyn.codegen.latex import latex_files
 from robodyn.codegen.mex import mex_files
 from robodyn.codegen.octave import octave_files
 from robodyn.codegen.python import python_files
+from robodyn.codegen.singular import structural_singularity
+from robodyn.robot.errors import SingularMassMatrixError
 from robodyn.robot.model import Robot
 
 LANGUAGES = ("c", "python", "octave", "fortran", "julia", "latex", "mex")
@@ -176,6 +178,10 @@ def generate(robot_or_kset: Robot | KernelSet, lang: str, directory: str | Path,
         kset = robot_or_kset
     elif isinstance(robot_or_kset, Robot):
         kset = build_kernels(robot_or_kset, parameters)
+        why = structural_singularity(robot_or_kset, kset, {})  # every parameter folded
+        if why is not None:
+            raise SingularMassMatrixError(why + " (no code is generated for a robot without "
+                                                "forward dynamics)")
     else:
         raise TypeError(f"generate needs a Robot or a KernelSet, got {type(robot_or_kset).__name__}")
     out = Path(directory)

@@ -41,7 +41,7 @@ from robodyn.codegen.kernels import (
     kernel_signature,
 )
 from robodyn.codegen.python import PythonPrinter
-from robodyn.numeric.checks import check_structure, out_buffer
+from robodyn.numeric.checks import out_buffer, structural_singularity, without_infinities
 from robodyn.numeric.integrate_numpy import integrate_numpy as _integrate_numpy
 from robodyn.numeric.runtime_parameters import check_physics, parameter_array, runtime_names
 from robodyn.robot.errors import SimulationError, SingularMassMatrixError
@@ -77,6 +77,11 @@ class Model:
         (``compile_model(robot, runtime_parameters=...)``): every method then takes
         ``parameters=`` (one set, or one per state of a batch; see :data:`ParameterValues`), and
         :meth:`integrate` one set per trajectory of an ensemble. Empty: all folded.
+    singular : str or None
+        Why the mass matrix is singular in every configuration (a kinematics-only description,
+        such as a calibration's), or None. Such a model still gives kinematics, inverse dynamics
+        and the regressor; forward dynamics, simulation and their derivatives raise
+        :class:`~robodyn.robot.errors.SingularMassMatrixError` with this reason.
     """
 
     robot: Robot
@@ -84,6 +89,7 @@ class Model:
     parameter_values: tuple[tuple[str, float], ...]
     _impl: CompiledLibrary | ModuleType = field(repr=False, compare=False)
     runtime_parameters: tuple[str, ...] = ()
+    singular: str | None = None
 
     @property
     def dof(self) -> int:
@@ -159,6 +165,7 @@ class Model:
         SingularMassMatrixError
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
+        self._require_dynamics()
         qdd = self._call("forward_dynamics", q, qd, tau, threads=threads, parameters=parameters)
         return self._nonsingular(qdd, q, parameters)
 
@@ -171,6 +178,7 @@ class Model:
         SingularMassMatrixError
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
+        self._require_dynamics()
         xd = self._call("state_derivative", x, tau, threads=threads, parameters=parameters)
         return self._nonsingular(xd, np.asarray(x, dtype=float)[..., : self.dof], parameters)
 
@@ -203,6 +211,11 @@ class Model:
             f"{np.array2string(vec[:, 0], precision=3)} move no mass or inertia here (a massless "
             "link, a point mass on a joint axis), so the forward dynamics has no solution; give "
             "the links mass and inertia, or the joints rotor inertia")
+
+    def _require_dynamics(self) -> None:
+        """Raise :class:`SingularMassMatrixError` for a model without forward dynamics."""
+        if self.singular is not None:
+            raise SingularMassMatrixError(self.singular)
 
     def _nonsingular(self, out: np.ndarray, q: np.ndarray,
                      parameters: ParameterValues = None) -> np.ndarray:
@@ -297,6 +310,7 @@ class Model:
         SingularMassMatrixError
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
+        self._require_dynamics()
         d = self._derivative_model._call("forward_dynamics_derivatives", q, qd, tau, threads=threads,
                                          parameters=parameters)
         d = self._nonsingular(d, q, parameters)
@@ -404,6 +418,7 @@ class Model:
         FloatingPointError
             When the state stops being finite (the step is named).
         """
+        self._require_dynamics()
         n, nx = self.dof, 2 * self.dof
         methods = {"rk4": 0, "semi_implicit": 1}
         modes = {"feedback": 0, "gravity": 1, "computed_torque": 2}
@@ -635,11 +650,11 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
     key = hashlib.sha256(repr((robot.description_hash, folded, backend, _generator_hash())
                               + ((runtime,) if runtime else ())).encode()).hexdigest()[:24]
     directory = cache_dir()
+    marker = directory / f"rd_model_{key}.singular"
     if backend == "c":
         src, decl = directory / f"rd_model_{key}.c", directory / f"rd_model_{key}.cdef"
         if not (src.exists() and decl.exists()):
-            kset = _kernels_cached(robot, values, runtime)
-            check_structure(robot, kset, values)
+            kset = _kinematic_safe(robot, values, runtime, marker)
             printer = CPrinter(_PREFIX)
             _write_atomic(decl, printer.declarations(kset))
             _write_atomic(src, printer.source(kset))
@@ -650,13 +665,28 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
     else:
         path = directory / f"rd_model_{key}.py"
         if not path.exists():
-            kset = _kernels_cached(robot, values, runtime)
-            check_structure(robot, kset, values)
+            kset = _kinematic_safe(robot, values, runtime, marker)
             _write_atomic(path, PythonPrinter().module(kset))
         else:
             _touch(path)
         impl = _import_file(path, f"robodyn_generated_{key}")
-    return Model(robot, backend, tuple(sorted(values.items())), impl, runtime)
+    singular = marker.read_text(encoding="utf-8") if marker.exists() else None
+    return Model(robot, backend, tuple(sorted(values.items())), impl, runtime, singular)
+
+
+def _kinematic_safe(robot: Robot, values: Mapping[str, float], runtime: tuple[str, ...],
+                    marker: Path) -> KernelSet:
+    """The kernels to print; for a mass matrix singular in every configuration (a kinematics-only
+    description, e.g. a calibration's) the non-finite forward-dynamics entries become NaN and
+    ``marker`` records why, so kinematics and inverse dynamics work and forward dynamics
+    raises :class:`SingularMassMatrixError` with that reason."""
+    kset = _kernels_cached(robot, values, runtime)
+    message = structural_singularity(robot, kset, values)
+    if message is None:
+        marker.unlink(missing_ok=True)
+        return kset
+    _write_atomic(marker, message)
+    return without_infinities(kset)
 
 
 def _compile_derivatives(model: Model, names: tuple[str, ...] = DERIVATIVE_KERNEL_NAMES,
