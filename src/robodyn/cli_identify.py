@@ -148,6 +148,13 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                                                                       strict=True))
         print(f"drive gains from the payload run(s), N m/A: {gain_text}")
     paths["metrics"] = _write_metrics([v for _, v in vals], out / "validation.csv")
+    pre = ident.preprocess
+    note = ("predicted by the identified model at states processed as the identification's: "
+            + ("measured velocity" if pre.velocity == "measured" else "velocity from positions")
+            + ("" if pre.cutoff is None else f", zero-phase low-pass at {pre.cutoff:.3g} Hz")
+            + (f", Coulomb dead band {pre.dead_band:g} rad/s" if pre.dead_band else ""))
+    for k, path in enumerate(_write_predictions(vals, out, note)):
+        paths[f"predictions{k + 1}"] = path
     if not args.no_report:
         with progress("writing the report and its figures"):
             paths["report"] = identification_html(ident, vals, out, [r.source for r in recs])
@@ -160,7 +167,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     for head, v in vals:
         print(f"\n{head}")
         print(v.summary())
-    print(f"\n{table}\n")
+    print(f"\n{table}\n{note}\n")
     for kind, path in paths.items():
         print(f"wrote {kind:<10} {path}")
     return _check_loadable(paths["yaml"])
@@ -168,10 +175,49 @@ def _cmd_identify(args: argparse.Namespace) -> int:
 
 def _held_out_table(vals: Sequence[tuple[str, rd.Validation]]) -> str:
     """Relative error of each validation, raw and against the reference-filtered target, beside
-    its noise floor (a jointwise run: its moving joint only)."""
-    from robodyn.validate.heldout import format_held_out, held_out_from_validation
+    its noise floor (a jointwise run: its moving joint only), and the held-out recordings
+    pooled over every joint (the figure a user compares models by)."""
+    from robodyn.validate.heldout import format_held_out, held_out_error, held_out_from_validation
 
-    return format_held_out([held_out_from_validation(v, label) for label, v in vals])
+    rows = [held_out_from_validation(v, label) for label, v in vals]
+    held = [v for label, v in vals if label.startswith("held-out")]
+    if held:
+        pooled = held_out_error([v.t for v in held], [v.measured for v in held],
+                                [v.predicted for v in held], held[0].joint_names,
+                                source=f"{len(held)} recording(s), all joints",
+                                cutoff=held[0].noise.cutoff)
+        rows.append(("held-out, pooled", pooled))
+    return format_held_out(rows)
+
+
+def _safe_stem(source: str) -> str:
+    """A file-name stem from a recording's source: its last path part, other characters as _."""
+    name = Path(str(source)).name or "recording"
+    for suffix in (".gz", ".csv", ".tsv", ".mcap", ".txt", ".log"):
+        name = name[: -len(suffix)] if name.lower().endswith(suffix) else name
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name).strip(".") or "recording"
+
+
+def _write_predictions(vals: Sequence[tuple[str, rd.Validation]], out: Path, note: str) -> list[Path]:
+    """One CSV per validation: t, then measured and predicted target per joint (the model's
+    prediction exactly as the printed figures used it); ``note`` says how the states were
+    processed."""
+    paths, used = [], set()
+    for label, v in vals:
+        stem = _safe_stem(v.source)
+        while stem in used:
+            stem += "_"
+        used.add(stem)
+        path = out / f"predictions_{stem}.csv"
+        head = ["t"] + [f"{kind}_{j}" for j in v.joint_names for kind in ("measured", "predicted")]
+        cols = [v.t] + [a[:, k] for k in range(len(v.joint_names)) for a in (v.measured, v.predicted)]
+        with path.open("w", newline="", encoding="utf-8") as fh:
+            fh.write(f"# {label}; target {v.target} ({v.unit}); {note}\n")
+            writer = csv.writer(fh)
+            writer.writerow(head)
+            writer.writerows(zip(*(c.tolist() for c in cols), strict=True))
+        paths.append(path)
+    return paths
 
 
 def _with_gains(robot: rd.Robot, gains: np.ndarray) -> rd.Robot:

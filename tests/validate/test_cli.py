@@ -88,6 +88,16 @@ def test_identify_command_writes_a_loadable_robot_and_tables(files, tmp_path, ca
         # the pooled error ||E|| / ||Y|| lies within the per-joint relative errors' range
         assert min(v) - 1e-3 <= float(raw) <= max(v) + 1e-3
     assert "at 2.5 Hz" in captured.out
+    # the held-out recordings pooled (one here: the same figures as its own row), the states'
+    # processing named, and each validation's predictions written beside the report
+    pooled = [line for line in captured.out.splitlines() if line.startswith("held-out, pooled")]
+    assert len(pooled) == 1 and pooled[0].split()[-4:-1] == table["held.csv"]
+    assert "velocity from positions" in captured.out or "measured velocity" in captured.out
+    with (tmp_path / "predictions_held.csv").open() as fh:
+        assert fh.readline().startswith("# held-out (--validate): held.csv; target tau (N m); ")
+        pred = list(csv.DictReader(fh))
+    assert len(pred) > 10 and {"t", "measured_q1", "predicted_q6"} <= set(pred[0])
+    assert (tmp_path / "predictions_train.csv").exists()
 
 
 def test_validate_command_rejects_joints_that_do_not_match(files, tmp_path, capsys):
