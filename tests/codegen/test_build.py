@@ -6,6 +6,7 @@ import os
 import stat
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -109,8 +110,14 @@ def test_cli_cache_info_and_clear_leave_other_files_alone(cache: Path, capsys) -
     compile_library(source(30), DECL)
     compile_library(source(31), DECL)
     cache.joinpath("notes.txt").write_text("mine")  # a user's file in a shared $ROBODYN_CACHE
-    (cache / ".build-stale").mkdir()
-    size = sum(p.stat().st_size for p in cache.glob("rd_*"))
+    # user files whose names look like robodyn's (issue 23: 'cache clear' deleted them)
+    for name in ("rd_thesis_draft.docx", "rd_measurements.csv", "rd_model_notes.py"):
+        cache.joinpath(name).write_text("mine")
+    (cache / ".build-notes").mkdir()
+    (cache / ".build-notes" / "keep.txt").write_text("mine")
+    # what an interrupted compilation leaves: tempfile's own folder name
+    tempfile.mkdtemp(dir=cache, prefix=".build-")
+    size = sum(p.stat().st_size for p in cache.glob("rd_*") if p.read_bytes() != b"mine")
     assert main(["cache", "info"]) == 0
     out = capsys.readouterr().out
     assert f"location  {cache}\n" in out
@@ -119,7 +126,9 @@ def test_cli_cache_info_and_clear_leave_other_files_alone(cache: Path, capsys) -
     assert build.DEFAULT_CACHE_MAX_MB == 1024
     assert main(["cache", "clear"]) == 0
     assert f"removed 4 files ({size} bytes) from {cache}" in capsys.readouterr().out
-    assert sorted(p.name for p in cache.iterdir()) == ["notes.txt"]
+    assert sorted(p.name for p in cache.iterdir()) == [".build-notes", "notes.txt", "rd_measurements.csv",
+                                                       "rd_model_notes.py", "rd_thesis_draft.docx"]
+    assert (cache / ".build-notes" / "keep.txt").read_text() == "mine"
     assert clear_cache() == (0, 0)
 
 

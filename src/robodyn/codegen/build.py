@@ -21,6 +21,7 @@ import contextlib
 import hashlib
 import os
 import platform
+import re
 import shutil
 import subprocess
 import tempfile
@@ -155,11 +156,19 @@ def cache_limit() -> int:
     return int(mb * 2**20)
 
 
+#: The names robodyn gives its cache files: ``rd_<24 hex>.so`` and its manifest, and generated
+#: sources ``rd_<tag>_<24 hex>.c/.cdef/.py/.singular``; nothing else is ever removed.
+_OWN_NAME = re.compile(r"rd_(?:[a-z]+_)?[0-9a-f]{24}(?:\.so(?:\.sha256)?|\.c|\.cdef|\.py|\.singular)")
+#: A temporary compilation folder: ``tempfile``'s ``.build-`` plus 8 name characters.
+_OWN_BUILD = re.compile(r"\.build-[a-z0-9_]{8}")
+
+
 def _entries(directory: Path) -> list[Path]:
-    """robodyn's own files in the cache (never anything else the folder holds)."""
+    """robodyn's own files in the cache (names :data:`_OWN_NAME`; never anything else the folder
+    holds, such as a user's ``rd_measurements.csv``)."""
     if not directory.is_dir():
         return []
-    return [p for p in directory.iterdir() if p.name.startswith(_ENTRY_PREFIX) and p.is_file()]
+    return [p for p in directory.iterdir() if _OWN_NAME.fullmatch(p.name) and p.is_file()]
 
 
 def cache_info() -> CacheInfo:
@@ -184,7 +193,8 @@ def clear_cache() -> tuple[int, int]:
         removed, freed = removed + 1, freed + size
     if directory.is_dir():
         for tmp in directory.glob(".build-*"):
-            shutil.rmtree(tmp, ignore_errors=True)  # left by an interrupted compilation
+            if _OWN_BUILD.fullmatch(tmp.name) and tmp.is_dir() and not tmp.is_symlink():
+                shutil.rmtree(tmp, ignore_errors=True)  # left by an interrupted compilation
     return removed, freed
 
 
