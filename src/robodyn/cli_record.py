@@ -92,9 +92,18 @@ def _cmd_convert(args: argparse.Namespace) -> int:
     from robodyn.measure.csv_io import write_csv
     from robodyn.measure.mcap_io import write_mcap
 
-    rec = _read(args)
     out = Path(args.output)
+    source = Path(args.file)
+    if out.exists() and source.exists() and out.resolve() == source.resolve():
+        raise ValueError(f"{out}: -o is the file being converted; write to another file "
+                         "(the input is never overwritten)")
+    rec = _read(args)
     if out.suffix.lower() == ".mcap":
+        dropped = [name for name in ("current", "temperature") if getattr(rec, name) is not None]
+        if dropped:
+            # a JointState carries position, velocity and effort only
+            err(f"robodyn: warning: {out}: a ROS 2 JointState bag has no field for "
+                f"{' and '.join(dropped)}: not written (convert to .csv to keep them)")
         write_mcap(rec, out)
     elif out.suffix.lower() in (".csv", ".gz"):
         write_csv(rec, out)

@@ -40,3 +40,27 @@ def test_errors_exit_2_with_one_line(tmp_path, capsys):
     assert "neither a built-in spec" in capsys.readouterr().err
     assert main(["record", "info", str(tmp_path / "missing.csv")]) == 2
     assert "missing.csv: no such file" in capsys.readouterr().err
+
+
+def test_convert_never_overwrites_its_input(tmp_path, capsys):
+    _, rec = _bag(tmp_path)
+    csv_path = tmp_path / "same.csv"
+    assert main(["record", "convert", str(tmp_path / "run.mcap"), "-o", str(csv_path)]) == 0
+    before = csv_path.read_bytes()
+    capsys.readouterr()
+    for target in (csv_path, tmp_path / "." / "same.csv"):
+        assert main(["record", "convert", str(csv_path), "-o", str(target)]) == 2
+        assert "-o is the file being converted" in capsys.readouterr().err
+    assert csv_path.read_bytes() == before
+
+
+def test_convert_to_a_bag_says_what_it_cannot_carry(tmp_path, capsys):
+    t = 1e-3 * np.arange(200)
+    rec = rd.Recording(t=t, q=np.sin(np.outer(t, [1.0, 2.0])), joint_names=("a", "b"),
+                       current=np.ones((200, 2)), temperature=np.full((200, 2), 30.0))
+    from robodyn.measure.csv_io import write_csv
+
+    src = write_csv(rec, tmp_path / "amps.csv")
+    assert main(["record", "convert", str(src), "-o", str(tmp_path / "amps.mcap")]) == 0
+    err = capsys.readouterr().err
+    assert "has no field for current and temperature: not written" in err
