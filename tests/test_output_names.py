@@ -45,3 +45,32 @@ def test_simulate_robot_name_with_a_path_is_exit_2(tmp_path, capsys) -> None:
     assert rc == 2
     assert "robot name '../../evil' is not a plain file name" in capsys.readouterr().err
     assert not list(tmp_path.rglob("*evil_simulation*"))
+
+
+EVIL = ("name: ../../escaped_by_robotname\njoints:\n  - {name: j, type: revolute, dh: {a: 1}, "
+        "link: {mass: 1, com: [-0.5, 0, 0], inertia: {ixx: 0, iyy: 0.1, izz: 0.1}}}\n")
+
+
+@pytest.mark.parametrize("lang", ["c", "python", "julia"])
+def test_codegen_robot_name_with_a_path_stays_in_the_folder(tmp_path, lang) -> None:
+    # before: robodyn codegen wrote escaped_by_robotname.c/.h two folders above -o
+    desc = tmp_path / "evil.yaml"
+    desc.write_text(EVIL)
+    out = tmp_path / "a" / "b" / "gen"
+    assert main(["codegen", str(desc), "--lang", lang, "-o", str(out)]) == 0
+    written = [p for p in tmp_path.rglob("*") if p.is_file() and p != desc]
+    assert written and all(p.parent == out for p in written)
+    assert all("/" not in p.name and "escaped_by_robotname" in p.name for p in written)
+
+
+def test_identify_robot_name_with_a_path_is_exit_2(tmp_path, capsys) -> None:
+    desc = tmp_path / "evil.yaml"
+    desc.write_text(EVIL)
+    data = tmp_path / "run.csv"
+    data.write_text("t,q[j],tau[j]\n" + "".join(f"{k * 0.01},{0.01 * k},{0.1}\n" for k in range(50)))
+    out = tmp_path / "deep" / "out"
+    rc = main(["identify", str(desc), "--data", str(data), "--cutoff", "none", "-o", str(out)])
+    assert rc == 2
+    assert "robot name '../../escaped_by_robotname_identified' is not a plain file name" in \
+        capsys.readouterr().err
+    assert not list(tmp_path.rglob("*escaped*"))

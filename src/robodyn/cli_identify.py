@@ -18,6 +18,7 @@ import numpy as np
 
 import robodyn as rd
 from robodyn.cli_workflows import floats
+from robodyn.output_names import check_stem
 from robodyn.report.text import err, progress
 
 __all__ = ["add_parsers"]
@@ -109,6 +110,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     from robodyn.robot.yaml_writer import dump_yaml
 
     robot = rd.load(args.robot, tool=args.tool)
+    stem = check_stem(f"{robot.name}_identified", what="robot name")  # data, never a path
     gains = _gains(args.gains, robot.dof)
     if gains is not None:
         robot = _with_gains(robot, gains)
@@ -128,7 +130,6 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                             dead_band=args.dead_band, cutoff=args.cutoff,
                             regularization=args.regularization, decimate=args.decimate,
                             sensor=args.sensor, **extra)
-    stem = f"{robot.name}_identified"
     paths = {"yaml": out / f"{stem}.yaml", "urdf": out / f"{stem}.urdf",
              "parameters": out / "parameters.csv"}
     paths["yaml"].write_text(dump_yaml(ident.robot), encoding="utf-8")

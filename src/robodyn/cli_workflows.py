@@ -186,7 +186,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     )
 
     robot = rd.load(args.robot, tool=args.tool)
-    stem = check_stem(args.stem) if args.stem is not None else f"{robot.name}_calibrated"
+    stem = check_stem(args.stem) if args.stem is not None else \
+        check_stem(f"{robot.name}_calibrated", what="robot name")
     jmap = read_joint_map(args.joint_map, robot) if args.joint_map else None
     data = read_calibration_csv(args.data, robot, targets=args.targets, joint_map=jmap)
     units = {"length_unit": args.length_unit, "angle_unit": args.angle_unit}

@@ -40,7 +40,7 @@ from __future__ import annotations
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
-from robodyn.codegen.base import GeneratedFile, Printer
+from robodyn.codegen.base import GeneratedFile, Printer, identifier
 from robodyn.codegen.c_outputs import STREAM_MIN_BYTES, copy_out_source, output_lines, staged_outputs
 from robodyn.codegen.kernels import Argument, Kernel, KernelSet
 
@@ -763,8 +763,8 @@ def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool,
 def c_files(kset: KernelSet, prefix: str = "robodyn_", with_simulation: bool = True) -> list[GeneratedFile]:
     """``<robot>.h`` and ``<robot>.c`` for a kernel set."""
     printer = CPrinter(prefix)
-    stem = kset.robot_name
-    guard = f"ROBODYN_{stem.upper()}_H".replace("-", "_")
+    stem = identifier(kset.robot_name)  # the robot's name is data, never a path
+    guard = f"ROBODYN_{stem.upper()}_H"
     header = "\n".join([printer.header(kset).rstrip(), f"#ifndef {guard}", f"#define {guard}",
                         printer.declarations(kset, with_simulation).rstrip(), "#endif", ""])
     source = printer.source(kset, with_simulation)

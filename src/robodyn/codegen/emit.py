@@ -188,6 +188,8 @@ def generate(robot_or_kset: Robot | KernelSet, lang: str, directory: str | Path,
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for f in _WRITERS[lang](kset):
+        if Path(f.name).name != f.name or f.name in ("", ".", ".."):
+            raise ValueError(f"generated file name {f.name!r} is not a plain file name")
         path = out / f.name
         path.write_text(f.text)
         written.append(path)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
-from robodyn.codegen.base import GeneratedFile, Printer
+from robodyn.codegen.base import GeneratedFile, Printer, identifier
 from robodyn.codegen.kernels import Argument, Kernel, KernelSet
 
 
@@ -70,4 +70,4 @@ class PythonPrinter(Printer):
 
 def python_files(kset: KernelSet) -> list[GeneratedFile]:
     """``<robot>.py`` for a kernel set."""
-    return [GeneratedFile(f"{kset.robot_name}.py", PythonPrinter().module(kset))]
+    return [GeneratedFile(f"{identifier(kset.robot_name)}.py", PythonPrinter().module(kset))]
