@@ -119,3 +119,41 @@ def test_spec_value_errors(tmp_path):
 def test_not_own_layout_without_spec(tmp_path):
     with pytest.raises(RecordingError, match=r"run.csv: spec: the file is not in robodyn's own layout"):
         _read(tmp_path, GOOD, None)
+
+
+BOMB = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+    f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+    for p, c in zip("abcdefgh", "bcdefghi", strict=True)) + "joints: *i\n"
+
+
+@pytest.mark.parametrize("text, why", [
+    (BOMB, r"spec.yaml: line 2, column \d+: YAML alias \*a is not allowed"),
+    ("joints: " + "[" * 40 + "]" * 40 + "\n", r"spec.yaml: line 1, column \d+: nested more than 32"),
+    ("joints: 2\njoints: 3\n", r"spec.yaml: line 2, column \d+: .*duplicate key 'joints'"),
+])
+def test_spec_yaml_bombs_and_nesting_refused_like_descriptions(tmp_path, text, why):
+    # issue 23: an alias bomb in a spec ran past 120 s and 0.8-1.4 GB; now refused from the
+    # event stream, before anything expands
+    spec = tmp_path / "spec.yaml"
+    spec.write_text(text)
+    (tmp_path / "run.csv").write_text("t,q1\n0,0\n")
+    with pytest.raises(RecordingError, match=why):
+        rd.read_recording(tmp_path / "run.csv", spec=spec)
+
+
+def test_huge_spec_refused_before_parsing(tmp_path):
+    spec = tmp_path / "spec.yaml"
+    spec.write_text("# padding\n" * 500_000 + "joints: 2\n")
+    (tmp_path / "run.csv").write_text("t,q1\n0,0\n")
+    with pytest.raises(RecordingError, match=r"spec.yaml: \d+ characters of YAML; at most"):
+        rd.read_recording(tmp_path / "run.csv", spec=spec)
+
+
+def test_study_file_alias_refused(tmp_path):
+    from robodyn.robot.errors import StudyError
+    from robodyn.study.study_file import read_study
+
+    path = tmp_path / "study.yaml"
+    path.write_text(BOMB)
+    with pytest.raises(StudyError, match=r"study.yaml: line 2, column \d+: YAML alias \*a"):
+        read_study(path)

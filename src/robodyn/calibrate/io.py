@@ -216,13 +216,14 @@ def read_joint_map(spec, robot: Robot) -> JointMap:
     """
     source = "<mapping>"
     if isinstance(spec, (str, Path)):
-        import yaml
+        from robodyn.robot.yaml_loader import safe_yaml
 
         source = str(spec)
         try:
-            spec = yaml.safe_load(Path(spec).read_text(encoding="utf-8"))
-        except (OSError, yaml.YAMLError) as exc:
+            text = Path(spec).read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
             raise DataFileError(f"{source}: cannot read the joint mapping: {exc}") from None
+        spec = safe_yaml(text, source, DataFileError)
     if not isinstance(spec, dict):
         raise DataFileError(f"{source}: a joint mapping is a mapping of model joint -> "
                             "{column, sign, offset, coupling}")

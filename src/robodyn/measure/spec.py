@@ -18,9 +18,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from robodyn.robot.errors import RecordingError
+from robodyn.robot.yaml_loader import safe_yaml
 
 __all__ = ["Channel", "Coupling", "RecordingSpec", "builtin_specs", "load_spec"]
 
@@ -131,10 +131,7 @@ def load_spec(spec: str | PathLike[str] | Mapping[str, Any]) -> RecordingSpec:
         if not p.is_file():
             raise RecordingError(f"{p}: spec file not found")
         name, text = p.name, p.read_text(encoding="utf-8")
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise RecordingError(f"{name}: not valid YAML: {' '.join(str(exc).split())}") from None
+    data = safe_yaml(text, name, RecordingError)
     if not isinstance(data, dict):
         raise RecordingError(f"{name}: a spec must be a mapping of fields, got {type(data).__name__}")
     return _parse(data, name)

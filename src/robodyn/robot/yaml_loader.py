@@ -157,8 +157,8 @@ class _UniqueKeys:
 
 def _alias_refused(event: yaml.AliasEvent) -> _Refused:
     return _Refused(
-        f"YAML alias *{event.anchor} is not allowed in robot descriptions (aliases can "
-        "expand a small file to gigabytes); write the values out",
+        f"YAML alias *{event.anchor} is not allowed in robot descriptions or any YAML robodyn "
+        "reads (aliases can expand a small file to gigabytes); write the values out",
         event.start_mark,
     )
 
@@ -211,6 +211,26 @@ def _c_events_checked(text: str) -> None:
             depth += 1
         elif isinstance(event, yaml.CollectionEndEvent):
             depth -= 1
+
+
+#: Largest YAML text read for a spec, study or mapping (characters): a hand-written file is a few
+#: kilobytes; a bigger one is refused before parsing.
+MAX_YAML_CHARS = 4 * 2**20
+
+
+def safe_yaml(text: str, source: str, error: type[Exception]) -> Any:
+    """YAML text -> Python data as robot descriptions are read, for every YAML robodyn reads
+    (recording specs, study files, joint mappings): safe constructors only, aliases and nesting
+    deeper than :data:`MAX_YAML_DEPTH` refused from the event stream, a key repeated in one
+    mapping refused, at most :data:`MAX_YAML_CHARS` characters. Problems raise ``error`` with
+    ``source`` and the line."""
+    if len(text) > MAX_YAML_CHARS:
+        raise error(f"{source}: {len(text)} characters of YAML; at most {MAX_YAML_CHARS} are read "
+                    "(a hand-written file is a few kilobytes)")
+    try:
+        return _parse_yaml(text, source)
+    except DescriptionError as exc:
+        raise error(str(exc)) from None
 
 
 def _parse_yaml(text: str, source: str) -> Any:

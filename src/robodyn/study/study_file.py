@@ -28,9 +28,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from robodyn.robot.errors import StudyError
+from robodyn.robot.yaml_loader import safe_yaml
 from robodyn.study.calibration_mc import CalibrationMonteCarlo
 from robodyn.study.cases import Grid, LatinHypercube, RandomSampler, Range
 from robodyn.study.identification_mc import IdentificationMonteCarlo
@@ -137,11 +137,10 @@ def _load_mapping(path: Path) -> dict[str, Any]:
     """The study file's top-level mapping, its keys and task name checked."""
     name = str(path)
     try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except yaml.YAMLError as exc:
-        raise StudyError(f"{name}: not valid YAML ({' '.join(str(exc).split())})") from None
+        text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError:
         raise StudyError(f"{name}: not a UTF-8 text file") from None
+    data = safe_yaml(text, name, StudyError)
     if not isinstance(data, dict):
         raise StudyError(f"{name}: expected a mapping with task, robot and parameters")
     unknown = [k for k in data if k not in _KEYS]
