@@ -10,6 +10,7 @@ import argparse
 import csv
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -229,6 +230,19 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         stats_before = ErrorStats.from_residuals(first - robot_positions(cal.before_robot, held_q))
         validation = (Path(args.validate).name, (held_pts - cal.predict(held_q)).reshape(-1, 3))
     paths = write_calibration(cal, args.output, stem=stem)
+    terms = tuple(args.nongeometric or ())
+    check = alone = None
+    if terms:
+        from robodyn.calibrate.term_check import description_alone, terms_cross_validation
+
+        with progress(f"cross-validating the non-geometric terms over {len(data.q)} poses"):
+            check = terms_cross_validation(
+                rd.calibrate, robot, data.q, data.points, terms, model=args.model, sigma=sigma,
+                loss=args.loss, payload=_payload(args.payload), deflection=args.deflection,
+                **units)
+        on = (Path(args.validate).name, *si(held)) if args.validate else (Path(args.data).name, *si(data))
+        alone = (on[0], *description_alone(cal, on[1], on[2]))
+        _state_alone(paths, alone, stem)
     if validation is not None:
         report = json.loads(paths["json"].read_text(encoding="utf-8"))
         report["validation"] = {"file": str(args.validate), "before_m": stats_before.__dict__,
@@ -236,12 +250,29 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         if rot_stats is not None:
             report["validation"]["orientation_after_rad"] = rot_stats.__dict__
         paths["json"].write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
+    if check is not None and alone is not None:
+        report = json.loads(paths["json"].read_text(encoding="utf-8"))
+        report["terms_cross_validation_m"] = {" + ".join(("geometry",) + t): r
+                                              for t, r in zip(check.term_sets, check.rms, strict=True)}
+        report["description_alone_m"] = {"poses": alone[0], "alone_rms": alone[1],
+                                          "with_terms_rms": alone[2]}
+        paths["json"].write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
     if not args.no_report:
         from robodyn.report.calibration_report import calibration_html  # matplotlib: after the solve
 
         paths["html"] = calibration_html(cal, output_path(args.output, stem, "_report.html"),
                                          source=str(args.data), validation=validation)
     print(cal.summary())
+    if check is not None and alone is not None:
+        print(f"\n{check.text()}")
+        for family in check.overfitting:
+            err(f"robodyn: warning: adding '{family}' made the held-out error worse "
+                "(cross-validation over poses): it fits these poses, not the arm; consider "
+                "leaving it out")
+        err(f"robodyn: note: {paths['yaml'].name} holds the geometry only, estimated together with "
+            f"the non-geometric terms of {stem}_terms.yaml: loaded alone it predicts "
+            f"{alone[1] * 1e3:.4f} mm RMS on {alone[0]} (with the terms, cal.predict: "
+            f"{alone[2] * 1e3:.4f} mm)")
     if validation is not None:
         print(f"\nheld-out ({args.validate}), after calibration: {stats.text()}")
         print(f"held-out ({args.validate}), before (nominal, placed): {stats_before.text()}"
@@ -256,6 +287,23 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         err("robodyn: warning: the least-squares solver did not converge")
         return 1
     return 0
+
+
+def _state_alone(paths: dict[str, Any], alone: tuple[str, float, float], stem: str) -> None:
+    """Say in the written description's header (YAML and URDF) what it predicts alone."""
+    line = (f"estimated together with the non-geometric terms of {stem}_terms.yaml, which this "
+            f"file cannot hold: alone it predicts {alone[1] * 1e3:.4f} mm RMS on {alone[0]} "
+            f"(with the terms: {alone[2] * 1e3:.4f} mm)")
+    yaml_path = paths.get("yaml")
+    if yaml_path is not None:
+        yaml_path.write_text(f"# {line}\n" + yaml_path.read_text(encoding="utf-8"), encoding="utf-8")
+    urdf = paths.get("urdf")
+    if urdf is not None:
+        text = urdf.read_text(encoding="utf-8")
+        head, sep, rest = text.partition("?>")
+        comment = "\n<!-- " + line.replace("--", "- -") + " -->"
+        urdf.write_text(head + sep + comment + rest if sep else f"<!-- {line} -->\n" + text,
+                        encoding="utf-8")
 
 
 # ----------------------------------------------------------------------------------------------

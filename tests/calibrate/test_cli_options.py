@@ -181,3 +181,35 @@ def test_circle_file_whose_readings_do_not_follow_the_arc_says_what_to_do(tmp_pa
     assert code == 2
     assert "circle-point set 5 (q6)" in err and "measure the sweep in steps under 180 deg" in err
     assert len([line for line in err.splitlines() if line.startswith("robodyn: error:")]) == 1
+
+
+def test_nongeometric_terms_cross_validated_and_the_description_alone_stated(data, tmp_path, capsys):
+    # the data are geometric errors only (perturbed_robot): terms cannot help on held-out poses
+    assert main(["calibrate", "puma560", "--data", str(data / "si.csv"), "--targets", "2",
+                 "--validate", str(data / "si_test.csv"), "--nongeometric", "compliance",
+                 "--nongeometric", "harmonics", "-o", str(tmp_path)]) == 0
+    captured = capsys.readouterr()
+    assert "held-out RMS over 5 folds of 60 poses (cross-validation):" in captured.out
+    j = json.loads((tmp_path / "puma560_calibrated_report.json").read_text())
+    cv = j["terms_cross_validation_m"]
+    assert list(cv) == ["geometry", "geometry + compliance", "geometry + compliance + harmonics"]
+    names = list(cv)
+    worse = [b.split(" + ")[-1] for a, b in zip(names[:-1], names[1:], strict=True) if cv[b] > cv[a]]
+    for family in worse:
+        assert f"adding '{family}' made the held-out error worse" in captured.err
+    # the written description alone, evaluated here independently (loaded from the file, placed
+    # by its own base and tool), against the figure its header and the report state
+    import robodyn as rd
+    from robodyn.calibrate.simulate_study import robot_positions
+
+    alone_robot = rd.load(str(tmp_path / "puma560_calibrated.yaml"))
+    held = read_calibration_csv(data / "si_test.csv", alone_robot, targets=2)
+    rms = float(np.sqrt(np.mean(np.sum((held.points[:, 0] - robot_positions(alone_robot, held.q)) ** 2,
+                                       axis=1))))
+    stated = j["description_alone_m"]
+    assert stated["poses"] == "si_test.csv"
+    assert stated["alone_rms"] == pytest.approx(rms, rel=1e-9)
+    header = (tmp_path / "puma560_calibrated.yaml").read_text().splitlines()[0]
+    assert header.startswith("# estimated together with the non-geometric terms")
+    assert f"alone it predicts {rms * 1e3:.4f} mm RMS on si_test.csv" in header
+    assert "<!-- estimated together" in (tmp_path / "puma560_calibrated.urdf").read_text()
