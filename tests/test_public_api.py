@@ -3,6 +3,8 @@
 import subprocess
 import sys
 
+import pytest
+
 import robodyn as rd
 
 
@@ -29,3 +31,18 @@ def test_import_is_light():
             " 'matplotlib') if m in sys.modules]; print(','.join(heavy))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == ""
+
+
+def test_every_input_error_has_one_base(tmp_path):
+    import robodyn.errors as errors
+
+    classes = [getattr(errors, name) for name in errors.__all__ if name.endswith("Error")]
+    assert errors.RobodynError in classes and len(classes) >= 9
+    for cls in classes:
+        assert issubclass(cls, errors.RobodynError)
+        assert cls is errors.RobodynError or issubclass(cls, ValueError)
+    # one except clause catches what the library raises about its input
+    run = tmp_path / "run.csv"
+    run.write_text("t,q1\n0,0\n")
+    with pytest.raises(errors.RobodynError, match="neither a built-in spec"):
+        rd.read_recording(run, spec="nonesuch")

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 __all__ = [
     "DataFileError",
+    "RecordingError",
+    "RecordingWarning",
+    "RobodynError",
     "DescriptionError",
     "DescriptionWarning",
     "IdentificationError",
@@ -14,7 +17,14 @@ __all__ = [
 ]
 
 
-class DescriptionError(ValueError):
+class RobodynError(Exception):
+    """Base of every error robodyn raises about its input: catch this to handle them all.
+
+    Each subclass is also a :class:`ValueError` (bad input), as before.
+    """
+
+
+class DescriptionError(RobodynError, ValueError):
     """A robot description is malformed or physically impossible.
 
     The message always names where the problem is (file and field path, e.g.
@@ -29,7 +39,7 @@ class DescriptionWarning(UserWarning):
     """
 
 
-class ValidationError(ValueError):
+class ValidationError(RobodynError, ValueError):
     """Measured data cannot be compared with a robot's model.
 
     Raised by :func:`robodyn.validate`: the message names the recording (its source file), the
@@ -38,7 +48,7 @@ class ValidationError(ValueError):
     """
 
 
-class RecordingError(ValueError):
+class RecordingError(RobodynError, ValueError):
     """Measured data (a recording file, a recording spec or arrays) is malformed.
 
     The message names the file (or ``Recording``), the field or column, the row or line where
@@ -51,7 +61,7 @@ class RecordingWarning(UserWarning):
     """Measured data is readable but suspicious (e.g. gaps in the time stamps)."""
 
 
-class SimulationError(FloatingPointError, ValueError):
+class SimulationError(RobodynError, FloatingPointError, ValueError):
     """A simulation (or a forward-dynamics call) stopped being finite.
 
     A ``FloatingPointError`` (what the integrators always raised) and a ``ValueError`` (what the
@@ -65,7 +75,7 @@ class SingularMassMatrixError(SimulationError):
     forward dynamics has no solution. The message names the robot and the joint."""
 
 
-class IdentificationError(ValueError):
+class IdentificationError(RobodynError, ValueError):
     """Measured data cannot be used to identify a robot's parameters, or an estimator failed.
 
     Raised by :func:`robodyn.identify`: the message names the recording (its source file), the
@@ -75,7 +85,7 @@ class IdentificationError(ValueError):
     """
 
 
-class StudyError(ValueError):
+class StudyError(RobodynError, ValueError):
     """A parameter study (``rd.sweep`` or a study file) cannot run as given.
 
     The message names the study file and field where one applies (e.g. ``"study.yaml:
@@ -85,7 +95,7 @@ class StudyError(ValueError):
     """
 
 
-class DataFileError(ValueError):
+class DataFileError(RobodynError, ValueError):
     """A data table (calibration poses, ISO 9283 cycles, approach records) cannot be read.
 
     Raised by :func:`robodyn.calibrate.io.read_table` and the readers built on it: the message
