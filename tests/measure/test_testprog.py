@@ -93,8 +93,8 @@ def test_iso_cube_unreachable(puma):
 
 
 @pytest.mark.parametrize(("kwargs", "message"), [
-    ({"speeds": (0.0,)}, r"speeds must be fractions in \(0, 1\]"),
-    ({"speeds": (1.5,)}, r"speeds must be fractions in \(0, 1\]"),
+    ({"speeds": (0.0,)}, r"speeds must be fractions in \[0.001, 1\] of the velocity limit"),
+    ({"speeds": (1.5,)}, r"speeds must be fractions in \[0.001, 1\] of the velocity limit"),
     ({"joints": ["elbow"]}, "unknown joint 'elbow'; the robot's joints are q1, q2"),
     ({"stroke": -1.0}, "stroke must be a positive angle"),
     ({"velocity": [1.0, 2.0]}, "velocity must be positive"),

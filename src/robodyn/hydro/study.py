@@ -55,6 +55,7 @@ from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import StudyError
 from robodyn.robot.model import Robot
 from robodyn.robot.overrides import checked_parameter_values
+from robodyn.robot.sizes import time_grid_steps
 from robodyn.simulate.controllers import PD
 from robodyn.simulate.simulation import Trajectory, simulate
 from robodyn.simulate.trajectory import JointTrajectory, quintic
@@ -329,6 +330,10 @@ def effect_series(robot: Robot, *, start: Sequence[float] | None = None,
         q0 = _move_vector(start, n, "start")
     if end is not None:
         q1 = _move_vector(end, n, "end")
+    for name, value in (("move_time", move_time), ("hold_time", hold_time), ("free_time", free_time)):
+        time_grid_steps(value, dt, "effect_series", duration_name=name)
+    time_grid_steps(move_time + hold_time + free_time, dt, "effect_series",
+                    duration_name="move_time + hold_time + free_time")
     reference = quintic(q0, q1, move_time, dt=dt)
     duration = move_time + hold_time
     t = dt * np.arange(round(duration / dt) + 1)

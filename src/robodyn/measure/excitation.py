@@ -59,6 +59,7 @@ from scipy.optimize import minimize
 
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.model import Robot
+from robodyn.robot.sizes import time_grid_steps
 from robodyn.simulate.trajectory import JointTrajectory
 from robodyn.symbolic.regressor import JOINT_NAMES, PER_JOINT, parameter_names
 
@@ -532,6 +533,7 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
     if not np.isfinite(periods) or periods < 1 - 1e-9 or abs(periods - round(periods)) > 1e-6:
         raise ValueError(f"excitation: duration {duration!r} s must be a whole number of periods "
                          f"(1 / base_frequency = {period:g} s)")
+    time_grid_steps(total, dt, "excitation", duration_name="duration (whole periods)")
     if criterion not in ("cond", "logdet"):
         raise ValueError(f"excitation: unknown criterion {criterion!r}; choose 'cond' or 'logdet'")
     if starts < 1:

@@ -150,10 +150,17 @@ def _vector(v: float | Sequence[float] | None, default: np.ndarray, name: str) -
     return arr
 
 
+#: Slowest speed fraction of a test program (a stroke at 1e-6 of the limit takes days of samples).
+MIN_SPEED = 1e-3
+#: Most ISO 9283 cycles (the standard's repeatability test uses 30).
+MAX_CYCLES = 10_000
+
+
 def _speeds(speeds: Sequence[float]) -> tuple[float, ...]:
     out = tuple(float(s) for s in speeds)
-    if not out or any(not (0.0 < s <= 1.0) for s in out):
-        raise ValueError(f"speeds must be fractions in (0, 1], got {speeds!r}")
+    if not out or any(not (MIN_SPEED <= s <= 1.0) for s in out):
+        raise ValueError(f"speeds must be fractions in [{MIN_SPEED:g}, 1] of the velocity limit, "
+                         f"got {speeds!r}")
     return out
 
 
@@ -317,8 +324,9 @@ def iso_cube(robot: Robot | Model, *, size: float = 0.5, center: Sequence[float]
     vel = _vector(velocity, lim.velocity, "velocity")
     acc = _vector(acceleration, lim.acceleration, "acceleration")
     (s,) = _speeds([speed])
-    if cycles < 1:
-        raise ValueError(f"iso_cube: cycles must be >= 1, got {cycles!r}")
+    if isinstance(cycles, bool) or not isinstance(cycles, int) or not 1 <= cycles <= MAX_CYCLES:
+        raise ValueError(f"iso_cube: cycles must be an integer in [1, {MAX_CYCLES}] (ISO 9283 "
+                         f"uses 30), got {cycles!r}")
     if dwell < 0:
         raise ValueError(f"iso_cube: dwell must be >= 0 s, got {dwell!r}")
     has = np.array([j.lower is not None and j.upper is not None for j in rob.joints])
