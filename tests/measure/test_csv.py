@@ -176,3 +176,21 @@ def test_csv_round_trip_identical(tmp_path, suffix):
         assert np.array_equal(getattr(back, field), getattr(rec, field)), field
     assert np.array_equal(back.tau, rec.tau, equal_nan=True)
     assert back.temperature is None
+
+
+def test_period_estimate_and_a_corrupt_cell():
+    # one position cell of 1e308 once set the estimated period (and so the duration) to 1e304 s
+    rng = np.random.default_rng(5)
+    period = 1.003e-3
+    t = period * np.arange(3000)
+    q = np.column_stack([np.sin(2 * t), np.cos(3 * t)])
+    qd = np.column_stack([2 * np.cos(2 * t), -3 * np.sin(3 * t)]) + rng.normal(0, 1e-4, (3000, 2))
+    clean = estimate_period(q, qd)
+    assert clean == pytest.approx(period, rel=1e-4)
+    q_bad = q.copy()
+    q_bad[1200, 0] = 1e308
+    assert estimate_period(q_bad, qd) == pytest.approx(clean, rel=1e-6)
+    # and the recording itself names the cell
+    with pytest.raises(RecordingError, match=r"q: 1e\+308 at row 1200, column 0 \('q1'\) is not a "
+                                             r"plausible joint position"):
+        rd.Recording(t=t, q=q_bad, qd=qd)

@@ -81,6 +81,11 @@ def current_to_torque(current: np.ndarray, gear_ratio: np.ndarray, torque_consta
     return np.asarray(current, dtype=float) * (gear_ratio * torque_constant)
 
 
+#: Steps whose residual exceeds this many robust standard deviations are left out of the
+#: period estimate.
+PERIOD_OUTLIER = 10000.0
+
+
 def estimate_period(q: np.ndarray, qd: np.ndarray) -> float:
     """Sample period, s, of a log whose time column is only a sample index.
 
@@ -96,14 +101,29 @@ def estimate_period(q: np.ndarray, qd: np.ndarray) -> float:
     qd : (N, n) ndarray
         Measured velocities, rad/s.
 
+    The least squares are taken over the steps that agree with the median ratio
+    ``median(dq / vbar)`` (on steps with a clear velocity) to within ``PERIOD_OUTLIER`` robust
+    standard deviations, so that one corrupt cell (a position of 1e308, a velocity spike) cannot
+    set the period: it is left to the checks of the values themselves.
+
     Returns
     -------
     float
         T, s; raises ValueError when the arm did not move.
     """
-    dq = np.diff(q, axis=0)
-    vbar = 0.5 * (qd[1:] + qd[:-1])  # trapezoidal rule: dq = T (v_k + v_k+1) / 2
-    den = float(np.sum(vbar * vbar))
-    if den <= 0.0:
+    with np.errstate(over="ignore", invalid="ignore"):
+        dq = np.diff(q, axis=0).ravel()
+        vbar = (0.5 * (qd[1:] + qd[:-1])).ravel()  # trapezoidal rule: dq = T (v_k + v_k+1) / 2
+    ok = np.isfinite(dq) & np.isfinite(vbar)
+    dq, vbar = dq[ok], vbar[ok]
+    if not np.any(vbar != 0.0):
         raise ValueError("cannot estimate the sample period: the measured velocity is zero throughout")
-    return float(np.sum(dq * vbar)) / den
+    clear = np.abs(vbar) >= 0.1 * np.max(np.abs(vbar))
+    ratio = dq[clear] / vbar[clear]
+    t0 = float(np.median(ratio))
+    # residuals of dq = T vbar at the median ratio, and their robust scale (MAD)
+    r = dq - t0 * vbar
+    scale = 1.4826 * float(np.median(np.abs(r - np.median(r)))) or float(np.max(np.abs(r))) or 1.0
+    keep = np.abs(r) <= PERIOD_OUTLIER * scale
+    den = float(np.sum(vbar[keep] ** 2))
+    return float(np.sum(dq[keep] * vbar[keep])) / den if den > 0 else t0

@@ -38,6 +38,10 @@ def _readonly(a: np.ndarray) -> np.ndarray:
     return a
 
 
+#: Largest joint position a recording may hold, rad or m (10^6 rad is 160,000 turns).
+MAX_POSITION = 1e6
+
+
 @dataclass(frozen=True, eq=False)
 class Recording:
     """A measured run: joint signals on one time base, tracker points on another.
@@ -130,6 +134,8 @@ class Recording:
                 raise RecordingError(f"{self._where(name)}: expected shape ({t.size}, {n}) like q, "
                                      f"got {a.shape}")
             self._finite(name, a, names, allow_nan_columns=name in _MAY_LACK_COLUMNS)
+            if name == "q":
+                self._plausible(name, a, names, MAX_POSITION, "joint position (rad or m)")
             set_(self, name, _readonly(a))
         self._tool()
         units = dict(DEFAULT_UNITS)
@@ -149,6 +155,19 @@ class Recording:
         where = f"row {row}" + (f", column {col[0]} ({names[col[0]]!r})" if col else "")
         raise RecordingError(f"{self._where(name)}: {value} at {where} "
                              f"({int(bad.sum())} non-finite value(s) in all)")
+
+    def _plausible(self, name: str, a: np.ndarray, names: Sequence[str], bound: float,
+                   what: str) -> None:
+        """Refuse a value beyond ``bound`` (one corrupt cell would set every scale: a duration of
+        1e304 s, a filter at 1e-302 Hz)."""
+        big = np.abs(a) > bound
+        if not big.any():
+            return
+        row, col = (int(v) for v in np.argwhere(big)[0])
+        raise RecordingError(f"{self._where(name)}: {a[row, col]:g} at row {row}, column {col} "
+                             f"({names[col]!r}) is not a plausible {what} (|value| > {bound:g}); "
+                             f"check the unit and that row of the file ({int(big.sum())} such "
+                             "value(s) in all)")
 
     def _tool(self) -> None:
         if (self.tool_t is None) != (self.tool_points is None):
