@@ -49,6 +49,11 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     print(f"{len(table)} cases, {failed} failed")
     for path in (parquet, csv, *figures, report):
         print(path)
+    if len(table) and failed == len(table):
+        first = str(table["error"].dropna().iloc[0]).splitlines()[0]
+        print(f"robodyn: error: every case failed (the first: {first}); the table lists each "
+              "case's message", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -62,7 +67,8 @@ def add_sweep_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
                     "results.parquet and results.csv (one row per case: parameters, results, "
                     "error message of a failed case), figures and study.html to DIR. The same file "
                     "and seed give the same table whatever the workers or batch size. Ctrl-C keeps "
-                    "the finished cases in results.partial.parquet/.csv.",
+                    "the finished cases in results.partial.parquet/.csv. Exit code 1 when every "
+                    "case failed.",
         epilog="examples:\n  robodyn sweep examples/studies/aa300_sizing.yaml -o out/sweep\n"
                "  robodyn sweep study.yaml --scheduler tcp://10.0.0.5:8786 -o out/sweep")
     p.add_argument("study", metavar="STUDY.yaml", help="study file")

@@ -111,3 +111,20 @@ def test_identification_and_underwater_tasks_run_from_study_files(tmp_path):
     assert isinstance(uw.task, UnderwaterEffects)
     with pytest.raises(StudyError, match="task: expected one of .*identification_monte_carlo"):
         read_study(_write(tmp_path, "task: nonesuch\nparameters:\n  a: [1]\n", "bad.yaml"))
+
+
+def test_cli_sweep_where_every_case_failed_exits_1_with_the_table(tmp_path, capsys):
+    text = """
+task: actuator_sizing
+robot: aa300
+settings: {trajectory: trapezoid, q_start: [0, 0.6, 1], q_goal: [0.5, 0.9, 1],
+           vmax: [1, 0.5, 1.5], amax: [2, 2, 4], dt: 0.005, settle: 0.1}
+parameters:
+  payload: [-50, -60]
+"""
+    path = _write(tmp_path, text)
+    assert main(["sweep", str(path), "--workers", "1", "-o", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err
+    assert "every case failed (the first: ValueError: payload mass must be >= 0 kg" in err
+    table = pd.read_parquet(tmp_path / "out" / "results.parquet")
+    assert len(table) == 2 and table["error"].notna().all()
