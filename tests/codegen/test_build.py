@@ -153,3 +153,25 @@ def test_default_cache_folder_left_open_is_closed_but_a_chosen_one_is_not(
     monkeypatch.setenv("ROBODYN_CACHE", str(chosen))
     assert build.cache_dir() == chosen
     assert stat.S_IMODE(chosen.stat().st_mode) == 0o755  # the user's folder: left as it is
+
+
+@pytest.mark.tool("cc")
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+def test_corrupted_cached_sources_are_generated_again(cache: Path, backend) -> None:
+    # issue 23: a truncated cached .c/.py made every later run fail instead of being rebuilt
+    import numpy as np
+
+    import robodyn as rd
+
+    robot = rd.load("planar_2r")
+    first = rd.compile_model(robot, backend=backend)
+    q = np.array([0.3, -0.4])
+    expected = first.inverse_dynamics(q, q, q)
+    suffix = ".c" if backend == "c" else ".py"
+    (src,) = [p for p in cache.glob(f"rd_model_*{suffix}")]
+    src.write_text(src.read_text()[: len(src.read_text()) // 3])  # truncated mid-function
+    if backend == "numpy":
+        sys.modules.pop(f"robodyn_generated_{src.stem.removeprefix('rd_model_')}", None)
+    again = rd.compile_model(robot, backend=backend)
+    np.testing.assert_array_equal(again.inverse_dynamics(q, q, q), expected)
+    assert len(src.read_text()) > 3 * 100  # written whole again

@@ -14,12 +14,12 @@ import os
 import subprocess
 import sys
 import tempfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 from types import ModuleType
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -653,25 +653,41 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
     marker = directory / f"rd_model_{key}.singular"
     if backend == "c":
         src, decl = directory / f"rd_model_{key}.c", directory / f"rd_model_{key}.cdef"
-        if not (src.exists() and decl.exists()):
+
+        def write_c() -> None:
             kset = _kinematic_safe(robot, values, runtime, marker)
             printer = CPrinter(_PREFIX)
             _write_atomic(decl, printer.declarations(kset))
             _write_atomic(src, printer.source(kset))
-        else:
-            _touch(src, decl)
-        impl: CompiledLibrary | ModuleType = compile_library(src.read_text(), decl.read_text(),
-                                                             flags=openmp_flags())
+
+        impl: CompiledLibrary | ModuleType = _from_cache(
+            (src, decl), write_c,
+            lambda: compile_library(src.read_text(), decl.read_text(), flags=openmp_flags()))
     else:
         path = directory / f"rd_model_{key}.py"
-        if not path.exists():
+
+        def write_py() -> None:
             kset = _kinematic_safe(robot, values, runtime, marker)
             _write_atomic(path, PythonPrinter().module(kset))
-        else:
-            _touch(path)
-        impl = _import_file(path, f"robodyn_generated_{key}")
+
+        impl = _from_cache((path,), write_py, lambda: _import_file(path, f"robodyn_generated_{key}"))
     singular = marker.read_text(encoding="utf-8") if marker.exists() else None
     return Model(robot, backend, tuple(sorted(values.items())), impl, runtime, singular)
+
+
+def _from_cache(paths: Sequence[Path], write: Callable[[], None], load: Callable[[], Any]) -> Any:
+    """``load()`` of generated sources ``paths``, written by ``write()`` when missing. Sources
+    found in the cache that do not compile or import (a truncated or edited file) are generated
+    again once instead of failing every later run."""
+    if not all(p.exists() for p in paths):
+        write()
+        return load()
+    _touch(*paths)
+    try:
+        return load()
+    except Exception:  # noqa: BLE001 - any failure of cached sources: rebuilt, then raised if it recurs
+        write()
+        return load()
 
 
 def _kinematic_safe(robot: Robot, values: Mapping[str, float], runtime: tuple[str, ...],
@@ -702,22 +718,24 @@ def _compile_derivatives(model: Model, names: tuple[str, ...] = DERIVATIVE_KERNE
     directory = cache_dir()
     if backend == "c":
         src, decl = directory / f"rd_{tag}_{key}.c", directory / f"rd_{tag}_{key}.cdef"
-        if not (src.exists() and decl.exists()):
+
+        def write_c() -> None:
             kset = build_kernels(robot, values, names=names, runtime=runtime)
             printer = CPrinter(_PREFIX)
             _write_atomic(decl, printer.declarations(kset, with_simulation=False))
             _write_atomic(src, printer.source(kset, with_simulation=False))
-        else:
-            _touch(src, decl)
-        impl: CompiledLibrary | ModuleType = compile_library(src.read_text(), decl.read_text())
+
+        impl: CompiledLibrary | ModuleType = _from_cache(
+            (src, decl), write_c, lambda: compile_library(src.read_text(), decl.read_text()))
     else:
         path = directory / f"rd_{tag}_{key}.py"
-        if not path.exists():
+
+        def write_py() -> None:
             kset = build_kernels(robot, values, names=names, runtime=runtime)
             _write_atomic(path, PythonPrinter().module(kset))
-        else:
-            _touch(path)
-        impl = _import_file(path, f"robodyn_generated_{tag}_{key}")
+
+        impl = _from_cache((path,), write_py,
+                           lambda: _import_file(path, f"robodyn_generated_{tag}_{key}"))
     return Model(robot, backend, model.parameter_values, impl, runtime)
 
 
