@@ -183,9 +183,12 @@ def _held_out_table(vals: Sequence[tuple[str, rd.Validation]]) -> str:
     rows = [held_out_from_validation(v, label) for label, v in vals]
     held = [v for label, v in vals if label.startswith("held-out")]
     if held:
+        # every joint with a measurement in every held-out recording
+        cols = [j for j in range(len(held[0].joint_names))
+                if all(not np.all(np.isnan(v.measured[:, j])) for v in held)]
         pooled = held_out_error([v.t for v in held], [v.measured for v in held],
-                                [v.predicted for v in held], held[0].joint_names,
-                                source=f"{len(held)} recording(s), all joints",
+                                [v.predicted for v in held], held[0].joint_names, cols,
+                                source=f"{len(held)} recording(s), all measured joints",
                                 cutoff=held[0].noise.cutoff)
         rows.append(("held-out, pooled", pooled))
     return format_held_out(rows)

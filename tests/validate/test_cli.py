@@ -191,3 +191,20 @@ def test_identify_and_validate_accept_tool(command):
     args = _parser().parse_args([command, "arm.urdf", "--data", "run.csv", "--tool", "flange",
                                  "-o", "out"])
     assert args.tool == "flange"
+
+
+def test_validate_with_a_joint_without_sensor(tmp_path, capsys):
+    # the README's example on RunTrajectory1 (no torque sensor on joint 1: an all-NaN column)
+    # failed with "lowpass: non-finite value at row 0, column 0" after writing its outputs
+    robot, _, sim = puma_run(duration=1.0)
+    tau = sim.tau.copy()
+    tau[:, 0] = np.nan
+    rec = rd.Recording(t=sim.t, q=sim.q, qd=sim.qd, qdd=sim.qdd, tau=tau,
+                       joint_names=robot.joint_names)
+    path = write_csv(rec, tmp_path / "nosensor.csv")
+    assert main(["validate", "puma560", "--data", str(path), "-o", str(tmp_path / "val")]) == 0
+    out = capsys.readouterr().out
+    (row,) = [line.split() for line in out.splitlines() if line.startswith("validation  nosensor.csv")]
+    # the joints with a sensor, and finite figures (the exact model: raw error 0)
+    assert row[2] == "q2,q3,q4,q5,q6"
+    assert all(np.isfinite(float(x)) for x in row[3:6]) and float(row[3]) < 1e-3

@@ -128,7 +128,8 @@ def held_out_error(t: Sequence[np.ndarray] | np.ndarray, measured: Sequence[np.n
     count = 0
     for ti, yi, pi in zip(t, measured, predicted, strict=True):
         y = np.asarray(yi, dtype=float)
-        y_f = reference_filter(ti, y, cutoff)[:, cols]
+        y_f = reference_filter(ti, y[:, cols], cutoff)  # the pooled columns only: a joint
+        # without a sensor (an all-NaN column) is left out, not filtered
         y, p = y[:, cols], np.asarray(pi, dtype=float)[:, cols]
         # squared norms of p - y, y, p - y_f, y_f, y - y_f, pooled over recordings
         e2 += float(np.sum((p - y) ** 2))
