@@ -157,3 +157,26 @@ def test_study_file_alias_refused(tmp_path):
     path.write_text(BOMB)
     with pytest.raises(StudyError, match=r"study.yaml: line 2, column \d+: YAML alias \*a"):
         read_study(path)
+
+
+def test_gzip_bomb_and_long_files_refused_while_reading(tmp_path, monkeypatch, capsys):
+    # issue 23: a 0.8 MB gzip expanding to 800 MB reached 3.3 GB (19 GB here) and a traceback
+    from robodyn.cli import main
+
+    bomb = tmp_path / "bomb.csv.gz"
+    with gzip.open(bomb, "wb") as fh:
+        fh.write(b"t,q1\n" + b"0,0\n" * 300_000)  # 1.2 MB of text
+    monkeypatch.setenv("ROBODYN_MAX_FILE_MB", "1")
+    assert main(["record", "info", str(bomb)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == ("robodyn: error: bomb.csv.gz: expands to more than 1 MB when decompressed "
+                   "(set ROBODYN_MAX_FILE_MB to read it)")
+    plain = tmp_path / "long.csv"
+    plain.write_bytes(b"t,q1\n" + b"0,0\n" * 300_000)
+    with pytest.raises(RecordingError, match=r"long.csv: 1.1 MB, more than the 1 MB read"):
+        rd.read_recording(plain)
+    monkeypatch.setenv("ROBODYN_MAX_FILE_MB", "10")
+    monkeypatch.setenv("ROBODYN_MAX_ROWS", "1000")
+    with pytest.raises(RecordingError, match=r"long.csv: 300001 lines, more than the 1000 read "
+                                             r"\(set ROBODYN_MAX_ROWS"):
+        rd.read_recording(plain)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import gzip
 import io
+import os
 import re
 from os import PathLike
 from pathlib import Path
@@ -55,6 +56,63 @@ _TOOL = ("tool_t", "tool_x", "tool_y", "tool_z")
 # the table: lines, field counts, numbers
 # ----------------------------------------------------------------------------------------------
 
+#: Largest text a recording file may hold (decompressed), bytes; ``$ROBODYN_MAX_FILE_MB`` raises it.
+MAX_FILE_BYTES = 512 * 2**20
+
+
+def max_file_bytes() -> int:
+    """The text size limit: ``$ROBODYN_MAX_FILE_MB`` (megabytes) when set, else the default."""
+    text = os.environ.get("ROBODYN_MAX_FILE_MB", "").strip()
+    if not text:
+        return MAX_FILE_BYTES
+    try:
+        mb = float(text)
+    except ValueError:
+        mb = -1.0
+    if not 0 < mb < float("inf"):
+        raise ValueError(f"ROBODYN_MAX_FILE_MB={text!r}: expected a positive number of megabytes")
+    return int(mb * 2**20)
+
+
+#: Most lines a recording file may hold (``$ROBODYN_MAX_ROWS`` raises it): 5 x 10^6 lines are
+#: 83 minutes at 1 kHz.
+MAX_ROWS = 5_000_000
+
+
+def max_rows() -> int:
+    """The line limit: ``$ROBODYN_MAX_ROWS`` when set to a positive integer, else the default."""
+    text = os.environ.get("ROBODYN_MAX_ROWS", "").strip()
+    if not text:
+        return MAX_ROWS
+    if not text.isdigit() or int(text) < 1:
+        raise ValueError(f"ROBODYN_MAX_ROWS={text!r}: expected a positive integer")
+    return int(text)
+
+
+def read_text_bytes(path: Path, error: type[Exception]) -> bytes:
+    """The bytes of a text file, gunzipped when its name ends in ``.gz``, refused (``error``)
+    beyond :func:`max_file_bytes`: a gzip bomb of 0.8 MB expanding to gigabytes is stopped
+    while it is read, not after."""
+    limit = max_file_bytes()
+    name = path.name
+    if path.suffix.lower() != ".gz":
+        if path.stat().st_size > limit:
+            raise error(f"{name}: {path.stat().st_size / 2**20:.1f} MB, more than the "
+                        f"{limit / 2**20:g} MB read (set ROBODYN_MAX_FILE_MB to read it)")
+        return path.read_bytes()
+    out = bytearray()
+    try:
+        with gzip.open(path, "rb") as fh:
+            while chunk := fh.read(1 << 20):
+                out += chunk
+                if len(out) > limit:
+                    raise error(f"{name}: expands to more than {limit / 2**20:g} MB when "
+                                "decompressed (set ROBODYN_MAX_FILE_MB to read it)")
+    except (OSError, EOFError) as exc:
+        raise error(f"{name}: not a readable gzip file ({exc})") from None
+    return bytes(out)
+
+
 #: The ``delimiter`` of a recording spec for fields separated by runs of spaces or tabs.
 WHITESPACE = "whitespace"
 
@@ -65,16 +123,15 @@ class _Table:
 
     def __init__(self, path: Path, delimiter: str | None, header: bool, comment: str | None):
         self.name = path.name
-        raw = path.read_bytes()
-        if path.suffix.lower() == ".gz":
-            try:
-                raw = gzip.decompress(raw)
-            except (OSError, EOFError) as exc:
-                raise RecordingError(f"{self.name}: not a readable gzip file ({exc})") from None
+        raw = read_text_bytes(path, RecordingError)
         try:
             text = raw.decode("utf-8-sig")
         except UnicodeDecodeError as exc:
             raise RecordingError(f"{self.name}: not UTF-8 text (byte {exc.start})") from None
+        rows, limit = text.count("\n"), max_rows()
+        if rows > limit:
+            raise RecordingError(f"{self.name}: {rows} lines, more than the {limit} read (set "
+                                 "ROBODYN_MAX_ROWS to read it)")
         lines = text.splitlines()
         keep = [k for k, line in enumerate(lines)
                 if line.strip() and not (comment and line.lstrip().startswith(comment))]
