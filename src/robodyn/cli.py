@@ -405,6 +405,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         except (DescriptionError, FileNotFoundError, ValueError, OSError) as exc:
             _err(f"robodyn: error: {' '.join(str(exc).split())}")
             return 2
+        except RuntimeError as exc:
+            from robodyn.codegen.build import CompilerNotFoundError
+
+            if not isinstance(exc, CompilerNotFoundError):
+                raise
+            _err(f"robodyn: error: {' '.join(str(exc).split())} (commands with --backend numpy "
+                 "run without one)")
+            return 2
         except KeyboardInterrupt:
             _err("robodyn: interrupted")
             return 130

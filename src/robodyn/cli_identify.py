@@ -123,9 +123,11 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     extra = {"gains": "description"} if gains is not None else {}
     if loaded:
         extra["payloads"] = [None] * len(recs) + [payload] * len(loaded)
+    model = _compiled(robot)
     with progress(f"identifying {robot.name} ({args.method}, {len(recs) + len(loaded)} "
                   "recording(s))"):
         ident = rd.identify(robot, recs + loaded, target=args.target, method=args.method,
+                            model=model,
                             friction=args.friction, velocity=args.velocity,
                             dead_band=args.dead_band, cutoff=args.cutoff,
                             regularization=args.regularization, decimate=args.decimate,
@@ -143,7 +145,8 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     jobs = [("identification data", r) for r in recs] + [("held-out (--validate)", r) for r in held]
     for kind, rec in tqdm(jobs, desc="validating", unit="recording", leave=False):
         vals.append((f"{kind}: {rec.source}", rd.validate(ident.robot, rec, ident=ident,
-                                                          window=args.window)))
+                                                          window=args.window,
+                                                          backend=model.backend)))
     if ident.target == "current" and loaded:
         gain_text = ", ".join(f"{k:.4g} +- {s:.2g}" for k, s in zip(ident.gains, ident.gains_std,
                                                                       strict=True))
@@ -172,6 +175,21 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     for kind, path in paths.items():
         print(f"wrote {kind:<10} {path}")
     return _check_loadable(paths["yaml"])
+
+
+def _compiled(robot: rd.Robot) -> rd.Model:
+    """The compiled model of ``robot``; without a C compiler the NumPy one, with a note (same
+    results, slower) instead of a traceback."""
+    from robodyn.codegen.build import CompilerNotFoundError
+
+    try:
+        with progress(f"compiling {robot.name}"):
+            return rd.compile_model(robot)
+    except CompilerNotFoundError as exc:
+        err(f"robodyn: note: {' '.join(str(exc).split())}; using the NumPy backend (same results, "
+            "slower)")
+        with progress(f"generating the NumPy model of {robot.name}"):
+            return rd.compile_model(robot, backend="numpy")
 
 
 def _held_out_table(vals: Sequence[tuple[str, rd.Validation]]) -> str:
@@ -270,14 +288,13 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
     recs = _read(args.data, args.spec, robot, "data")
-    with progress(f"compiling {robot.name}"):
-        model = rd.compile_model(robot)
+    model = _compiled(robot)
     gains = _gains(args.gains, robot.dof)
     vals = []
     for rec in tqdm(recs, desc="validating", unit="recording", leave=False, disable=len(recs) < 2):
         extra = {} if args.noise_cutoff is None else {"noise_cutoff": args.noise_cutoff}
         vals.append(rd.validate(robot, rec, args.target, model=model, gains=gains,
-                                window=args.window, **extra))
+                                window=args.window, backend=model.backend, **extra))
     paths = {"metrics": _write_metrics(vals, out / "validation.csv")}
     with progress("writing the report and its figures"):
         for i, v in enumerate(vals):

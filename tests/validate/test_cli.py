@@ -208,3 +208,17 @@ def test_validate_with_a_joint_without_sensor(tmp_path, capsys):
     # the joints with a sensor, and finite figures (the exact model: raw error 0)
     assert row[2] == "q2,q3,q4,q5,q6"
     assert all(np.isfinite(float(x)) for x in row[3:6]) and float(row[3]) < 1e-3
+
+
+def test_validate_and_underwater_without_a_c_compiler(files, tmp_path, monkeypatch, capsys):
+    # issue 23: tracebacks when no compiler is on PATH
+    train, _ = files
+    monkeypatch.setenv("PATH", str(tmp_path / "empty"))
+    monkeypatch.setenv("CC", "")
+    assert main(["validate", "puma560", "--data", str(train), "--window", "0.05",
+                 "-o", str(tmp_path / "val")]) == 0
+    err = capsys.readouterr().err
+    assert "no C compiler found" in err and "using the NumPy backend" in err
+    assert main(["underwater", "underwater_2r", "-o", str(tmp_path / "uw")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("robodyn: error: no C compiler found") and "--backend numpy" in err[-1]
