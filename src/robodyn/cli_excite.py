@@ -23,7 +23,8 @@ def _cmd_excite(args: argparse.Namespace) -> int:
     limits = excitation_limits(robot, velocity=args.velocity, acceleration=args.acceleration)
     ex = rd.excitation(robot, harmonics=args.harmonics, base_frequency=args.frequency,
                        duration=args.duration, limits=limits, criterion=args.criterion,
-                       starts=args.starts, seed=args.seed, dt=args.dt, gradient=args.gradient)
+                       starts=args.starts, seed=args.seed, dt=args.dt, gradient=args.gradient,
+                       progress=True)
     path = ex.to_csv(args.output)
     print(f"{robot.name}: {ex.series.harmonics} harmonics at {ex.series.base_frequency:g} Hz, "
           f"{ex.duration:g} s, {len(ex.columns)} base columns")

@@ -50,7 +50,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import scipy.linalg
@@ -467,13 +467,22 @@ def write_trajectory_csv(path: str | Path, t: np.ndarray, q: np.ndarray, qd: np.
 # ----------------------------------------------------------------------------------------------
 # design
 # ----------------------------------------------------------------------------------------------
+def _starts(starts: int, progress: bool) -> Any:
+    """``range(starts)``, with a progress bar on stderr when asked."""
+    if not progress:
+        return range(starts)
+    from tqdm import tqdm
+
+    return tqdm(range(starts), desc="optimising the excitation", unit="start", leave=False)
+
+
 def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float = 0.1,
                duration: float | None = None, limits: ExcitationLimits | None = None, *,
                criterion: Criterion = "cond", starts: int = 6, seed: int = 0, dt: float = 1e-3,
                design_samples: int | None = None, max_iterations: int = 40,
                columns: Sequence[int] | None = None,
-               gradient: Literal["analytic", "finite_difference"] = "finite_difference"
-               ) -> Excitation:
+               gradient: Literal["analytic", "finite_difference"] = "finite_difference",
+               progress: bool = False) -> Excitation:
     """Design an optimal periodic excitation trajectory (finite Fourier series, Swevers 1997).
 
     Parameters
@@ -507,6 +516,8 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
         How the criterion's gradient is differentiated in the joint states: central
         differences of the regressor (default), or the compiled regressor derivatives (the first
         design for a robot compiles them, which takes minutes for a six-joint arm, then cached).
+    progress : bool
+        A progress bar over the starts on stderr (the command line's).
 
     Returns
     -------
@@ -552,7 +563,7 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
     problem = _Problem(model, layout, f, k, cols, lim, criterion, gradient)
     best: tuple[float, FourierTrajectory] | None = None
     history = []
-    for _ in range(starts):
+    for _ in _starts(starts, progress):
         x0 = layout.pack(random_fourier(lim, harmonics, f, rng, samples=k))
         problem.best = (np.inf, x0)
         minimize(problem.objective, x0, jac=True, method="SLSQP",
