@@ -10,6 +10,10 @@
   cube's P1-P5) each attained 30 times; input of ``robodyn iso9283``.
 * ``approach.csv``: one measured approach to a pose (a damped oscillation settling at the
   attained position); input of ``robodyn iso9283 --approach``.
+* ``run.mcap``: a ROS 2 bag (``sensor_msgs/JointState`` on ``/joint_states``) of a PUMA 560 in
+  the virtual lab: 4 s of an excitation at 100 Hz with encoder quantisation and joint torque
+  sensors (position, velocity left out so it is estimated, effort); input of ``robodyn record``
+  and ``rd.read_recording("run.mcap", robot=robot)``.
 """
 
 from __future__ import annotations
@@ -75,7 +79,26 @@ def approach() -> None:
            "ISO 9283 overshoot: one approach to a pose, t (s), x, y, z (m); simulated")
 
 
+def bag() -> None:
+    from robodyn.measure.mcap_io import write_mcap
+    from robodyn.measure.virtual_lab import Sensors, virtual_lab
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = rd.load("puma560")
+    model = rd.compile_model(robot)
+    ex = rd.excitation(model, harmonics=3, base_frequency=0.25, starts=1, seed=5,
+                       max_iterations=5, dt=0.01)
+    sensors = Sensors(sample_period=0.01, jitter=0.0, torque_noise=0.05, tracker_period=0.0)
+    rec = virtual_lab(model, ex, sensors=sensors, seed=5).recording
+    # a controller's bag: positions and efforts at its own stamps (no current, no temperature)
+    out = rd.Recording(t=rec.t + 1.7e9, q=rec.q, tau=np.round(rec.tau, 4),
+                       joint_names=robot.joint_names, source="run.mcap")
+    write_mcap(out, HERE / "run.mcap")
+
+
 if __name__ == "__main__":
     poses()
     cycles()
     approach()
+    bag()

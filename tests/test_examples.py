@@ -28,3 +28,19 @@ def test_iso9283_examples(capsys):
     assert main(["iso9283", "--approach", str(EXAMPLES / "approach.csv"), "--band", "0.1"]) == 0
     overshoot = float(re.search(r"position overshoot\s+([0-9.]+) mm", capsys.readouterr().out).group(1))
     assert 0.5 < overshoot < 2.0
+
+
+def test_sample_bag_reads_plots_and_converts(tmp_path, capsys):
+    import numpy as np
+
+    import robodyn as rd
+
+    bag = EXAMPLES / "run.mcap"
+    assert main(["record", "info", str(bag)]) == 0
+    assert "401 samples of 6 joints (q1, q2, q3, q4, q5, q6)" in capsys.readouterr().out
+    assert main(["record", "plot", str(bag), "-o", str(tmp_path / "plots")]) == 0
+    assert len(list((tmp_path / "plots").glob("*.png"))) == 6
+    assert main(["record", "convert", str(bag), "-o", str(tmp_path / "run.csv")]) == 0
+    rec = rd.read_recording(bag, robot=rd.load("puma560"))
+    back = rd.read_recording(tmp_path / "run.csv")
+    assert np.array_equal(back.q, rec.q) and np.array_equal(back.tau, rec.tau)
