@@ -2,6 +2,7 @@
 
 import gzip
 
+import numpy as np
 import pytest
 
 import robodyn as rd
@@ -180,3 +181,21 @@ def test_gzip_bomb_and_long_files_refused_while_reading(tmp_path, monkeypatch, c
     with pytest.raises(RecordingError, match=r"long.csv: 300001 lines, more than the 1000 read "
                                              r"\(set ROBODYN_MAX_ROWS"):
         rd.read_recording(plain)
+
+
+def test_time_unit_contradicted_by_positions_and_velocities(tmp_path):
+    # issue 23: time.unit s on a sample-index column gave 1 Hz for a 1 kHz log, silently
+    k = np.arange(3000)
+    t = k * 1e-3
+    rows = ["idx,p1,v1"] + [f"{i},{float(np.sin(2 * x))!r},{float(2 * np.cos(2 * x))!r}"
+                            for i, x in zip(k, t, strict=True)]
+    path = tmp_path / "log.csv"
+    path.write_text("\n".join(rows) + "\n")
+    spec = {"joints": 1, "time": {"column": "idx", "unit": "s"},
+            "position": {"columns": ["p1"], "unit": "rad"}, "velocity": {"columns": ["v1"], "unit": "rad/s"}}
+    with pytest.raises(RecordingError, match=r"log.csv: time.unit 's' makes the samples 1 s apart, but "
+                                             r"the positions and measured velocities imply 0.001 s"):
+        rd.read_recording(path, spec=spec)
+    ok = rd.read_recording(path, spec={**spec, "time": {"column": "idx", "unit": "index",
+                                                         "period": "estimate"}})
+    assert ok.dt == pytest.approx(1e-3, rel=1e-3)

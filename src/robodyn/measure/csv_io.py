@@ -271,6 +271,29 @@ def _time(table: _Table, spec: RecordingSpec) -> np.ndarray:
     return raw
 
 
+#: A time unit whose stamps step by more than this factor from the period that positions and
+#: measured velocities imply is refused.
+TIME_UNIT_FACTOR = 5.0
+
+
+def _check_time_unit(name: str, unit: str, t: np.ndarray, q: np.ndarray, qd: np.ndarray) -> None:
+    """Refuse a ``time.unit`` the data contradict: the median step of the stamps against the
+    period the position increments and measured velocities imply (``time.unit: s`` on a sample
+    index gave 1 Hz for a 1 kHz log)."""
+    if t.size < 3 or not np.any(np.abs(qd) > 0):
+        return
+    try:
+        implied = estimate_period(q, qd)
+    except ValueError:
+        return
+    step = float(np.median(np.diff(t)))
+    if implied > 0 and not 1 / TIME_UNIT_FACTOR <= step / implied <= TIME_UNIT_FACTOR:
+        raise RecordingError(
+            f"{name}: time.unit {unit!r} makes the samples {step:.6g} s apart, but the positions "
+            f"and measured velocities imply {implied:.6g} s: check time.unit (a sample index is "
+            "unit: index, with period: estimate or the period in seconds)")
+
+
 def read_csv(path: str | PathLike[str], spec: Any = None, robot: Any = None) -> Recording:
     """Read a CSV/TSV recording (``.gz`` decompressed) through a recording spec.
 
@@ -313,6 +336,8 @@ def read_csv(path: str | PathLike[str], spec: Any = None, robot: Any = None) -> 
         t = (raw_t - raw_t[0]) * period
     else:
         t = raw_t * TIME_UNITS[sp.time_unit]
+        if qd is not None:
+            _check_time_unit(table.name, sp.time_unit, t, q, qd)
     current = _current(table, ch["current"]) if "current" in ch else None
     tau = None
     if "torque" in ch:
