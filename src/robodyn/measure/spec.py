@@ -32,6 +32,9 @@ CURRENT_UNITS = {"A": 1.0, "mA": 1e-3, "V": None}
 TORQUE_UNITS = {"N m": 1.0, "N mm": 1e-3, "N": 1.0}
 TEMPERATURE_UNITS = {"degC": 1.0}
 
+#: Most joints a recording spec may name (a robot arm has a handful; a typo of 10^8 allocated GBs).
+MAX_JOINTS = 256
+
 _TOP = ("description", "delimiter", "header", "comment", "joints", "time", "position", "velocity",
         "current", "torque", "temperature", "couplings")
 _ALLOWED = {
@@ -150,7 +153,7 @@ def _keys(data: Mapping[str, Any], allowed: tuple[str, ...], name: str, path: st
 
 
 def _unit(value: Any, table: Mapping[str, Any], name: str, path: str) -> str:
-    if value not in table:
+    if not isinstance(value, str) or value not in table:
         raise RecordingError(f"{name}: {path}: unknown unit {value!r} (expected one of "
                              f"{', '.join(table)})")
     return str(value)
@@ -249,6 +252,10 @@ def _channel(field: str, data: Any, n: int, name: str) -> Channel:
 def _parse(data: dict[str, Any], name: str) -> RecordingSpec:
     _keys(data, _TOP, name, "")
     joints = data.get("joints")
+    count = joints if isinstance(joints, int) and not isinstance(joints, bool) else \
+        len(joints) if isinstance(joints, list) else 0
+    if count > MAX_JOINTS:
+        raise RecordingError(f"{name}: joints: {count} joints, more than {MAX_JOINTS}")
     if isinstance(joints, int) and not isinstance(joints, bool) and joints > 0:
         names = tuple(f"q{k + 1}" for k in range(joints))
     elif isinstance(joints, list) and joints and all(isinstance(j, str) and j for j in joints):
