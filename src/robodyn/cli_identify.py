@@ -157,6 +157,10 @@ def _cmd_identify(args: argparse.Namespace) -> int:
             + ("measured velocity" if pre.velocity == "measured" else "velocity from positions")
             + ("" if pre.cutoff is None else f", zero-phase low-pass at {pre.cutoff:.3g} Hz")
             + (f", Coulomb dead band {pre.dead_band:g} rad/s" if pre.dead_band else ""))
+    if pre.velocity == "position" and not pre.dead_band and ident.friction_fit is None \
+            and ident.thermal_fit is None and pre.cutoff is not None:
+        note += (f"; robodyn validate {paths['yaml']} --target {ident.target} --cutoff "
+                 f"{pre.cutoff:.17g} reproduces these figures from the written description")
     for k, path in enumerate(_write_predictions(vals, out, note)):
         paths[f"predictions{k + 1}"] = path
     if not args.no_report:
@@ -293,6 +297,8 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     vals = []
     for rec in tqdm(recs, desc="validating", unit="recording", leave=False, disable=len(recs) < 2):
         extra = {} if args.noise_cutoff is None else {"noise_cutoff": args.noise_cutoff}
+        if args.cutoff is not None:
+            extra["cutoff"] = args.cutoff
         vals.append(rd.validate(robot, rec, args.target, model=model, gains=gains,
                                 window=args.window, backend=model.backend, **extra))
     paths = {"metrics": _write_metrics(vals, out / "validation.csv")}
@@ -451,5 +457,10 @@ def _validate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
                    help="low-pass cut-off separating the target from its noise, Hz (default: the "
                         "reference filter of robodyn.validate.heldout, zero-phase Butterworth "
                         "order 4 at 2.5 Hz, which reproduces the Kinova data README's noise floor)")
+    p.add_argument("--cutoff", type=float, metavar="HZ",
+                   help="process the states as an identification did: positions low-passed at HZ "
+                        "and differentiated (robodyn identify prints its value; with it, an "
+                        "identified description reproduces identify's figures) (default: the "
+                        "recording's own velocities and accelerations)")
     _common(p)
     p.set_defaults(func=_cmd_validate)

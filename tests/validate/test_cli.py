@@ -222,3 +222,24 @@ def test_validate_and_underwater_without_a_c_compiler(files, tmp_path, monkeypat
     assert main(["underwater", "underwater_2r", "-o", str(tmp_path / "uw")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1].startswith("robodyn: error: no C compiler found") and "--backend numpy" in err[-1]
+
+
+def test_validate_on_the_written_description_gives_identify_figures(files, tmp_path, capsys):
+    # issue 25 item 3: one model, one verdict
+    train, held = files
+    rc = main(["identify", "puma560", "--data", str(train), "--validate", str(held), "--method",
+               "consistent", "--velocity", "position", "--no-report", "-o", str(tmp_path / "id")])
+    out = capsys.readouterr().out
+    assert rc in (0, 1)
+    hint = out.split("robodyn validate ")[1].split(" reproduces")[0].split()
+    yaml_path, args = hint[0], hint[1:]
+    assert args[:2] == ["--target", "tau"] and args[2] == "--cutoff"
+
+    def figures(text):
+        rows = [line.split() for line in text.splitlines()]
+        return {r[-6]: r[-4:-1] for r in rows if len(r) >= 7 and r[-6] == "held.csv"}
+
+    identify_row = figures(out)["held.csv"]
+    assert main(["validate", yaml_path, *args, "--data", str(held), "--window", "0.05",
+                 "-o", str(tmp_path / "val")]) == 0
+    assert figures(capsys.readouterr().out)["held.csv"] == identify_row
