@@ -121,11 +121,11 @@ def test_cli_cache_info_and_clear_leave_other_files_alone(cache: Path, capsys) -
     assert main(["cache", "info"]) == 0
     out = capsys.readouterr().out
     assert f"location  {cache}\n" in out
-    assert "entries   2 compiled libraries (4 files)" in out
+    assert "entries   2 compiled libraries (6 files)" in out  # each: library, manifest, index
     assert f"size      {size / 2**20:.1f} MB ({size} bytes) of 1024.0 MB" in out
     assert build.DEFAULT_CACHE_MAX_MB == 1024
     assert main(["cache", "clear"]) == 0
-    assert f"removed 4 files ({size} bytes) from {cache}" in capsys.readouterr().out
+    assert f"removed 6 files ({size} bytes) from {cache}" in capsys.readouterr().out
     assert sorted(p.name for p in cache.iterdir()) == [".build-notes", "notes.txt", "rd_measurements.csv",
                                                        "rd_model_notes.py", "rd_thesis_draft.docx"]
     assert (cache / ".build-notes" / "keep.txt").read_text() == "mine"
@@ -175,3 +175,33 @@ def test_corrupted_cached_sources_are_generated_again(cache: Path, backend) -> N
     again = rd.compile_model(robot, backend=backend)
     np.testing.assert_array_equal(again.inverse_dynamics(q, q, q), expected)
     assert len(src.read_text()) > 3 * 100  # written whole again
+
+
+@pytest.mark.tool("cc")
+def test_cached_library_loads_without_a_compiler(cache: Path, monkeypatch) -> None:
+    # issue 24: a worker with the compiled model in its cache but no toolchain failed every case
+    # because the compiler was looked up before the cache
+    import numpy as np
+
+    import robodyn as rd
+
+    lib = compile_library(source(40), DECL)
+    robot = rd.load("planar_2r")
+    q = np.array([0.2, 0.7])
+    expected = rd.compile_model(robot).inverse_dynamics(q, q, q)
+    from robodyn.numeric.model import openmp_flags
+
+    monkeypatch.setenv("PATH", str(cache / "no-tools"))
+    monkeypatch.setenv("CC", "")
+    openmp_flags.cache_clear()  # as in a fresh worker process: no compiler to probe OpenMP with
+    try:
+        with pytest.raises(build.CompilerNotFoundError):
+            build.find_compiler()
+        again = compile_library(source(40), DECL)
+        assert again.path == lib.path and again.lib.rd_test_twice(4.0) == lib.lib.rd_test_twice(4.0)
+        np.testing.assert_array_equal(rd.compile_model(robot).inverse_dynamics(q, q, q), expected)
+        with pytest.raises(build.CompilerNotFoundError):
+            compile_library(source(41), DECL)  # never built: a compiler is still needed
+    finally:
+        monkeypatch.undo()
+        openmp_flags.cache_clear()

@@ -7,7 +7,10 @@ SHA-256 of the library) beside it; the compiled models also keep their generated
 (``rd_model_<hash>.c``/``.cdef``/``.py``). A library is compiled into a private temporary
 folder and renamed into place, so concurrent processes never see a half-written library and at
 worst compile the same thing twice. A library whose size or hash does not match its manifest (a
-truncated or altered file) is compiled again before it is loaded.
+truncated or altered file) is compiled again before it is loaded. An index
+``rd_<source hash>.src`` names the library last built from a source on this kind of processor,
+so that a process without a C compiler (a cluster worker sharing the cache) loads it instead of
+failing: only a source never built needs the compiler.
 
 Size limit: after each compilation the least recently used files (by modification time, which
 loading a library refreshes) are removed until the cache holds at most ``$ROBODYN_CACHE_MAX_MB``
@@ -158,7 +161,7 @@ def cache_limit() -> int:
 
 #: The names robodyn gives its cache files: ``rd_<24 hex>.so`` and its manifest, and generated
 #: sources ``rd_<tag>_<24 hex>.c/.cdef/.py/.singular``; nothing else is ever removed.
-_OWN_NAME = re.compile(r"rd_(?:[a-z]+_)?[0-9a-f]{24}(?:\.so(?:\.sha256)?|\.c|\.cdef|\.py|\.singular)")
+_OWN_NAME = re.compile(r"rd_(?:[a-z]+_)?[0-9a-f]{24}(?:\.so(?:\.sha256)?|\.src|\.c|\.cdef|\.py|\.singular)")
 #: A temporary compilation folder: ``tempfile``'s ``.build-`` plus 8 name characters.
 _OWN_BUILD = re.compile(r"\.build-[a-z0-9_]{8}")
 
@@ -285,7 +288,16 @@ def compile_library(source: str, declarations: str, flags: tuple[str, ...] = CFL
     RuntimeError
         When compilation fails (the compiler's message is included).
     """
-    compiler = find_compiler()
+    # a library built before from this source for this processor is used without a compiler
+    # (a worker that has the cache but no toolchain): the index names it
+    index = cache_dir() / f"{_ENTRY_PREFIX}{_source_key(source)}.src"
+    try:
+        compiler = find_compiler()
+    except CompilerNotFoundError:
+        built = _indexed(index)
+        if built is None:
+            raise
+        return _load(built, declarations)
     # -march=native code is only valid on this kind of processor: it is part of the key
     key = hashlib.sha256("\0".join([source, compiler, *flags, _cpu_id()]).encode()).hexdigest()[:24]
     target = cache_dir() / f"{_ENTRY_PREFIX}{key}.so"
@@ -309,10 +321,42 @@ def compile_library(source: str, declarations: str, flags: tuple[str, ...] = CFL
             os.replace(out, target)
             os.replace(manifest, target.with_name(target.name + _MANIFEST))
         _evict(target.parent, keep=target)
+    with contextlib.suppress(OSError):
+        if _indexed(index) != target:
+            _write_index(index, target)
+    return _load(target, declarations)
+
+
+def _load(target: Path, declarations: str) -> CompiledLibrary:
     ffi = cffi.FFI()
     ffi.cdef(declarations)
     lib = ffi.dlopen(str(target))
     return CompiledLibrary(target, ffi, lib)
+
+
+def _source_key(source: str) -> str:
+    """The compiler-independent key of a source: its text and the processor (not the flags: a
+    process without a compiler cannot probe for OpenMP, and the library built with or without
+    it has the same functions)."""
+    return hashlib.sha256("\0".join([source, _cpu_id()]).encode()).hexdigest()[:24]
+
+
+def _indexed(index: Path) -> Path | None:
+    """The intact cached library an index file names, or None."""
+    try:
+        name = index.read_text(encoding="utf-8").strip()
+    except OSError:
+        return None
+    target = index.with_name(name)
+    if not _OWN_NAME.fullmatch(name) or not name.endswith(".so") or not _intact(target):
+        return None
+    return target
+
+
+def _write_index(index: Path, target: Path) -> None:
+    tmp = index.with_name(f".{index.name}.{os.getpid()}.tmp")
+    tmp.write_text(target.name + "\n", encoding="utf-8")
+    os.replace(tmp, index)  # atomic
 
 
 def _cpu_id() -> str:
