@@ -20,3 +20,10 @@ def slow_square(case: dict) -> dict:
     """``noisy_square`` taking a while (so that a worker can be killed mid-study)."""
     time.sleep(0.05)
     return {**noisy_square(case), "pid": os.getpid()}
+
+
+def crashing_square(case: dict) -> dict:
+    """``x**2``; for ``x == 5`` the worker process dies, as in a crash in compiled code."""
+    if case["x"] == 5:
+        os._exit(1)
+    return {"y": float(case["x"]) ** 2}

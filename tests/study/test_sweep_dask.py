@@ -130,3 +130,24 @@ def test_killing_a_worker_mid_study_still_completes(client):
     assert list(table.index) == list(range(16)) and table["error"].isna().all()
     serial = run_serial(noisy_square, cases, seed=3)
     assert table.drop(columns="pid").equals(serial)
+
+
+def test_case_that_kills_its_worker_is_recorded_and_the_sweep_goes_on():
+    # issue 24: a case crashing its worker every time aborted the whole sweep (KilledWorker) and
+    # returned no table. Its batch is split into single cases; only the crashing one fails.
+    import dask
+    from distributed import Client, LocalCluster
+
+    from tests.study.tasks import crashing_square
+
+    # one worker thread: a case beside the crashing one on the same worker would die with it
+    with dask.config.set({"distributed.scheduler.allowed-failures": 1}), \
+            LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
+                         dashboard_address=None, silence_logs=logging.CRITICAL) as cluster, \
+            Client(cluster, set_as_default=False) as one:
+        frame = sweep(crashing_square, {"x": list(range(10))}, client=one, batch=4, seed=None)
+    assert list(frame.index) == list(range(10))
+    assert frame["error"].notna().tolist() == [x == 5 for x in range(10)]
+    assert "the worker running this case died 2 times" in frame.loc[5, "error"]
+    ok = frame.drop(index=5)
+    assert (ok["y"] == ok.index.to_numpy(float) ** 2).all()

@@ -301,25 +301,76 @@ def sweep(task: Callable[[dict[str, Any]], Mapping[str, Any]], cases: Any, *, cl
         size = batch or max(1, math.ceil(len(expanded) / (4 * threads)))
         parts = [[(i, expanded[i]) for i in r] for r in batches(len(expanded), size)]
         token = uuid.uuid4().hex[:12]
-        futures = dask.map(_run_part, parts, task=task, on_error=on_error, pure=False,
-                           key=[f"robodyn-sweep-{token}-{k}" for k in range(len(parts))])
+        keys = [f"robodyn-sweep-{token}-{k}" for k in range(len(parts))]
+        futures = dask.map(_run_part, parts, task=task, on_error=on_error, pure=False, key=keys)
+        part_of = dict(zip(keys, parts, strict=True))
         bar = tqdm(total=len(expanded), unit="case", disable=not progress, desc="sweep")
+        submitted = list(futures)
         try:
-            for _, out in as_completed(futures, with_results=True, loop=dask.loop):
+            pending = as_completed(futures, loop=dask.loop)
+            for fut in pending:
+                out = _finished(dask, fut, part_of, pending, submitted, task, on_error, token)
                 for row in out:
                     rows[row[0]] = row
                 bar.update(len(out))
-                if on_batch is not None:
+                if on_batch is not None and out:
                     on_batch(out)
         except KeyboardInterrupt:
-            dask.cancel(futures)
+            dask.cancel(submitted)
             raise SweepInterrupted(table(expanded, rows)) from None
         except BaseException:
-            dask.cancel(futures)
+            dask.cancel(submitted)
             raise
         finally:
             bar.close()
     return table(expanded, rows)
+
+
+def _finished(dask: Any, fut: Any, part_of: dict[str, list[tuple[int, dict[str, Any]]]],
+              pending: Any, submitted: list[Any], task: Any, on_error: str, token: str) -> list[Row]:
+    """The rows of a finished task. A task whose worker died on it (the scheduler's
+    ``distributed.scheduler.allowed-failures`` retries spent: a crash in compiled code, an
+    out-of-memory kill) is split into one task per case, added to ``pending``, so that only the
+    case that kills its worker is recorded as failed, with the reason, and the sweep goes on."""
+    from distributed import KilledWorker
+
+    part = part_of.pop(fut.key)
+    rest = part_of.pop(f"{fut.key}-rest", [])
+    if rest:  # the next case of a split batch
+        _submit_single(dask, rest, part_of, pending, submitted, task, on_error, token)
+    if fut.status != "error":
+        return fut.result()
+    exc = fut.exception()
+    if not isinstance(exc, KilledWorker) or on_error != "record":
+        raise exc
+    if len(part) > 1:
+        # one case per task, one after the other (not beside each other on a worker, where the
+        # crashing case would take the others down with it)
+        _submit_single(dask, part, part_of, pending, submitted, task, on_error, token)
+        return []
+    tries = 1 + int(dask.run_on_scheduler(_allowed_failures))
+    return [(part[0][0], {}, f"the worker running this case died {tries} times (a crash in "
+                             f"compiled code or an out-of-memory kill?): {exc}")]
+
+
+def _submit_single(dask: Any, cases: list[tuple[int, dict[str, Any]]], part_of: dict[str, Any],
+                   pending: Any, submitted: list[Any], task: Any, on_error: str, token: str) -> None:
+    """Submit the first of ``cases`` alone; the others wait in ``part_of[key + "-rest"]``."""
+    first = cases[0]
+    key = f"robodyn-sweep-{token}-case-{first[0]}"
+    fut = dask.submit(_run_part, [first], task=task, on_error=on_error, pure=False, key=key)
+    part_of[key] = [first]
+    if len(cases) > 1:
+        part_of[f"{key}-rest"] = cases[1:]
+    pending.add(fut)
+    submitted.append(fut)
+
+
+def _allowed_failures(dask_scheduler: Any = None) -> int:
+    """The scheduler's ``allowed-failures`` setting (run on the scheduler)."""
+    import dask
+
+    return int(dask.config.get("distributed.scheduler.allowed-failures"))
 
 
 def write_table(frame: pd.DataFrame, directory: str | Path, stem: str = "results") -> tuple[Path, Path]:
