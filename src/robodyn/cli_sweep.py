@@ -47,7 +47,12 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                       encoding="utf-8")
     failed = int(table["error"].notna().sum())
     print(f"{len(table)} cases, {failed} failed")
-    for path in (parquet, csv, *figures, report):
+    written = [parquet, csv, *figures, report]
+    if failed:
+        failures = out / "failures.csv"
+        table.loc[table["error"].notna(), ["error"]].to_csv(failures)
+        written.append(failures)
+    for path in written:
         print(path)
     if len(table) and failed == len(table):
         first = str(table["error"].dropna().iloc[0]).splitlines()[0]
@@ -67,8 +72,8 @@ def add_sweep_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
                     "results.parquet and results.csv (one row per case: parameters, results, "
                     "error message of a failed case), figures and study.html to DIR. The same file "
                     "and seed give the same table whatever the workers or batch size. Ctrl-C keeps "
-                    "the finished cases in results.partial.parquet/.csv. Exit code 1 when every "
-                    "case failed.",
+                    "the finished cases in results.partial.parquet/.csv; failed cases are also "
+                    "listed in failures.csv. Exit code 1 when every case failed.",
         epilog="examples:\n  robodyn sweep examples/studies/aa300_sizing.yaml -o out/sweep\n"
                "  robodyn sweep study.yaml --scheduler tcp://10.0.0.5:8786 -o out/sweep")
     p.add_argument("study", metavar="STUDY.yaml", help="study file")

@@ -128,3 +128,5 @@ parameters:
     assert "every case failed (the first: ValueError: payload mass must be >= 0 kg" in err
     table = pd.read_parquet(tmp_path / "out" / "results.parquet")
     assert len(table) == 2 and table["error"].notna().all()
+    failures = pd.read_csv(tmp_path / "out" / "failures.csv", index_col="case")
+    assert list(failures.index) == [0, 1] and failures["error"].str.contains("payload mass").all()
