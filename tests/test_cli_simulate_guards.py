@@ -51,6 +51,8 @@ def _no_compiler():
 
 def test_without_a_compiler_simulate_names_the_numpy_backend(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(build, "find_compiler", _no_compiler)
+    # an empty cache: a library built before would load without a compiler (the cache index)
+    monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path / "cache"))
     code = main(["simulate", "planar_2r", "--duration", "0.1", "-o", str(tmp_path)])
     (line,) = _error_lines(capsys.readouterr().err)
     assert code == 2 and "--backend numpy" in line

@@ -215,6 +215,8 @@ def test_validate_and_underwater_without_a_c_compiler(files, tmp_path, monkeypat
     train, _ = files
     monkeypatch.setenv("PATH", str(tmp_path / "empty"))
     monkeypatch.setenv("CC", "")
+    # an empty cache: a library built before would load without a compiler (the cache index)
+    monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path / "cache"))
     assert main(["validate", "puma560", "--data", str(train), "--window", "0.05",
                  "-o", str(tmp_path / "val")]) == 0
     err = capsys.readouterr().err
