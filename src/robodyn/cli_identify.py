@@ -376,10 +376,10 @@ def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
     p.add_argument("--payload-frame", choices=("tool", "link"), default="tool",
                    help="frame of --payload's centre of mass and inertia: the tool frame or the "
                         "last link's frame (default: %(default)s)")
-    p.add_argument("--friction", default="linear", choices=FRICTION_MODELS,
+    p.add_argument("--friction", default="auto", choices=(*FRICTION_MODELS, "auto"),
                    help="friction model: linear (viscous, Coulomb +/-, offset, in the linear fit), "
-                        "none, or a nonlinear law fitted after the linear step (default: "
-                        "%(default)s)")
+                        "none, a nonlinear law fitted after the linear step, or auto: linear or "
+                        "Stribeck chosen by held-out time blocks (default: %(default)s)")
     _preprocessing(p)
     _common(p)
     p.set_defaults(func=_cmd_identify)

@@ -338,3 +338,33 @@ def test_link_side_torque_sensor_drops_the_rotor_inertia(puma):
         rd.identify(robot, rd.Recording(t=t, q=q, qd=qd, qdd=qdd, current=tau,
                                         joint_names=robot.joint_names), target="current",
                     model=model, sensor="link")
+
+
+def test_friction_law_chosen_by_held_out_blocks(planar):
+    from robodyn.identify.friction import _law
+
+    robot, model = planar
+    t = np.arange(0.0, 30.0, 0.01)
+    q, qd, qdd = fourier(t, 2, np.random.default_rng(17), amplitude=0.6)
+    rigid = model.regressor(q, qd, qdd) @ _without_friction_truth(robot)
+    rng = np.random.default_rng(18)
+    # a strong Stribeck hump (Fs = 3 Fc at low speed), written out with the library's law
+    stribeck = np.column_stack([_law("stribeck", np.array([1.0, 3.0, 0.08, 0.4, 0.2]), qd[:, j],
+                                     rigid[:, j]) for j in range(2)])
+    noise = 0.01 * rng.standard_normal(q.shape)
+    for tau, expected in ((rigid + stribeck + noise, "stribeck"),
+                          (model.inverse_dynamics(q, qd, qdd) + noise, "linear")):
+        rec = _recording(model, t, q, qd, qdd, tau, expected)
+        ident = rd.identify(robot, rec, cutoff=None, model=model)  # friction="auto" by default
+        assert ident.choices.friction == expected, ident.choices.summary()
+        assert (ident.friction_fit is not None) == (expected == "stribeck")
+        scores = dict(ident.choices.friction_scores)
+        assert set(scores) == {"linear", "stribeck"}
+
+
+def _without_friction_truth(robot):
+    from robodyn.identify.friction import without_friction
+
+    p = without_friction(nominal_standard(robot))
+    p[len(INERTIAL_NAMES)::PER_JOINT] = nominal_standard(robot)[len(INERTIAL_NAMES)::PER_JOINT]
+    return p

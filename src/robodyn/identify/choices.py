@@ -104,6 +104,11 @@ class Choices:
         Whether temperature-dependent friction was used.
     chosen : Candidate or None
         The winning candidate (its entry of ``candidates``).
+    friction : str or None
+        The friction law chosen by ``friction="auto"`` (:mod:`robodyn.identify.friction_choice`),
+        else None.
+    friction_scores : tuple of (str, float)
+        Each law's relative held-out error of the friction residual (``friction="auto"``).
     """
 
     velocity: str
@@ -114,6 +119,8 @@ class Choices:
     reason: str
     thermal: bool = False
     chosen: Candidate | None = None
+    friction: str | None = None
+    friction_scores: tuple[tuple[str, float], ...] = ()
 
     def summary(self) -> str:
         """A few lines for the terminal and the report."""
@@ -121,6 +128,10 @@ class Choices:
         lines = [f"velocity {self.velocity}, Coulomb dead band {self.dead_band:g} rad/s, cut-off "
                  f"{cut}, regularization {self.regularization:g}"
                  + (", thermal friction" if self.thermal else "") + f": {self.reason}"]
+        if self.friction is not None:
+            scores = ", ".join(f"{law} {score:.4f}" for law, score in self.friction_scores)
+            lines.append(f"  friction law {self.friction} (held-out blocks of the friction "
+                         f"residual: {scores})")
         if len(self.candidates) > 1:
             for c in self.candidates:
                 mark = "*" if self.chosen is not None and c.key == self.chosen.key else " "

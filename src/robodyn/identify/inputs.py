@@ -91,8 +91,9 @@ def checked_inputs(robot: Robot, recordings: Any, target: str | None, method: st
         raise IdentificationError(f"target: expected one of {TARGETS}, got {target!r}")
     if method not in METHODS:
         raise IdentificationError(f"method: expected one of {METHODS}, got {method!r}")
-    if friction not in FRICTION_MODELS:
-        raise IdentificationError(f"friction: expected one of {FRICTION_MODELS}, got {friction!r}")
+    if friction not in (*FRICTION_MODELS, "auto"):
+        raise IdentificationError(f"friction: expected one of {(*FRICTION_MODELS, 'auto')}, got "
+                                  f"{friction!r}")
     if weights not in WEIGHTS:
         raise IdentificationError(f"weights: expected one of {WEIGHTS}, got {weights!r}")
     if weights == "state-noise" and state_noise is None:

@@ -31,6 +31,7 @@ from robodyn.identify.choices import Candidate, Choices, Problem, candidates, ch
 from robodyn.identify.drive_gains import estimate_drive_gains
 from robodyn.identify.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identify.friction import NONLINEAR, fit_friction_samples, without_friction
+from robodyn.identify.friction_choice import choose_friction_law
 from robodyn.identify.inputs import check_recording, checked_inputs
 from robodyn.identify.payload import Payload, payload_standard, payload_torque
 from robodyn.identify.preprocess import (
@@ -98,7 +99,7 @@ def _stack(samples: Sequence[Samples], y_full: Sequence[np.ndarray], columns: np
 
 
 def identify(robot: Robot, recordings: Any, target: str | None = None, method: str = "wls", *,
-             friction: str = "linear", regularization: float | str | None = "auto",
+             friction: str = "auto", regularization: float | str | None = "auto",
              cutoff: float | str | None = "auto", decimate: int | str = "auto",
              velocity: str = "auto", dead_band: float | str = 0.0, gains: str = "auto",
              bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None,
@@ -119,10 +120,11 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         Default: ``"tau"`` when every recording has torques, else ``"current"``.
     method : {"ols", "wls", "consistent"}
         Ordinary or weighted least squares, or physically consistent (pseudo-inertia LMIs).
-    friction : {"linear", "none", "stribeck", "load", "polynomial"}
+    friction : {"linear", "none", "stribeck", "load", "polynomial", "auto"}
         "linear": viscous, Coulomb (+/-) and offset per joint in the linear fit; "none": no
         friction; the others: a nonlinear law fitted after the linear step
-        (:mod:`robodyn.identify.friction`).
+        (:mod:`robodyn.identify.friction`); "auto": linear or Stribeck, chosen by time-block
+        cross-validation (:mod:`robodyn.identify.friction_choice`).
     regularization : "auto", float or None
         Tikhonov weight toward the description's values (dimensionless, see
         :mod:`robodyn.identify.estimate`); "auto": chosen by time-block cross-validation on these
@@ -222,9 +224,14 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     result = replace(result, choices=Choices(best.velocity, best.dead_band, data.settings.cutoff,
                                              step.fit.lam, tuple(scored), reason, best.thermal, best),
                      thermal_fit=thermal_fit)
-    if friction in NONLINEAR:
+    law = friction
+    if friction == "auto":
+        law, scores = choose_friction_law(result, data.samples, data.y_full)
+        result = replace(result, choices=replace(result.choices, friction=law,
+                                                 friction_scores=tuple(scores.items())))
+    if law in NONLINEAR:
         result = replace(result, friction_fit=fit_friction_samples(result, data.samples, data.y_full,
-                                                                    friction))
+                                                                    law))
     return result
 
 
