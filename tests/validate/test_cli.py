@@ -230,7 +230,8 @@ def test_validate_on_the_written_description_gives_identify_figures(files, tmp_p
     # issue 25 item 3: one model, one verdict
     train, held = files
     rc = main(["identify", "puma560", "--data", str(train), "--validate", str(held), "--method",
-               "consistent", "--velocity", "position", "--no-report", "-o", str(tmp_path / "id")])
+               "consistent", "--velocity", "position", "--friction", "linear", "--no-report",
+               "-o", str(tmp_path / "id")])
     out = capsys.readouterr().out
     assert rc in (0, 1)
     hint = out.split("robodyn validate ")[1].split(" reproduces")[0].split()
