@@ -175,8 +175,6 @@ def _payload(values: np.ndarray | None) -> tuple[float, np.ndarray] | None:
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
-    import json
-
     from robodyn.calibrate.io import read_calibration_csv, read_joint_map, write_calibration
     from robodyn.calibrate.pipeline import (
         ANGLE_UNITS,
@@ -230,33 +228,17 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         stats_before = ErrorStats.from_residuals(first - robot_positions(cal.before_robot, held_q))
         validation = (Path(args.validate).name, (held_pts - cal.predict(held_q)).reshape(-1, 3))
     paths = write_calibration(cal, args.output, stem=stem)
-    terms = tuple(args.nongeometric or ())
     check = alone = None
-    if terms:
-        from robodyn.calibrate.term_check import description_alone, terms_cross_validation
-
-        with progress(f"cross-validating the non-geometric terms over {len(data.q)} poses"):
-            check = terms_cross_validation(
-                rd.calibrate, robot, data.q, data.points, terms, model=args.model, sigma=sigma,
-                loss=args.loss, payload=_payload(args.payload), deflection=args.deflection,
-                **units)
-        on = (Path(args.validate).name, *si(held)) if args.validate else (Path(args.data).name, *si(data))
-        alone = (on[0], *description_alone(cal, on[1], on[2]))
-        _state_alone(paths, alone, stem)
+    if args.nongeometric:
+        poses = (Path(args.validate).name, held_q, held_pts) if args.validate else \
+            (Path(args.data).name, *si(data))
+        check, alone = _terms_check(args, robot, cal, data, sigma, units, poses, paths, stem)
     if validation is not None:
-        report = json.loads(paths["json"].read_text(encoding="utf-8"))
-        report["validation"] = {"file": str(args.validate), "before_m": stats_before.__dict__,
-                                "before_targets": "first", "after_m": stats.__dict__}
+        entry = {"file": str(args.validate), "before_m": stats_before.__dict__,
+                 "before_targets": "first", "after_m": stats.__dict__}
         if rot_stats is not None:
-            report["validation"]["orientation_after_rad"] = rot_stats.__dict__
-        paths["json"].write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
-    if check is not None and alone is not None:
-        report = json.loads(paths["json"].read_text(encoding="utf-8"))
-        report["terms_cross_validation_m"] = {" + ".join(("geometry",) + t): r
-                                              for t, r in zip(check.term_sets, check.rms, strict=True)}
-        report["description_alone_m"] = {"poses": alone[0], "alone_rms": alone[1],
-                                          "with_terms_rms": alone[2]}
-        paths["json"].write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
+            entry["orientation_after_rad"] = rot_stats.__dict__
+        _add_to_report(paths["json"], {"validation": entry})
     if not args.no_report:
         from robodyn.report.calibration_report import calibration_html  # matplotlib: after the solve
 
@@ -264,15 +246,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
                                          source=str(args.data), validation=validation)
     print(cal.summary())
     if check is not None and alone is not None:
-        print(f"\n{check.text()}")
-        for family in check.overfitting:
-            err(f"robodyn: warning: adding '{family}' made the held-out error worse "
-                "(cross-validation over poses): it fits these poses, not the arm; consider "
-                "leaving it out")
-        err(f"robodyn: note: {paths['yaml'].name} holds the geometry only, estimated together with "
-            f"the non-geometric terms of {stem}_terms.yaml: loaded alone it predicts "
-            f"{alone[1] * 1e3:.4f} mm RMS on {alone[0]} (with the terms, cal.predict: "
-            f"{alone[2] * 1e3:.4f} mm)")
+        _print_terms(check, alone, paths["yaml"].name, stem)
     if validation is not None:
         print(f"\nheld-out ({args.validate}), after calibration: {stats.text()}")
         print(f"held-out ({args.validate}), before (nominal, placed): {stats_before.text()}"
@@ -287,6 +261,51 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         err("robodyn: warning: the least-squares solver did not converge")
         return 1
     return 0
+
+
+def _terms_check(args: argparse.Namespace, robot: rd.Robot, cal: Any, data: Any, sigma: Any,
+                 units: dict[str, str], poses: tuple[str, Any, Any], paths: dict[str, Any],
+                 stem: str) -> tuple[Any, tuple[str, float, float]]:
+    """The non-geometric terms cross-validated over the poses, and the written description's own
+    figure on ``poses`` (name, q rad, points m), stated in its files and the JSON report."""
+    from robodyn.calibrate.term_check import description_alone, terms_cross_validation
+
+    with progress(f"cross-validating the non-geometric terms over {len(data.q)} poses"):
+        check = terms_cross_validation(
+            rd.calibrate, robot, data.q, data.points, tuple(args.nongeometric), model=args.model,
+            sigma=sigma, loss=args.loss, payload=_payload(args.payload),
+            deflection=args.deflection, **units)
+    alone = (poses[0], *description_alone(cal, poses[1], poses[2]))
+    _state_alone(paths, alone, stem)
+    _add_to_report(paths["json"], {
+        "terms_cross_validation_m": {" + ".join(("geometry",) + t): r
+                                     for t, r in zip(check.term_sets, check.rms, strict=True)},
+        "description_alone_m": {"poses": alone[0], "alone_rms": alone[1],
+                                "with_terms_rms": alone[2]}})
+    return check, alone
+
+
+def _add_to_report(path: Path, entries: dict[str, Any]) -> None:
+    """Add top-level ``entries`` to the calibration's JSON report at ``path``."""
+    import json
+
+    report = json.loads(path.read_text(encoding="utf-8"))
+    report.update(entries)
+    path.write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
+
+
+def _print_terms(check: Any, alone: tuple[str, float, float], yaml_name: str, stem: str) -> None:
+    """The terms' cross-validation, a warning per family that overfits, and the description's
+    own figure (:mod:`robodyn.calibrate.term_check`)."""
+    print(f"\n{check.text()}")
+    for family in check.overfitting:
+        err(f"robodyn: warning: adding '{family}' made the held-out error worse "
+            "(cross-validation over poses): it fits these poses, not the arm; consider "
+            "leaving it out")
+    err(f"robodyn: note: {yaml_name} holds the geometry only, estimated together with the "
+        f"non-geometric terms of {stem}_terms.yaml: loaded alone it predicts "
+        f"{alone[1] * 1e3:.4f} mm RMS on {alone[0]} (with the terms, cal.predict: "
+        f"{alone[2] * 1e3:.4f} mm)")
 
 
 def _state_alone(paths: dict[str, Any], alone: tuple[str, float, float], stem: str) -> None:

@@ -71,17 +71,16 @@ def test_cli_unreachable_scheduler_is_exit_2(tmp_path, capsys):
     assert "cannot reach the Dask scheduler at 'tcp://127.0.0.1:9'" in capsys.readouterr().err
 
 
-def test_cli_sweep_writes_table_figures_and_report(tmp_path, capsys):
-    text = """
+SIZING = """
 task: actuator_sizing
 robot: aa300
 settings: {trajectory: trapezoid, q_start: [0, 0.6, 1], q_goal: [0.5, 0.9, 1],
            vmax: [1, 0.5, 1.5], amax: [2, 2, 4], dt: 0.005, settle: 0.1}
-parameters:
-  payload: [0, 50]
-  bandwidth_hz: [3, 5]
 """
-    path = _write(tmp_path, text)
+
+
+def test_cli_sweep_writes_table_figures_and_report(tmp_path, capsys):
+    path = _write(tmp_path, SIZING + "parameters:\n  payload: [0, 50]\n  bandwidth_hz: [3, 5]\n")
     assert main(["sweep", str(path), "--workers", "1", "-o", str(tmp_path / "out")]) == 0
     out = tmp_path / "out"
     table = pd.read_parquet(out / "results.parquet")
@@ -114,15 +113,7 @@ def test_identification_and_underwater_tasks_run_from_study_files(tmp_path):
 
 
 def test_cli_sweep_where_every_case_failed_exits_1_with_the_table(tmp_path, capsys):
-    text = """
-task: actuator_sizing
-robot: aa300
-settings: {trajectory: trapezoid, q_start: [0, 0.6, 1], q_goal: [0.5, 0.9, 1],
-           vmax: [1, 0.5, 1.5], amax: [2, 2, 4], dt: 0.005, settle: 0.1}
-parameters:
-  payload: [-50, -60]
-"""
-    path = _write(tmp_path, text)
+    path = _write(tmp_path, SIZING + "parameters:\n  payload: [-50, -60]\n")
     assert main(["sweep", str(path), "--workers", "1", "-o", str(tmp_path / "out")]) == 1
     err = capsys.readouterr().err
     assert "every case failed (the first: ValueError: payload mass must be >= 0 kg" in err

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import gzip
 import io
-import os
 import re
 from os import PathLike
 from pathlib import Path
@@ -45,6 +44,7 @@ from robodyn.measure.spec import (
     load_spec,
 )
 from robodyn.robot.errors import RecordingError
+from robodyn.robot.sizes import env_limit
 
 __all__ = ["read_csv", "write_csv"]
 
@@ -62,16 +62,7 @@ MAX_FILE_BYTES = 512 * 2**20
 
 def max_file_bytes() -> int:
     """The text size limit: ``$ROBODYN_MAX_FILE_MB`` (megabytes) when set, else the default."""
-    text = os.environ.get("ROBODYN_MAX_FILE_MB", "").strip()
-    if not text:
-        return MAX_FILE_BYTES
-    try:
-        mb = float(text)
-    except ValueError:
-        mb = -1.0
-    if not 0 < mb < float("inf"):
-        raise ValueError(f"ROBODYN_MAX_FILE_MB={text!r}: expected a positive number of megabytes")
-    return int(mb * 2**20)
+    return env_limit("ROBODYN_MAX_FILE_MB", MAX_FILE_BYTES, scale=2**20)
 
 
 #: Most lines a recording file may hold (``$ROBODYN_MAX_ROWS`` raises it): 5 x 10^6 lines are
@@ -81,12 +72,7 @@ MAX_ROWS = 5_000_000
 
 def max_rows() -> int:
     """The line limit: ``$ROBODYN_MAX_ROWS`` when set to a positive integer, else the default."""
-    text = os.environ.get("ROBODYN_MAX_ROWS", "").strip()
-    if not text:
-        return MAX_ROWS
-    if not text.isdigit() or int(text) < 1:
-        raise ValueError(f"ROBODYN_MAX_ROWS={text!r}: expected a positive integer")
-    return int(text)
+    return env_limit("ROBODYN_MAX_ROWS", MAX_ROWS)
 
 
 def read_text_bytes(path: Path, error: type[Exception]) -> bytes:

@@ -11,21 +11,32 @@ from __future__ import annotations
 import math
 import os
 
-__all__ = ["MAX_GRID_SAMPLES", "max_grid_samples", "time_grid_steps"]
+__all__ = ["MAX_GRID_SAMPLES", "env_limit", "max_grid_samples", "time_grid_steps"]
 
 #: Default largest time grid, samples (``$ROBODYN_MAX_GRID_SAMPLES`` raises it): 10^7 samples of a
 #: 7-joint arm's q, qd, qdd are 1.7 GB.
 MAX_GRID_SAMPLES = 10_000_000
 
 
-def max_grid_samples() -> int:
-    """The grid limit: ``$ROBODYN_MAX_GRID_SAMPLES`` when set to a positive integer, else the default."""
-    text = os.environ.get("ROBODYN_MAX_GRID_SAMPLES", "").strip()
+def env_limit(name: str, default: int, scale: int = 1) -> int:
+    """A size limit: the environment variable ``name`` times ``scale`` when set (a positive
+    number; an integer when ``scale`` is 1), else ``default``; ValueError naming the variable."""
+    text = os.environ.get(name, "").strip()
     if not text:
-        return MAX_GRID_SAMPLES
-    if not text.isdigit() or int(text) < 1:
-        raise ValueError(f"ROBODYN_MAX_GRID_SAMPLES={text!r}: expected a positive integer")
-    return int(text)
+        return default
+    try:
+        value = float(text) if scale != 1 else int(text)
+    except ValueError:
+        value = -1
+    if not 0 < value < float("inf"):
+        kind = "a positive integer" if scale == 1 else "a positive number"
+        raise ValueError(f"{name}={text!r}: expected {kind}")
+    return int(value * scale)
+
+
+def max_grid_samples() -> int:
+    """The grid limit: ``$ROBODYN_MAX_GRID_SAMPLES`` when set, else :data:`MAX_GRID_SAMPLES`."""
+    return env_limit("ROBODYN_MAX_GRID_SAMPLES", MAX_GRID_SAMPLES)
 
 
 def time_grid_steps(duration: float, dt: float, where: str, *, duration_name: str = "duration",
