@@ -48,6 +48,8 @@ def _cmd_underwater(args: argparse.Namespace) -> int:
         hold_time=args.hold_time, free_time=args.free_time, dt=args.dt, bandwidth=args.bandwidth,
         current=args.current, lift=args.lift, parameters=params,
         backend=args.backend, progress=True)
+    for note in series.notes:
+        print(note)
     sens = errors = None
     if not args.series_only:
         t = series.runs[0].tracked.t

@@ -14,7 +14,8 @@ def test_underwater_writes_table_figures_and_report(tmp_path, capsys) -> None:
                  "--current", "0.5", "0", "0", "--cd-values", "0.6", "2.4",
                  "--current-speeds", "0", "1"])
     assert code == 0
-    printed = capsys.readouterr().out.split()
+    text = capsys.readouterr().out
+    printed = text.split()
     for name in ("effects.csv", "effects.md", "tracking_q.png", "tracking_tau.png", "free_q.png",
                  "ideal_tau.png", "sensitivity.csv", "sensitivity.png", "model_error.csv",
                  "model_error.png", "underwater_section.html", "underwater.html"):
@@ -31,8 +32,9 @@ def test_underwater_writes_table_figures_and_report(tmp_path, capsys) -> None:
     assert "Which effects must the controller" in html and "Sensitivity to the drag" in html
     with (out / "effects.csv").open() as f:
         rows = list(csv.DictReader(f))
-    assert [r["effect"] for r in rows[::2]] == ["dry", "buoyancy", "added_mass", "drag", "lift",
-                                                "current"]
+    # no lift row on the planar arm, and the terminal says why
+    assert [r["effect"] for r in rows[::2]] == ["dry", "buoyancy", "added_mass", "drag", "current"]
+    assert "No '+ lift' row" in text
     assert float(rows[2]["peak_tau"]) < float(rows[0]["peak_tau"])  # buoyancy unloads joint 1
 
 

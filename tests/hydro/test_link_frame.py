@@ -1,5 +1,6 @@
 """Link-frame hydrodynamics on a SPATIAL arm (twisted axes, URDF-style origins, a 3-D current)
-against the world-frame strip formulas evaluated numerically here."""
+against the world-frame strip formulas evaluated numerically here (the added mass in the
+current by Lagrange's equations of the relative kinetic energy, differentiated numerically)."""
 
 from __future__ import annotations
 
@@ -123,15 +124,60 @@ def _world_reference(functions: list, qv: np.ndarray, qdv: np.ndarray) -> tuple[
     return m_a, tau
 
 
+def _added_energy(functions: list, qv: np.ndarray, qdv: np.ndarray,
+                  current: np.ndarray) -> tuple[float, np.ndarray]:
+    """``(T_r, dT_r/dqd)``: the added mass's kinetic energy of the motion relative to the water
+    (world-frame strips, the model's rule) and its momentum, shape (3,)."""
+    cax = (0.0, 0.2, 0.0)
+    energy, momentum = 0.0, np.zeros(3)
+    for link, cyl, rot_fn, jac_fn in functions:
+        a = np.array(cyl["axis"], float) / np.linalg.norm(cyl["axis"])
+        r, length = cyl["radius"], cyl["length"]
+        e = np.array(rot_fn(qv), float) @ a
+        p = np.eye(3) - np.outer(e, e)
+        m_n = 1025.0 * np.pi * r**2
+        for xi, w in gauss_legendre(6, sp.Float(length)):
+            jac = p @ np.array(jac_fn(qv, float(xi)), float)
+            u = jac @ qdv - p @ current
+            # T += w m' |P (v - c)|^2 / 2,  p += w m' (P J)^T P (v - c)
+            energy += float(w) * m_n * (u @ u) / 2
+            momentum += float(w) * m_n * jac.T @ u
+        j0 = np.array(jac_fn(qv, 0.0), float)
+        u_a = e @ (j0 @ qdv - current)
+        energy += cax[link] * m_n * length * u_a**2 / 2
+        momentum += cax[link] * m_n * length * u_a * (j0.T @ e)
+    return energy, momentum
+
+
+def _current_added_mass(functions: list, qv: np.ndarray, qdv: np.ndarray) -> np.ndarray:
+    """Lagrange's equations of T_r at qdd = 0 with the current less those without it, by central
+    differences in q: the added mass's terms that the current brings, shape (3,)."""
+    h, eye = 1e-6, np.eye(3)
+    out = np.zeros(3)
+    for sign, current in ((1.0, np.array([0.3, -0.2, 0.1])), (-1.0, np.zeros(3))):
+        # d/dt dT/dqd - dT/dq  with qdd = 0
+        ddt = (_added_energy(functions, qv + h * qdv, qdv, current)[1]
+               - _added_energy(functions, qv - h * qdv, qdv, current)[1]) / (2 * h)
+        dtdq = np.array([_added_energy(functions, qv + h * e, qdv, current)[0]
+                         - _added_energy(functions, qv - h * e, qdv, current)[0] for e in eye]) / (2 * h)
+        out += sign * (ddt - dtdq)
+    return out
+
+
 def test_spatial_hydro_terms_equal_world_frame_strip_formulas() -> None:
     robot = load_yaml_text(SPATIAL, source="spatial.yaml")
     q, qd = sp.symbols("q1:4", real=True), sp.symbols("qd1:4", real=True)
     h = hydro_terms(robot, q, qd, sp.symbols("qdd1:4", real=True))
     f_m = sp.lambdify([q], h.mass_matrix, cse=True)
-    f_v = sp.lambdify([q, qd], h.velocity_forces, cse=True)
+    f_v = sp.lambdify([q, qd], h.drag + h.skin_friction + h.lift, cse=True)
+    f_c = sp.lambdify([q, qd], h.current_added_mass, cse=True)
     functions = _world_functions(robot)
     rng = np.random.default_rng(6)
     for qv, qdv in rng.uniform(-2, 2, (3, 2, 3)):
         m_ref, tau_ref = _world_reference(functions, qv, qdv)
         np.testing.assert_allclose(np.array(f_m(qv), float), m_ref, rtol=1e-11, atol=1e-13)
         np.testing.assert_allclose(np.ravel(f_v(qv, qdv)), tau_ref, rtol=1e-10, atol=1e-12)
+        # the added mass in the current: Lagrange's equations of the relative kinetic energy
+        c_ref = _current_added_mass(functions, qv, qdv)
+        assert np.abs(c_ref).max() > 1e-2
+        np.testing.assert_allclose(np.ravel(f_c(qv, qdv)), c_ref, rtol=1e-7, atol=1e-8)

@@ -8,9 +8,19 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from robodyn.hydro.study import EFFECTS, effect_series, effect_variant
-from robodyn.hydro.study_plots import write_study
+from robodyn.hydro.lift_reach import lift_reaches_joints
+from robodyn.hydro.study import (
+    EFFECTS,
+    LIFT_DROPPED,
+    LIFT_IN_CURRENT,
+    LIFT_NOT_IN_CURRENT,
+    effect_series,
+    effect_variant,
+)
+from robodyn.hydro.study_plots import study_section, write_study
 from robodyn.robot.errors import StudyError
+from robodyn.robot.yaml_loader import load_yaml_text
+from tests.hydro.test_link_frame import SPATIAL
 
 RHO, CA, CD = 1000.0, 1.0, 1.2
 R1, L1, R2, L2 = 0.06, 1.0, 0.05, 0.8
@@ -26,14 +36,16 @@ def series():
 
 
 def test_series_runs_every_variant_and_fills_the_table(series) -> None:
-    assert [r.effect for r in series.runs] == list(EFFECTS)
+    # lift cannot reach a planar arm's joints in an in-plane current: its row is dropped
+    shown = [e for e in EFFECTS if e != "lift"]
+    assert [r.effect for r in series.runs] == shown
     table = series.table
-    assert len(table) == len(EFFECTS) * 2
+    assert len(table) == len(shown) * 2
     numbers = table.drop(columns=["variant", "effect", "joint"]).to_numpy()
     assert np.all(np.isfinite(numbers))
     dry = table[table.effect == "dry"]
     assert (dry[["diff_vs_dry", "free_diff_vs_dry", "effect_peak_tau"]].to_numpy() == 0).all()
-    # every effect but lift (C_L = 0 for the circular links of underwater_2r) changes the motion
+    # every effect changes the motion
     for effect in ("buoyancy", "added_mass", "drag", "current"):
         rows = table[table.effect == effect]
         assert (rows["effect_peak_tau"] > 1.0).all(), effect
@@ -44,9 +56,27 @@ def test_series_runs_every_variant_and_fills_the_table(series) -> None:
     assert "| + added mass | added_mass | q2 |" in series.markdown()
 
 
-def test_zero_lift_coefficient_adds_nothing(series) -> None:
-    np.testing.assert_array_equal(series.run("lift").ideal_tau, series.run("drag").ideal_tau)
-    np.testing.assert_array_equal(series.run("lift").free.q, series.run("drag").free.q)
+def test_lift_row_is_dropped_with_the_reason_where_lift_cannot_act(series) -> None:
+    # a planar arm in an in-plane current: lift (along e x u_n) is normal to the plane
+    assert series.notes == (LIFT_DROPPED + LIFT_NOT_IN_CURRENT,)
+    assert "lift cannot change any of this arm's joint torques" in series.markdown()
+    assert "normal to the plane" in study_section(series)
+    # with a current out of the plane the note says that the '+ current' row carries the lift
+    wet = effect_series(rd.load("underwater_2r"), end=END, move_time=0.2, hold_time=0.1,
+                        free_time=0.1, current=(0.5, 0.0, 0.4), lift=0.5,
+                        effects=("drag", "lift"))
+    assert wet.notes == (LIFT_DROPPED + LIFT_IN_CURRENT,)
+
+
+def test_lift_reaches_joints_is_physics_not_a_blanket_rule() -> None:
+    planar = rd.load("underwater_2r")
+    assert not lift_reaches_joints(planar, (0.0, 0.0, 0.0))
+    assert not lift_reaches_joints(planar, (0.5, -0.3, 0.0))
+    # an out-of-plane current gives u_n a component along the joint axes, e x u_n one in the plane
+    assert lift_reaches_joints(planar, (0.5, 0.0, 0.4))
+    # and a spatial arm feels lift from its own motion in still water
+    spatial = load_yaml_text(SPATIAL, source="spatial.yaml")
+    assert lift_reaches_joints(spatial, (0.0, 0.0, 0.0))
 
 
 def test_drag_dissipates_free_motion(series) -> None:
@@ -78,9 +108,13 @@ def test_a_current_on_the_arm_at_rest_needs_the_strip_integrated_drag_torque(ser
     # the normal current c_n = c sin(phi): joint 2 must resist 1/2 rho C_d D |c_n| c sin(phi) L^2/2
     phi = END.sum()
     c_n = CURRENT[0] * abs(math.sin(phi))
-    expected = 0.5 * RHO * CD * 2 * R2 * c_n * CURRENT[0] * math.sin(phi) * L2**2 / 2
-    d_tau = series.run("current").ideal_tau[-1] - series.run("lift").ideal_tau[-1]
-    assert d_tau[1] == pytest.approx(expected, rel=1e-9)
+    drag = 0.5 * RHO * CD * 2 * R2 * c_n * CURRENT[0] * math.sin(phi) * L2**2 / 2
+    # plus the added mass's Munk moment -1/2 dk/dq2, k = C_a rho pi r2^2 L2 (c sin phi)^2: the
+    # link is turned broadside to the flow (the motion relative to the water, as in Fossen)
+    munk = -0.5 * CA * RHO * math.pi * R2**2 * L2 * CURRENT[0] ** 2 * math.sin(2 * phi)
+    d_tau = series.run("current").ideal_tau[-1] - series.run("drag").ideal_tau[-1]
+    assert d_tau[1] == pytest.approx(drag + munk, rel=1e-9)
+    assert abs(munk) > 1e-3 * abs(drag)  # far above the tolerance: the test sees it
 
 
 def test_buoyancy_of_a_neutrally_buoyant_arm_removes_the_gravity_torque() -> None:

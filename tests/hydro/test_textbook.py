@@ -40,9 +40,10 @@ def test_printed_terms_sum_to_the_compiled_tau(eom: rd.EquationsOfMotion) -> Non
                 out[i, j] = book.evaluate(book.line(name, *key).value)
         return out
 
-    # (M + M_A) qdd + (C + C_A) qd + g + g_B + tau_D + tau_L, each from its printed lines
+    # (M + M_A) qdd + (C + C_A) qd + tau_Ac + g + g_B + tau_D + tau_L, each from its printed lines
     total = ((mat("M", n, n) + mat("M_A", n, n)) * qddv + (mat("C", n, n) + mat("C_A", n, n)) * qdv
-             + mat("g", n, 1) + mat("g_B", n, 1) + mat("tau_D", n, 1) + mat("tau_L", n, 1))
+             + mat("tau_Ac", n, 1) + mat("g", n, 1) + mat("g_B", n, 1) + mat("tau_D", n, 1)
+             + mat("tau_L", n, 1))
     assert not any(isinstance(e, sp.Integral) for e in total.atoms(sp.Integral))
     f = sp.lambdify([qv, qdv, qddv], total.xreplace(eom.numeric(WET)), "numpy")
     model = rd.compile_model(eom.robot, parameters=WET)

@@ -15,19 +15,36 @@ with ``v(xi) = (J_s + xi J_b) qd`` (``J_b`` already normal to e), integrated exa
 
 ``M_a`` is symmetric positive semidefinite, so ``M + M_a`` stays positive definite. Its Coriolis
 and centrifugal terms come from the same Christoffel symbols robodyn uses for the rigid body:
-``C_a = christoffel(M_a)`` (Lagrange's equations of ``T_a``). The current (uniform and steady)
-does not enter: the relative acceleration equals the body's (Morison's inertia term without the
-Froude-Krylov part, which vanishes for a steady uniform flow).
+``C_a = christoffel(M_a)`` (Lagrange's equations of ``T_a``).
+
+In a uniform steady current ``c`` the fluid's kinetic energy is that of the motion RELATIVE to
+the water, as in Fossen's equations (added mass on the relative velocity ``nu_r``): seen from
+a frame drifting with the water (inertial, the fluid at rest far away) the base moves at
+``-c``. With ``c_l = R^T c`` in link components the relative velocity is ``v(xi) - c_l`` and::
+
+    T_a = 1/2 qd^T M_a qd - qd^T b(q) + 1/2 k(q)
+    b = m_a' (L A^T + L^2/2 J_b^T) P c_l + m_ax J_s^T e (e . c_l)
+    k = m_a' L |P c_l|^2 + m_ax (e . c_l)^2
+
+Lagrange's equations of ``T_a`` add to ``M_a qdd + C_a qd`` the current's terms::
+
+    tau_c = (db/dq^T - db/dq) qd - 1/2 dk/dq
+
+a gyroscopic part (skew, does no work) and the Munk moment ``-1/2 dk/dq`` (a slender body at
+rest turns broadside to the flow). Without a current both vanish. The relative acceleration is
+the body's, and a steady uniform flow has no Froude-Krylov force.
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import sympy as sp
 
 from robodyn.hydro.geometry import CylinderMotion
 from robodyn.hydro.schema import Cylinder, Fluid, LinkHydro
 
-__all__ = ["added_mass_matrix"]
+__all__ = ["added_mass_matrix", "current_energy_terms", "current_torque"]
 
 
 def added_mass_matrix(fluid: Fluid, h: LinkHydro, cyl: Cylinder,
@@ -61,3 +78,61 @@ def added_mass_matrix(fluid: Fluid, h: LinkHydro, cyl: Cylinder,
         # + m_ax J_s^T e e^T J_s
         m += m_ax * s.T * s
     return sp.ImmutableMatrix(m)
+
+
+def current_energy_terms(fluid: Fluid, h: LinkHydro, cyl: Cylinder,
+                         motion: CylinderMotion) -> tuple[sp.Matrix, sp.Expr]:
+    """``(b, k)`` of one cylinder in the current: ``T_a = 1/2 qd^T M_a qd - qd^T b + 1/2 k``.
+
+    Parameters
+    ----------
+    fluid : Fluid
+        Its ``current`` (world frame, m/s) is rotated into the link frame.
+    h : LinkHydro
+    cyl : Cylinder
+    motion : CylinderMotion
+
+    Returns
+    -------
+    b : Matrix, shape (n, 1)
+        Added momentum taken by the current, kg m^2/s (kg m/s for prismatic joints).
+    k : Expr
+        Twice the added kinetic energy of the arm at rest in the current, J.
+    """
+    rho, r, length = fluid.density, cyl.radius, cyl.length
+    c = motion.to_link(fluid.current)
+    pc = motion.normal_projector() * c
+    a = motion.normal_projector() * motion.j_start
+    m_n = h.added_mass * rho * sp.pi * r**2
+    m_ax = h.axial_added_mass * rho * sp.pi * r**2 * length
+    # b = m_a' (L A^T + L^2/2 J_b^T) P c_l,  k = m_a' L |P c_l|^2
+    b = m_n * (length * a.T + length**2 / 2 * motion.j_bend.T) * pc
+    k = m_n * length * (pc.T * pc)[0, 0]
+    if m_ax != 0:
+        e_c = (motion.axis.T * c)[0, 0]
+        # + m_ax J_s^T e (e . c_l),  + m_ax (e . c_l)^2
+        b += m_ax * motion.j_start.T * motion.axis * e_c
+        k += m_ax * e_c**2
+    return b, k
+
+
+def current_torque(b: sp.MatrixBase, k: sp.Expr, q: Sequence[sp.Symbol],
+                   qd: Sequence[sp.Expr]) -> sp.ImmutableMatrix:
+    """``tau_c``: Lagrange's equations of ``- qd^T b(q) + 1/2 k(q)``, shape (n, 1), N m (N).
+
+    Parameters
+    ----------
+    b : Matrix, shape (n, 1)
+        Summed over the cylinders (:func:`current_energy_terms`).
+    k : Expr
+    q : sequence of Symbol, length n
+        ``b`` and ``k`` are differentiated with respect to them.
+    qd : sequence of Expr, length n
+    """
+    n = len(q)
+    if k == 0 and all(x == 0 for x in b):
+        return sp.ImmutableMatrix(sp.zeros(n, 1))
+    db = sp.Matrix(b).jacobian(list(q))
+    # tau_c = (db/dq^T - db/dq) qd - 1/2 dk/dq
+    grad = sp.Matrix([sp.diff(k, qj) for qj in q])
+    return sp.ImmutableMatrix((db.T - db) * sp.Matrix(qd) - grad / 2)

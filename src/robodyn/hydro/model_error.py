@@ -27,6 +27,7 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
+from robodyn.hydro.lift_reach import lift_reaches_joints
 from robodyn.hydro.study import effect_variant
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import StudyError
@@ -65,6 +66,8 @@ class ModelErrorStudy:
         ``Kp^-1 M^-1 g_B`` at the end of the buoyancy-omitting run, rad (m).
     current : (3,) ndarray
         The plant's current, base frame, m/s.
+    notes : tuple of str
+        What the study left out and why (the ``lift`` row where lift cannot reach the joints).
     """
 
     robot: str
@@ -75,6 +78,7 @@ class ModelErrorStudy:
     kd: np.ndarray
     predicted_error: np.ndarray
     current: np.ndarray
+    notes: tuple[str, ...] = ()
 
 
 def model_without(full: Robot, effect: str) -> Robot:
@@ -148,6 +152,11 @@ def model_error_study(robot: Robot, reference: JointTrajectory, duration: float,
     models: dict[str, Model] = {}
     rows: list[dict[str, Any]] = []
     chosen = [e for e in OMITTED if e in omitted]
+    notes: tuple[str, ...] = ()
+    if "lift" in chosen and not lift_reaches_joints(robot, c, params):
+        chosen.remove("lift")
+        notes = ("No 'lift' row: on this arm lift cannot change any joint torque (it acts normal "
+                 "to the plane of motion; see robodyn.hydro.lift_reach).",)
     for effect in tqdm(chosen, desc=f"model error {robot.name}", unit="model",
                        disable=not progress):
         model = plant if effect == "nothing" else compile_model(  # type: ignore[arg-type]
@@ -172,4 +181,4 @@ def model_error_study(robot: Robot, reference: JointTrajectory, duration: float,
         predicted = np.linalg.solve(plant.mass_matrix(q_ss), g_b) / kp
     return ModelErrorStudy(robot=robot.name, reference=reference, runs=runs,
                            table=pd.DataFrame(rows), kp=kp, kd=kd, predicted_error=predicted,
-                           current=c)
+                           current=c, notes=notes)

@@ -50,6 +50,7 @@ import pandas as pd
 from tqdm import tqdm
 
 from robodyn.hydro.effects import DEFAULT_CURRENT, EFFECTS, LABELS
+from robodyn.hydro.lift_reach import lift_reaches_joints
 from robodyn.hydro.schema import fluid_of
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import StudyError
@@ -69,6 +70,16 @@ __all__ = [
     "effect_series",
     "effect_variant",
 ]
+
+#: Why the ``+ lift`` row is left out where lift cannot reach the joints in still water.
+LIFT_DROPPED = (
+    "No '+ lift' row: in still water lift cannot change any of this arm's joint torques, "
+    "whatever C_L. Lift acts along e x u_n, normal to each link's axis and to its flow relative "
+    "to the water; with the links moving in one plane that is normal to the plane, so the "
+    "bearings carry it (see robodyn.hydro.lift_reach).")
+LIFT_IN_CURRENT = (" In the current of the '+ current' row it does act (the current has a "
+                   "component out of the plane), and that row includes it.")
+LIFT_NOT_IN_CURRENT = " Nor in the current of the '+ current' row (it lies in the plane)."
 
 #: Coefficients each effect switches on (the others are set to zero before it).
 _COEFFICIENTS: Mapping[str, tuple[str, ...]] = {
@@ -124,6 +135,8 @@ class EffectSeries:
         Lift coefficient given for the ``lift`` variant (None: the description's).
     move_time, hold_time, free_time, dt : float
         s.
+    notes : tuple of str
+        What the series left out and why (e.g. the ``+ lift`` row on a planar arm).
     """
 
     robot: str
@@ -138,6 +151,7 @@ class EffectSeries:
     hold_time: float
     free_time: float
     dt: float
+    notes: tuple[str, ...] = ()
 
     def run(self, effect: str) -> EffectRun:
         """The variant whose last effect is ``effect``."""
@@ -153,7 +167,7 @@ class EffectSeries:
         for row in self.table.itertuples(index=False):
             cells = [f"{v:.{digits}g}" if isinstance(v, float) else str(v) for v in row]
             lines.append("| " + " | ".join(cells) + " |")
-        return "\n".join(lines) + "\n"
+        return "\n".join(lines + [""] + list(self.notes)) + "\n"
 
 
 def _has_hydro(robot: Robot) -> bool:
@@ -324,6 +338,11 @@ def effect_series(robot: Robot, *, start: Sequence[float] | None = None,
     # unknown names and impossible values are refused before the progress bar starts
     checked_parameter_values(robot, params, where="effect_series(parameters=...)")
     c = _series_current(robot, params, current)
+    notes = []
+    if "lift" in chosen and not lift_reaches_joints(robot, (0.0, 0.0, 0.0), params):
+        chosen.remove("lift")
+        in_current = lift_reaches_joints(robot, c, params)
+        notes.append(LIFT_DROPPED + (LIFT_IN_CURRENT if in_current else LIFT_NOT_IN_CURRENT))
     n = robot.dof
     q0, q1 = _default_move(robot, params)
     if start is not None:
@@ -355,7 +374,7 @@ def effect_series(robot: Robot, *, start: Sequence[float] | None = None,
     table = _table(robot, runs, reference, move_time, q_r)
     return EffectSeries(robot=robot.name, runs=tuple(runs), reference=reference, table=table,
                         kp=kp, kd=kd, current=c, lift=lift, move_time=move_time,
-                        hold_time=hold_time, free_time=free_time, dt=dt)
+                        hold_time=hold_time, free_time=free_time, dt=dt, notes=tuple(notes))
 
 
 def _move_vector(v: Sequence[float], n: int, name: str) -> np.ndarray:

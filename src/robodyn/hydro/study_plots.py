@@ -16,6 +16,7 @@
 
 from __future__ import annotations
 
+import html
 from pathlib import Path
 
 import matplotlib
@@ -89,16 +90,17 @@ def study_section(series: EffectSeries, figures: tuple[Path, ...] = ()) -> str:
     lift = "the description's" if series.lift is None else f"{series.lift:g}"
     intro = (
         f"<h2>Underwater effect series: {series.robot}</h2>"
-        f"<p>Each variant adds one effect to the one before (dry, + buoyancy, + added mass, "
-        f"+ drag, + lift, + current). Tracked: a {series.move_time:g} s quintic move held for "
-        f"{series.hold_time:g} s under the same PD controller (kp = "
+        f"<p>Each variant adds one effect to the one before "
+        f"({', '.join(r.label for r in series.runs)}). Tracked: a {series.move_time:g} s "
+        f"quintic move held for {series.hold_time:g} s under the same PD controller (kp = "
         f"{', '.join(f'{k:.4g}' for k in series.kp)}; kd = {', '.join(f'{k:.4g}' for k in series.kd)}), "
         f"which knows nothing of the water. Free: released at rest for {series.free_time:g} s. "
         f"RK4 at {series.dt:g} s. Current of the last variant ({current}) m/s in the base frame; "
         f"lift coefficient: {lift}. Torques N m (N), positions rad (m), times s; "
         f"effect_peak_tau is the torque this effect adds to the inverse dynamics of the plan.</p>")
     figs = "".join(figure(p, p.stem.replace("_", " ")) for p in figures)
-    return intro + html_table(list(_SHOWN), rows) + figs
+    notes = "".join(f"<p>{html.escape(note)}</p>" for note in series.notes)
+    return intro + html_table(list(_SHOWN), rows) + notes + figs
 
 
 def _rows(table, digits: int = 4) -> list[list]:
@@ -190,7 +192,8 @@ def model_error_section(study: ModelErrorStudy, figures: tuple[Path, ...] = ()) 
         f"steady error Kp^-1 M^-1 g_B = ({pred}) rad predicted.</p>")
     cols = list(study.table.columns)
     figs = "".join(figure(p, p.stem.replace("_", " ")) for p in figures)
-    return intro + html_table(cols, _rows(study.table)) + figs
+    notes = "".join(f"<p>{html.escape(note)}</p>" for note in study.notes)
+    return intro + html_table(cols, _rows(study.table)) + notes + figs
 
 
 def write_study(series: EffectSeries, out: str | Path, sensitivity: Sensitivity | None = None,

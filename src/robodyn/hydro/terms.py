@@ -2,9 +2,10 @@
 
 With the rigid-body terms they give the underwater equations of motion::
 
-    (M + M_a) qdd + (C + C_a) qd + g + g_B + tau_d + tau_f + tau_L + friction = tau
+    (M + M_a) qdd + (C + C_a) qd + g + g_B + tau_c + tau_d + tau_f + tau_L + friction = tau
 
-``M_a``, ``C_a``: added mass (:mod:`~robodyn.hydro.added_mass`); ``g_B``: buoyancy
+``M_a``, ``C_a``: added mass, ``tau_c``: its terms in a current (relative velocity, as in Fossen;
+:mod:`~robodyn.hydro.added_mass`); ``g_B``: buoyancy
 (:mod:`~robodyn.hydro.buoyancy`); ``tau_d``, ``tau_f``: normal drag and axial skin friction
 (:mod:`~robodyn.hydro.drag`); ``tau_L``: lift (:mod:`~robodyn.hydro.lift`).
 
@@ -20,7 +21,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from robodyn.hydro.added_mass import added_mass_matrix
+from robodyn.hydro.added_mass import added_mass_matrix, current_energy_terms, current_torque
 from robodyn.hydro.buoyancy import buoyancy_torque
 from robodyn.hydro.drag import drag_torque, skin_friction_torque
 from robodyn.hydro.geometry import cylinder_motion
@@ -46,7 +47,10 @@ class HydroTerms:
     buoyancy : ImmutableMatrix, shape (n, 1)
         ``g_B(q)``: enters the gravity load.
     added_mass : ImmutableMatrix, shape (n, 1)
-        ``M_a qdd + C_a qd``.
+        The whole added-mass force ``M_a qdd + C_a qd + tau_c``.
+    current_added_mass : ImmutableMatrix, shape (n, 1)
+        ``tau_c(q, qd)``: the added mass's terms in the current (the motion relative to the
+        water, as in Fossen): a gyroscopic part and the Munk moment; zero without a current.
     drag, skin_friction, lift : ImmutableMatrix, shape (n, 1)
         ``tau_d``, ``tau_f``, ``tau_L`` (functions of q, qd and the current).
     """
@@ -55,19 +59,22 @@ class HydroTerms:
     coriolis: sp.ImmutableMatrix
     buoyancy: sp.ImmutableMatrix
     added_mass: sp.ImmutableMatrix
+    current_added_mass: sp.ImmutableMatrix
     drag: sp.ImmutableMatrix
     skin_friction: sp.ImmutableMatrix
     lift: sp.ImmutableMatrix
 
     @property
     def velocity_forces(self) -> sp.ImmutableMatrix:
-        """``tau_d + tau_f + tau_L``, shape (n, 1): the velocity-dependent fluid forces."""
-        return sp.ImmutableMatrix(self.drag + self.skin_friction + self.lift)
+        """``tau_c + tau_d + tau_f + tau_L``, shape (n, 1): the fluid forces outside
+        ``M_a qdd``, ``C_a qd`` and ``g_B``."""
+        return sp.ImmutableMatrix(self.current_added_mass + self.drag + self.skin_friction + self.lift)
 
     @property
     def tau(self) -> sp.ImmutableMatrix:
         """Everything the fluid adds to the inverse dynamics, shape (n, 1)."""
-        return sp.ImmutableMatrix(self.added_mass + self.buoyancy + self.velocity_forces)
+        return sp.ImmutableMatrix(self.added_mass + self.buoyancy + self.drag + self.skin_friction
+                                  + self.lift)
 
 
 def hydro_terms(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Expr],
@@ -92,7 +99,8 @@ def hydro_terms(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Expr],
     n = robot.dof
     hydro = hydro_of(robot)
     kin = forward_kinematics(robot, q)
-    m_a = sp.zeros(n, n)
+    m_a, b_c, k_c = sp.zeros(n, n), sp.zeros(n, 1), sp.Integer(0)
+    still = all(c == 0 for c in fluid.current)
     drag, skin, lift = sp.zeros(n, 1), sp.zeros(n, 1), sp.zeros(n, 1)
     for i, h in enumerate(hydro):
         if h is None:
@@ -100,16 +108,22 @@ def hydro_terms(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Expr],
         for cyl in h.cylinders:
             motion = cylinder_motion(robot, kin, i, cyl, q)
             m_a += added_mass_matrix(fluid, h, cyl, motion)
+            if not still:
+                b, k = current_energy_terms(fluid, h, cyl, motion)
+                b_c, k_c = b_c + b, k_c + k
             drag += drag_torque(fluid, h, cyl, motion, qd, h.quadrature)
             skin += skin_friction_torque(fluid, h, cyl, motion, qd)
             lift += lift_torque(fluid, h, cyl, motion, qd, h.quadrature)
     m_a = sp.ImmutableMatrix(m_a)
     c_a = christoffel_coriolis(m_a, q, qd)
-    # M_a qdd + C_a qd
-    inertial = m_a * sp.Matrix(qdd) + c_a * sp.Matrix(qd)
+    tau_c = current_torque(b_c, k_c, q, qd)
+    # M_a qdd + C_a qd + tau_c
+    inertial = m_a * sp.Matrix(qdd) + c_a * sp.Matrix(qd) + tau_c
     return HydroTerms(
         mass_matrix=m_a, coriolis=c_a,
         buoyancy=buoyancy_torque(robot, kin, fluid, hydro),
-        added_mass=sp.ImmutableMatrix(inertial), drag=sp.ImmutableMatrix(drag),
+        added_mass=sp.ImmutableMatrix(inertial), current_added_mass=tau_c,
+        drag=sp.ImmutableMatrix(drag),
         skin_friction=sp.ImmutableMatrix(skin), lift=sp.ImmutableMatrix(lift),
     )
+

@@ -2,11 +2,13 @@
 
 As the thesis's chapter 7 prints them::
 
-    (M + M_A) qdd + (C + C_A) qd + g + g_B + tau_D + tau_F + tau_L + friction = tau
+    (M + M_A) qdd + (C + C_A) qd + tau_Ac + g + g_B + tau_D + tau_F + tau_L + friction = tau
 
 * ``M``, ``C``, ``g``: the rigid body (rotor inertia included in ``M``);
 * ``M_A``, ``C_A``: added mass, from link-frame Jacobians (so a planar arm's added mass is a
   function of the relative joint angles only, as compact as its rigid inertia);
+* ``tau_Ac``: the added mass's terms in a current (printed when the current is not zero; see
+  :mod:`robodyn.hydro.added_mass`);
 * ``g_B``: buoyancy;
 * ``tau_D``: normal drag. The normal relative velocity of each cylinder is defined once, as a
   function of the arc length ``s`` in the link frame (``v_n2(s) = (l1 cos(q2) + s) qd1 + s qd2``
@@ -36,7 +38,7 @@ from typing import TYPE_CHECKING
 import sympy as sp
 
 from robodyn import spatial as S
-from robodyn.hydro.added_mass import added_mass_matrix
+from robodyn.hydro.added_mass import added_mass_matrix, current_energy_terms, current_torque
 from robodyn.hydro.geometry import CylinderMotion, cylinder_motion
 from robodyn.hydro.quadrature import gauss_legendre
 from robodyn.hydro.schema import fluid_of, hydro_of
@@ -215,7 +217,7 @@ def underwater_textbook(eom: EquationsOfMotion) -> UnderwaterTextbook:
     assert fluid is not None
     kin = eom.kinematics
     s = S_SYMBOL
-    m_a = sp.zeros(n, n)
+    m_a, b_c, k_c = sp.zeros(n, n), sp.zeros(n, 1), sp.Integer(0)
     drag, skin, lift = sp.zeros(n, 1), sp.zeros(n, 1), sp.zeros(n, 1)
     functions: dict[sp.Function, sp.Expr] = {}
     rules: dict[sp.Integral, tuple[tuple[sp.Expr, sp.Expr], ...]] = {}
@@ -227,6 +229,8 @@ def underwater_textbook(eom: EquationsOfMotion) -> UnderwaterTextbook:
         for c, cyl in enumerate(h.cylinders):
             motion = _simplified(cylinder_motion(robot, kin, i, cyl, q))
             m_a += added_mass_matrix(fluid, h, cyl, motion)
+            b, k = current_energy_terms(fluid, h, cyl, motion)
+            b_c, k_c = b_c + b, k_c + k
             # u_n(s) = P (J_s qd - R^T c) + s J_b qd   (link frame)
             p = sp.eye(3) - cyl.axis * cyl.axis.T
             current = sp.Matrix(motion.to_link(fluid.current))
@@ -270,14 +274,16 @@ def underwater_textbook(eom: EquationsOfMotion) -> UnderwaterTextbook:
                                        qd)
                 force = fluid.density * h.skin_friction * sp.pi * cyl.radius * sp.Abs(u_a) * u_a
                 skin += cyl.length * motion.j_start.T * e * force
-    sections = _sections(eom, m_a, drag, skin, lift, tuple(velocity_lines), notes)
+    tau_c = current_torque(b_c, k_c, q, qd)
+    sections = _sections(eom, m_a, tau_c, drag, skin, lift, tuple(velocity_lines), notes)
     return UnderwaterTextbook(tuple(sections), functions, rules)
 
 
-def _sections(eom: EquationsOfMotion, m_a: sp.Matrix, drag: sp.Matrix, skin: sp.Matrix,
-              lift: sp.Matrix, velocity_lines: tuple[Line, ...], notes: list[str]) -> list[Section]:
-    """The printed sections: rigid M, C, g (and friction), then M_A, C_A, g_B, v_n(s), tau_D,
-    tau_F (when any), tau_L."""
+def _sections(eom: EquationsOfMotion, m_a: sp.Matrix, tau_c: sp.Matrix, drag: sp.Matrix,
+              skin: sp.Matrix, lift: sp.Matrix, velocity_lines: tuple[Line, ...],
+              notes: list[str]) -> list[Section]:
+    """The printed sections: rigid M, C, g (and friction), then M_A, C_A, tau_Ac (when a
+    current can flow), g_B, v_n(s), tau_D, tau_F (when any), tau_L."""
     hydro, robot, n = eom.hydro, eom.robot, eom.dof
     q, qd = list(eom.q), list(eom.qd)
     rates = qd + list(eom.qdd)
@@ -299,6 +305,14 @@ def _sections(eom: EquationsOfMotion, m_a: sp.Matrix, drag: sp.Matrix, skin: sp.
                 _matrix_lines("M_A", m_a, rates, symmetric=True)),
         Section("added-mass Coriolis and centrifugal matrix C_A(q, qd) (Christoffel symbols of "
                 "M_A)", _matrix_lines("C_A", c_a, rates)),
+    ]
+    if any(x != 0 for x in tau_c):
+        sections.append(Section(
+            "added mass in the current tau_Ac(q, qd) (the motion relative to the water: "
+            "T_A = 1/2 qd^T M_A qd - qd^T b(q) + 1/2 k(q), tau_Ac = (db/dq^T - db/dq) qd - "
+            "1/2 dk/dq; the last term is the Munk moment)",
+            _matrix_lines("tau_Ac", tau_c, rates)))
+    sections += [
         Section("buoyancy g_B(q) (rho V g at each centre of buoyancy)",
                 _matrix_lines("g_B", hydro.buoyancy, rates)),
         Section("normal velocity relative to the current, in each link frame, at arc length s "

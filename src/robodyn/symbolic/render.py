@@ -247,8 +247,8 @@ def _underwater_layout(eom: EquationsOfMotion) -> _Layout:
     sections = [(sec.title, [_Row(ln.name, ln.index, list(ln.terms), ln.mirror)
                              for ln in sec.lines]) for sec in book.sections]
     tex = {f"{f.func.__name__}(s)": sp.latex(f) for f in book.functions}
-    return _Layout("textbook, under water: (M + M_A) qdd + (C + C_A) qd + g + g_B + tau_D + tau_F "
-                   "+ tau_L (+ friction) = tau, each hydrodynamic term separately", sections, [], tex)
+    return _Layout("textbook, under water: (M + M_A) qdd + (C + C_A) qd + tau_Ac + g + g_B + tau_D "
+                   "+ tau_F + tau_L (+ friction) = tau, each hydrodynamic term separately", sections, [], tex)
 
 
 def _continued(text: str) -> str:
@@ -346,7 +346,7 @@ class _Latex(LatexPrinter):
 _HYDRO_TEX = {"M_A": r"\mathbf{M}^{\mathrm{A}}", "C_A": r"\mathbf{C}^{\mathrm{A}}",
               "g_B": r"\mathbf{g}^{\mathrm{B}}", "tau_D": r"\tau^{\mathrm{D}}",
               "tau_F": r"\tau^{\mathrm{F}}", "tau_L": r"\tau^{\mathrm{L}}",
-              "friction": r"\tau^{\mathrm{f}}"}
+              "tau_Ac": r"\tau^{\mathrm{Ac}}", "friction": r"\tau^{\mathrm{f}}"}
 
 _NAME = re.compile(r"^([A-Za-z]+)(\d*)((?:_[A-Za-z0-9]+)*)$")
 
