@@ -30,9 +30,11 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks && $(BIN)/pytest -q
 
-## bench: timing suites in benchmarks/
+## bench: timing suites in benchmarks/; bench_kernels.py writes benchmarks/results/<machine>.json
+## (CPU, flags, load, min/median of every figure), then README's marked section is rendered from it
 bench: $(STAMP)
 	@set -e; for f in benchmarks/bench_*.py; do echo "== $$f"; $(BIN)/python $$f; done
+	$(BIN)/python benchmarks/render_readme.py --results "$$($(BIN)/python benchmarks/results.py)"
 
 ## clean: remove generated files (keeps .venv)
 clean:
@@ -41,4 +43,4 @@ clean:
 
 ## distclean: clean, and remove .venv too
 distclean: clean
-	rm -rf $(VENV)
+	rm -rf $(VENV) benchmarks/.build

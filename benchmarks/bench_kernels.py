@@ -1,14 +1,23 @@
 """Kernel speed: vectorised, threaded and ensemble robodyn against peers measured in the same run.
 
-Prints (PUMA 560, 100,000 random states, ns per state, best of several runs):
+Prints (PUMA 560, 100,000 random states, ns per state):
+  0. Against Pinocchio (issue 22; ``kernel_peers.py``): inverse dynamics, forward dynamics and
+     forward-dynamics derivatives on one thread, min and median of 7 rounds (the libraries take
+     turns in each round, so that load from other processes hits all alike), robodyn (without
+     friction, like for like, and with the PUMA's friction) against Pinocchio's templates
+     compiled natively with robodyn's compiler and flags (``native_peer.py``,
+     ``native/pinocchio_bench.cpp``, a C++ loop over the same states) and against the pip
+     wheel as users get it (``rneaInParallel``/``abaInParallel`` on 1 thread, derivatives from
+     a Python loop); every library's error against robodyn; the issue's targets against the
+     native build (ID >= 25x, FD >= 25x, FD derivatives >= 15x) printed as met or not. Full
+     runs merge these figures into ``benchmarks/results/<machine>.json`` (``results.py``),
+     from which ``render_readme.py`` renders the README's table.
   1. Single thread: robodyn inverse dynamics (with the PUMA's joint friction, and a copy of the
-     robot without friction, like for like with Pinocchio, which computes none) against
-     Pinocchio's ``rneaInParallel`` on ONE thread (a batch call, no Python per state) and
-     against CasADi-generated C of the same inverse dynamics (robodyn's recorded Newton-Euler
-     program evaluated on CasADi SX symbols, ``CodeGenerator`` C, compiled with robodyn's flags
-     ``-O3 -march=native ...`` and driven by a C loop over the states); forward dynamics
-     against ``abaInParallel`` on one thread; mass matrix against ``crba`` called from Python
-     (the no-op loop's own cost is measured and printed).
+     robot without friction) against CasADi-generated C of the same inverse dynamics
+     (robodyn's recorded Newton-Euler program evaluated on CasADi SX symbols, ``CodeGenerator``
+     C, compiled with robodyn's flags ``-O3 -march=native ...`` and driven by a C loop over the
+     states, one state per call); mass matrix against ``crba`` called from Python (the no-op
+     loop's own cost is measured and printed).
   2. Two threads: robodyn's ``threads=2`` against itself (scaling efficiency) and against
      ``rneaInParallel``/``abaInParallel`` on 2 threads. The machine may be shared: the ratios
      of one run are comparable, absolute times are not.
@@ -19,13 +28,13 @@ Prints (PUMA 560, 100,000 random states, ns per state, best of several runs):
      runtime_parameters=True)``, ``integrate(..., parameters=(1000, 6))``) against the ensemble
      with the parameters compiled in (the cost of keeping them runtime inputs).
 
-Run: ``.venv/bin/python benchmarks/bench_kernels.py [--quick]``.
+Run: ``.venv/bin/python benchmarks/bench_kernels.py [--quick] [--only pinocchio|kernels|ensemble]
+[--results PATH | --no-results]``.
 """
 
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import sys
 import warnings
 from pathlib import Path
@@ -38,15 +47,11 @@ from robodyn.codegen.build import CFLAGS, compile_library
 from robodyn.numeric.model import _kernels_cached
 
 sys.path.insert(0, str(Path(__file__).parent))
+import kernel_peers  # noqa: E402
+import results  # noqa: E402
 from bench_simulation import pinocchio_puma, trolley_mjcf  # noqa: E402
+from kernel_peers import without_friction  # noqa: E402
 from timing import best_of  # noqa: E402
-
-
-def without_friction(robot: rd.Robot) -> rd.Robot:
-    """The same robot with every joint's friction removed (rigid body + rotor inertia only)."""
-    joints = tuple(dataclasses.replace(j, friction=type(j.friction)()) for j in robot.joints)
-    # description_hash "" is recomputed from the new description (the compiled-model cache key)
-    return dataclasses.replace(robot, joints=joints, name=robot.name + "_nofriction", description_hash="")
 
 
 def casadi_inverse_dynamics(robot: rd.Robot):
@@ -159,12 +164,9 @@ def bench_kernels(quick: bool) -> None:
     def row(label, ours, theirs, target=""):
         print(f"{label:34s}{ours * ns:9.1f}{theirs * ns:9.1f}{theirs / ours:7.1f}x  {target}")
 
-    row("ID (friction) / rneaInParallel(1)", t["id"], t["pin_rnea1"], ">= 20x")
-    row("ID (no friction) / rneaInParallel(1)", t["id_rigid"], t["pin_rnea1"], "like for like")
+    # robodyn against Pinocchio natively compiled and its wheel on one thread: bench_pinocchio
     row("ID (friction) / CasADi C", t["id"], t["cs"], ">= 3x")
     row("ID (no friction) / CasADi C", t["id_rigid"], t["cs_rigid"], "")
-    row("FD (friction) / abaInParallel(1)", t["fd"], t["pin_aba1"], ">= 15x")
-    row("FD (no friction) / abaInParallel(1)", t["fd_rigid"], t["pin_aba1"], "like for like")
     row("M / crba from a Python loop", t["m"], t["pin_crba"],
         f"(the loop alone: {t['noop'] * ns:.0f} ns/state)")
     row("M / crba minus the loop", t["m"], t["pin_crba"] - t["noop"], "")
@@ -229,12 +231,51 @@ def bench_ensemble(quick: bool) -> None:
     print()
 
 
+def bench_pinocchio(quick: bool, results_path: Path | None, command: str) -> None:
+    """PUMA 560 ID, FD and FD derivatives against Pinocchio native and wheel (issue 22 targets).
+
+    Parameters
+    ----------
+    quick : bool
+        10,000 states and 3 rounds instead of 100,000 and 7.
+    results_path : Path or None
+        Results file to merge the figures into (benchmark name ``kernels``); None: not written.
+    command : str
+        The command line, recorded with the figures.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = rd.load("puma560")
+    pmodel, source = pinocchio_puma(robot)
+    count, repeats = (10_000, 3) if quick else (100_000, 7)
+    entry = kernel_peers.measure(robot, pmodel, count, repeats)
+    entry["pinocchio_model"] = f"{source}, with the PUMA's rotor inertia as armature"
+    entry["command"] = command
+    kernel_peers.print_entry(entry)
+    if results_path is not None:
+        print(f"figures written to {results.merge(results_path, 'kernels', entry)}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer states and trajectories")
+    parser.add_argument("--only", choices=("pinocchio", "kernels", "ensemble"), action="append",
+                        help="run only these sections (repeatable; default: all)")
+    parser.add_argument("--results", type=Path, default=None,
+                        help="results file for the Pinocchio figures (default: "
+                             "benchmarks/results/<machine>.json on full runs, none with --quick)")
+    parser.add_argument("--no-results", action="store_true", help="write no results file")
     args = parser.parse_args()
-    bench_kernels(args.quick)
-    bench_ensemble(args.quick)
+    sections = set(args.only or ("pinocchio", "kernels", "ensemble"))
+    path = args.results or (None if args.quick else results.default_path())
+    if "pinocchio" in sections:
+        command = " ".join(["python benchmarks/bench_kernels.py", *(["--quick"] if args.quick else []),
+                            *(f"--only {x}" for x in args.only or ())])
+        bench_pinocchio(args.quick, None if args.no_results else path, command)
+    if "kernels" in sections:
+        bench_kernels(args.quick)
+    if "ensemble" in sections:
+        bench_ensemble(args.quick)
 
 
 if __name__ == "__main__":

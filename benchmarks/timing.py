@@ -20,3 +20,30 @@ def best_of_with_result(fn: Callable[[], Any], repeat: int = 5) -> tuple[float, 
         out = fn()
         best = min(best, time.perf_counter() - start)
     return best, out
+
+
+def interleaved(fns: dict[str, Callable[[], Any]], repeat: int = 5) -> dict[str, list[float]]:
+    """Wall times of ``repeat`` calls of each function, s, the functions taking turns.
+
+    Taking turns (one call of each per round) spreads a burst of load from other processes over
+    all of them alike, so that ratios of one run stay comparable on a shared machine.
+
+    Parameters
+    ----------
+    fns : dict
+        Name to a callable without arguments.
+    repeat : int
+        Rounds.
+
+    Returns
+    -------
+    dict
+        Name to the list of its ``repeat`` wall times.
+    """
+    times: dict[str, list[float]] = {name: [] for name in fns}
+    for _ in range(repeat):
+        for name, fn in fns.items():
+            start = time.perf_counter()
+            fn()
+            times[name].append(time.perf_counter() - start)
+    return times

@@ -1,0 +1,151 @@
+"""One results file per machine: ``benchmarks/results/<machine>.json`` (issue 22).
+
+Each benchmark merges its entry under its own name (``{"benchmarks": {"kernels": {...}}}``), so
+that others can be added later without touching the rest. The file also records the machine:
+CPU model, logical CPUs, the load average at the time, and the date. Figures are stored as
+``{"min": ..., "median": ...}`` over the repeats, in the unit their key names.
+
+Used by the benchmarks (run as scripts: ``benchmarks/`` is on ``sys.path``) and by
+``render_readme.py``; nothing here times anything.
+"""
+
+from __future__ import annotations
+
+import datetime
+import json
+import os
+import platform
+import re
+import statistics
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+#: Folder of the results files.
+RESULTS_DIR = Path(__file__).resolve().parent / "results"
+
+
+def cpu_model() -> str:
+    """The processor's model name (``/proc/cpuinfo``, else :func:`platform.processor`).
+
+    Returns
+    -------
+    str
+        E.g. ``"AMD EPYC 7B13"``; ``"unknown"`` when nothing says.
+    """
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine() or "unknown"
+
+
+def machine_name() -> str:
+    """File-name-safe name of this machine: its CPU model and logical CPU count.
+
+    A CPU model rather than the host name: containers get random host names, and the figures
+    belong to the processor.
+
+    Returns
+    -------
+    str
+        Lower-case letters, digits and dashes, e.g. ``"intel-xeon-processor-2cpu"``.
+    """
+    model = re.sub(r"\((r|tm)\)", "", cpu_model().lower())
+    model = re.sub(r"\b(cpu|with|radeon graphics)\b", " ", model)
+    slug = re.sub(r"[^a-z0-9]+", "-", model).strip("-") or "unknown"
+    return f"{slug}-{os.cpu_count() or 0}cpu"
+
+
+def default_path() -> Path:
+    """``benchmarks/results/<machine_name()>.json``."""
+    return RESULTS_DIR / f"{machine_name()}.json"
+
+
+def load_average() -> list[float]:
+    """The 1, 5 and 15 minute load averages (zeros where the system has none)."""
+    try:
+        return [round(x, 2) for x in os.getloadavg()]
+    except OSError:
+        return [0.0, 0.0, 0.0]
+
+
+def summary(seconds: Sequence[float], scale: float = 1.0, digits: int = 1) -> dict[str, float]:
+    """Minimum and median of repeated timings, scaled (e.g. to ns per state).
+
+    Parameters
+    ----------
+    seconds : sequence of float
+        One wall time per repeat.
+    scale : float
+        Factor applied to both (``1e9 / count`` gives ns per state).
+    digits : int
+        Decimals kept.
+
+    Returns
+    -------
+    dict
+        ``{"min": ..., "median": ..., "repeats": n}``.
+    """
+    return {"min": round(min(seconds) * scale, digits),
+            "median": round(statistics.median(seconds) * scale, digits),
+            "repeats": len(seconds)}
+
+
+def simd() -> list[str]:
+    """The vector instruction sets among AVX, AVX2, FMA and AVX-512F that the CPU reports."""
+    try:
+        flags = next((line.split(":", 1)[1].split() for line in
+                      Path("/proc/cpuinfo").read_text().splitlines() if line.startswith("flags")), [])
+    except OSError:
+        flags = []
+    return [f for f in ("avx", "avx2", "fma", "avx512f") if f in flags]
+
+
+def machine_record() -> dict[str, Any]:
+    """What the file says about the machine (the entry of each benchmark has its own load)."""
+    return {"name": machine_name(), "cpu_model": cpu_model(), "simd": simd(),
+            "logical_cpus": os.cpu_count(),
+            "system": f"{platform.system()} {platform.release()}",
+            "python": platform.python_version()}
+
+
+def merge(path: Path, name: str, entry: dict[str, Any]) -> Path:
+    """Write ``entry`` as benchmark ``name`` into the results file at ``path``.
+
+    Other benchmarks' entries in the file are kept; the machine record and this entry are
+    replaced. The entry gets the date and the load average at the time of writing.
+
+    Parameters
+    ----------
+    path : Path
+        The results file (created with its folder when missing).
+    name : str
+        Benchmark name, e.g. ``"kernels"``.
+    entry : dict
+        JSON-serialisable figures.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    data: dict[str, Any] = {}
+    if path.exists():
+        data = json.loads(path.read_text())
+    data["machine"] = machine_record()
+    entry = {"date": datetime.date.today().isoformat(), **entry,
+             "load_average_at_end": load_average()}
+    data.setdefault("benchmarks", {})[name] = entry
+    data["benchmarks"] = dict(sorted(data["benchmarks"].items()))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps(data, indent=1) + "\n")
+    tmp.replace(path)
+    return path
+
+
+if __name__ == "__main__":  # the path of this machine's results file, for the Makefile
+    print(default_path().relative_to(RESULTS_DIR.parent.parent))
