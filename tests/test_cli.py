@@ -8,6 +8,7 @@ import json
 import math
 import operator
 import re
+import tempfile
 import warnings
 
 import numpy as np
@@ -16,6 +17,7 @@ import sympy as sp
 
 import robodyn as rd
 from robodyn.cli import main
+from robodyn.errors import DescriptionError
 from robodyn.report.agreement import Agreement
 from robodyn.symbolic.render import render_json, render_latex, render_mathml, render_text
 
@@ -137,6 +139,34 @@ def test_negative_mass_exits_2_naming_the_field(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1
     assert "bad_arm.yaml" in err and "mass" in err
+
+
+def test_a_bug_is_not_reported_as_bad_input(monkeypatch, tmp_path, capsys):
+    # an error that is not a RobodynError (or a file that cannot be read/written) is a bug:
+    # exit 1, one line that says so, and the traceback in a log file
+    def broken(*args, **kwargs):
+        raise ValueError("an internal inconsistency")
+
+    monkeypatch.setattr(rd, "load", broken)
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
+    monkeypatch.delenv("ROBODYN_DEBUG", raising=False)
+    tempfile.tempdir = None  # let tempfile read TMPDIR again
+    try:
+        assert run(["show", "puma560"]) == 1
+    finally:
+        tempfile.tempdir = None
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "internal error" in err and "Traceback" not in err
+    logs = list(tmp_path.glob("robodyn-internal-error-*.log"))
+    assert len(logs) == 1 and str(logs[0]) in err
+    text = logs[0].read_text()
+    assert "Traceback" in text and "an internal inconsistency" in text and "show puma560" in text
+    # a user-facing error of the same Python type is still bad input
+    def bad(*args, **kwargs):
+        raise DescriptionError("arm.yaml: joints[0].mass: must be >= 0")
+
+    monkeypatch.setattr(rd, "load", bad)
+    assert run(["show", "puma560"]) == 2
 
 
 def test_bad_option_exits_2(capsys):

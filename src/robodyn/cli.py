@@ -4,9 +4,10 @@ Subcommands: ``list``, ``show``, ``derive``, ``check``, ``codegen``, ``export``,
 ``calibrate``, ``iso9283``, ``identify``, ``validate`` and ``demo`` (``robodyn --help``);
 ``simulate``, ``calibrate`` and ``iso9283`` live in :mod:`robodyn.cli_workflows`, ``identify`` and
 ``validate`` in :mod:`robodyn.cli_identify`.
-Exit codes: 0 success; 1 the formulations disagree (check, demo) or the calibration did not
-converge (calibrate); 2 bad input (unknown robot, invalid description, unreadable data, unwritable
-output); 130 interrupted.
+Exit codes: 0 success; 1 the formulations disagree (check, demo), the calibration did not
+converge (calibrate), or an internal error (a bug: one line, the traceback in a log file); 2 bad
+input (a :class:`~robodyn.errors.RobodynError`: unknown robot, invalid description, unreadable
+data; or a file that cannot be read or written); 130 interrupted.
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from robodyn.report.text import err as _err
 from robodyn.report.text import progress as _progress
 from robodyn.report.text import steps as _steps
 from robodyn.report.text import table as _table
-from robodyn.robot.errors import DescriptionError
+from robodyn.robot.errors import RobodynError
 
 if TYPE_CHECKING:
     import sympy as sp
@@ -240,7 +241,11 @@ def _parser() -> argparse.ArgumentParser:
                "  robodyn simulate puma560 --controller computed-torque --target 0.5 -o sim/\n"
                "  robodyn calibrate puma560 --data poses.csv -o calib/\n"
                "  robodyn demo -o out\n\n"
-               "Run 'robodyn COMMAND --help' for the options of a command.")
+               "Run 'robodyn COMMAND --help' for the options of a command.\n\n"
+               "exit codes: 0 success; 1 a check failed (see the command's help) or an internal\n"
+               "error (a bug in robodyn: one line, and the traceback in a log file to report;\n"
+               "ROBODYN_DEBUG=1 shows it instead); 2 bad input (description, data, options, a\n"
+               "file that cannot be read or written); 130 interrupted.")
     parser.add_argument("--version", action="version", version=f"robodyn {rd.__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     _add_model_parsers(sub, fmt)
@@ -394,7 +399,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     Returns
     -------
     int
-        Exit code: 0 success, 1 the formulations disagree, 2 bad input, 130 interrupted.
+        Exit code: 0 success, 1 a check failed or an internal error, 2 bad input, 130
+        interrupted.
     """
     args = _parser().parse_args(argv)
     with warnings.catch_warnings():
@@ -402,20 +408,42 @@ def main(argv: Sequence[str] | None = None) -> int:
         warnings.showwarning = _show_warning
         try:
             return args.func(args)
-        except (DescriptionError, FileNotFoundError, ValueError, OSError) as exc:
+        except (RobodynError, OSError) as exc:
             _err(f"robodyn: error: {' '.join(str(exc).split())}")
-            return 2
-        except RuntimeError as exc:
-            from robodyn.codegen.build import CompilerNotFoundError
-
-            if not isinstance(exc, CompilerNotFoundError):
-                raise
-            _err(f"robodyn: error: {' '.join(str(exc).split())} (commands with --backend numpy "
-                 "run without one)")
             return 2
         except KeyboardInterrupt:
             _err("robodyn: interrupted")
             return 130
+        except Exception as exc:  # not bad input: a bug
+            from robodyn.codegen.build import CompilerNotFoundError
+
+            if isinstance(exc, CompilerNotFoundError):
+                _err(f"robodyn: error: {' '.join(str(exc).split())} (commands with --backend "
+                     "numpy run without one)")
+                return 2
+            if os.environ.get("ROBODYN_DEBUG"):
+                raise
+            _err(f"robodyn: internal error (a bug in robodyn, not in your input): "
+                 f"{type(exc).__name__}: {' '.join(str(exc).split())[:300]}; please report it "
+                 f"with the traceback in {_crash_log(exc, argv)}")
+            return 1
+
+
+def _crash_log(exc: BaseException, argv: Sequence[str] | None) -> str:
+    """Write the traceback of an internal error to a new log file; its path (or a note)."""
+    import tempfile
+    import traceback
+
+    text = (f"robodyn {rd.__version__}, python {sys.version.split()[0]}, {sys.platform}\n"
+            f"command: robodyn {' '.join(sys.argv[1:] if argv is None else argv)}\n\n"
+            + "".join(traceback.format_exception(exc)))
+    try:
+        fd, path = tempfile.mkstemp(prefix="robodyn-internal-error-", suffix=".log")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+    except OSError:
+        return "(no log: the temporary folder is not writable; rerun with ROBODYN_DEBUG=1)"
+    return path
 
 
 def run() -> None:

@@ -20,6 +20,7 @@ import robodyn as rd
 from robodyn.cli_workflows import floats
 from robodyn.output_names import check_stem
 from robodyn.report.text import err, progress
+from robodyn.robot.errors import InputError
 
 __all__ = ["add_parsers"]
 
@@ -42,7 +43,7 @@ def _gains(value: np.ndarray | None, n: int) -> np.ndarray | None:
     if value.size == 1:
         return np.full(n, float(value[0]))
     if value.size != n:
-        raise ValueError(f"--gains: expected 1 or {n} comma-separated values (one per joint), got "
+        raise InputError(f"--gains: expected 1 or {n} comma-separated values (one per joint), got "
                          f"{value.size}")
     return value
 
@@ -50,13 +51,13 @@ def _gains(value: np.ndarray | None, n: int) -> np.ndarray | None:
 def _payload(args: argparse.Namespace) -> rd.Payload | None:
     """The known payload of ``--payload`` (None without ``--payload-data``)."""
     if (args.payload is None) != (not args.payload_data):
-        raise ValueError("--payload and --payload-data go together: the recordings made with the "
+        raise InputError("--payload and --payload-data go together: the recordings made with the "
                          "payload attached, and its mass, centre of mass (and inertia)")
     if args.payload is None:
         return None
     v = args.payload
     if v.size not in (4, 7, 10):
-        raise ValueError(f"--payload: expected KG,X,Y,Z[,IXX,IYY,IZZ[,IXY,IXZ,IYZ]] (4, 7 or 10 "
+        raise InputError(f"--payload: expected KG,X,Y,Z[,IXX,IYY,IZZ[,IXY,IXZ,IYZ]] (4, 7 or 10 "
                          f"values), got {v.size}")
     inertia = np.zeros((3, 3))
     if v.size >= 7:
@@ -257,7 +258,7 @@ def _with_gains(robot: rd.Robot, gains: np.ndarray) -> rd.Robot:
     for j, k in zip(robot.joints, gains, strict=True):
         ratio = abs(float(sp.sympify(j.drive.gear_ratio).subs(robot.defaults())))
         if ratio == 0:
-            raise ValueError(f"--gains: joint {j.name} has gear ratio 0 in {robot.source}")
+            raise InputError(f"--gains: joint {j.name} has gear ratio 0 in {robot.source}")
         drive = dataclasses.replace(j.drive, torque_constant=sp.Float(float(k) / ratio))
         joints.append(dataclasses.replace(j, drive=drive))
     return dataclasses.replace(robot, joints=tuple(joints), description_hash="")

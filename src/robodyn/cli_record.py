@@ -14,6 +14,7 @@ import numpy as np
 
 import robodyn as rd
 from robodyn.report.text import err, table
+from robodyn.robot.errors import InputError
 
 __all__ = ["add_record_parser"]
 
@@ -95,7 +96,7 @@ def _cmd_convert(args: argparse.Namespace) -> int:
     out = Path(args.output)
     source = Path(args.file)
     if out.exists() and source.exists() and out.resolve() == source.resolve():
-        raise ValueError(f"{out}: -o is the file being converted; write to another file "
+        raise InputError(f"{out}: -o is the file being converted; write to another file "
                          "(the input is never overwritten)")
     rec = _read(args)
     if out.suffix.lower() == ".mcap":
@@ -108,7 +109,7 @@ def _cmd_convert(args: argparse.Namespace) -> int:
     elif out.suffix.lower() in (".csv", ".gz"):
         write_csv(rec, out)
     else:
-        raise ValueError(f"{out}: -o must end in .csv, .csv.gz or .mcap")
+        raise InputError(f"{out}: -o must end in .csv, .csv.gz or .mcap")
     err(f"wrote {out}")
     return 0
 

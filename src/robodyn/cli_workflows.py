@@ -17,6 +17,7 @@ import numpy as np
 import robodyn as rd
 from robodyn.output_names import check_stem, output_path
 from robodyn.report.text import err, progress, table
+from robodyn.robot.errors import InputError
 
 __all__ = ["add_parsers"]
 
@@ -44,7 +45,7 @@ def _vector(value: np.ndarray | None, n: int, option: str, default: float = 0.0)
     if value.size == 1:
         return np.full(n, float(value[0]))
     if value.size != n:
-        raise ValueError(f"{option}: expected 1 or {n} comma-separated values (one per joint), "
+        raise InputError(f"{option}: expected 1 or {n} comma-separated values (one per joint), "
                          f"got {value.size}")
     return value
 
@@ -62,12 +63,12 @@ def _controller(args: argparse.Namespace, model: rd.Model, q0: np.ndarray):
     n = model.dof
     if args.controller == "none":
         if args.target is not None:
-            raise ValueError("--target needs a controller (--controller pd|pid|gravity|computed-torque)")
+            raise InputError("--target needs a controller (--controller pd|pid|gravity|computed-torque)")
         return None, None
     target = _vector(args.target, n, "--target") if args.target is not None else q0
     move = args.move_time if args.move_time is not None else 0.5 * args.duration
     if not 0 < move <= args.duration:
-        raise ValueError(f"--move-time: must be in (0, duration = {args.duration:g}] s, got {move:g}")
+        raise InputError(f"--move-time: must be in (0, duration = {args.duration:g}] s, got {move:g}")
     plan = quintic(q0, target, move, dt=args.dt)
     # default gains: a stiff error loop for computed torque (1/s^2, 1/s), moderate PD otherwise
     ct = args.controller == "computed-torque"
@@ -90,15 +91,15 @@ def _check_size(args: argparse.Namespace, n: int) -> None:
     """Refuse, before anything runs, an output above ``--max-samples`` (the CSV size named)."""
     if not (math.isfinite(args.duration) and math.isfinite(args.dt) and args.dt > 0
             and args.duration > 0):
-        raise ValueError(f"--duration and --dt must be positive finite numbers, got "
+        raise InputError(f"--duration and --dt must be positive finite numbers, got "
                          f"{args.duration:g} and {args.dt:g}")
     if args.decimate < 1:
-        raise ValueError(f"--decimate: must be a positive integer, got {args.decimate}")
+        raise InputError(f"--decimate: must be a positive integer, got {args.decimate}")
     samples = math.floor(args.duration / args.dt / args.decimate) + 1
     if args.max_samples and samples > args.max_samples:
         size = samples * (4 * n + 2) * _CSV_VALUE_CHARS
         k = math.ceil(args.duration / args.dt / max(args.max_samples - 1, 1))
-        raise ValueError(
+        raise InputError(
             f"--duration {args.duration:g} s at --dt {args.dt:g} s writes {samples:,} rows (a CSV "
             f"of about {size / 1e6:,.0f} MB), above --max-samples {args.max_samples:,}; keep "
             f"every k-th step with --decimate k (k >= {k:,}), shorten the run, or raise "
@@ -121,7 +122,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         try:
             model = rd.compile_model(robot, backend=args.backend)
         except CompilerNotFoundError as exc:
-            raise ValueError(f"{exc}; rerun with --backend numpy (no compiler needed)") from None
+            raise InputError(f"{exc}; rerun with --backend numpy (no compiler needed)") from None
     controller, plan = _controller(args, model, q0)
     limit = _vector(args.tau_limit, n, "--tau-limit") if args.tau_limit is not None else None
     with progress(f"simulating {args.duration:g} s at dt = {args.dt:g} s ({args.method})"):
@@ -132,7 +133,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
                               substeps=args.substeps)
         except FloatingPointError as exc:
             # the controller's or the integrator's message, as one line and exit 2
-            raise ValueError(str(exc)) from None
+            raise InputError(str(exc)) from None
     names = robot.joint_names
     with csv_path.open("w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
@@ -169,7 +170,7 @@ def _payload(values: np.ndarray | None) -> tuple[float, np.ndarray] | None:
     if values is None:
         return None
     if values.size != 4:
-        raise ValueError(f"--payload: expected 4 numbers (mass in kg, then x, y, z of the centre of "
+        raise InputError(f"--payload: expected 4 numbers (mass in kg, then x, y, z of the centre of "
                          f"mass in the tool frame in m), got {values.size}")
     return float(values[0]), values[1:]
 
@@ -198,7 +199,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     circle = None
     if args.circle:
         if len(args.circle) != robot.dof:
-            raise ValueError(f"--circle: give one file per joint in chain order ({robot.dof} for "
+            raise InputError(f"--circle: give one file per joint in chain order ({robot.dof} for "
                              f"{robot.name}), got {len(args.circle)}")
         circle = [si(read_calibration_csv(path, robot, joint_map=jmap)) for path in args.circle]
     # sigma in the data's length unit (the option is in mm)
@@ -334,7 +335,7 @@ def _cmd_iso9283(args: argparse.Namespace) -> int:
     from robodyn.calibrate.iso9283 import overshoot_from_csv, pose_characteristics_from_csv
 
     if args.data is None and args.approach is None:
-        raise ValueError("give a CSV of repeated poses (DATA) and/or --approach FILE.csv")
+        raise InputError("give a CSV of repeated poses (DATA) and/or --approach FILE.csv")
     if args.data is not None:
         pc = pose_characteristics_from_csv(args.data)
         print(f"ISO 9283 pose accuracy and repeatability, {args.data} ({pc.cycles} cycles)")

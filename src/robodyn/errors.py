@@ -13,6 +13,7 @@ from robodyn.robot.errors import (
     DescriptionError,
     DescriptionWarning,
     IdentificationError,
+    InputError,
     RecordingError,
     RecordingWarning,
     RobodynError,
@@ -23,5 +24,5 @@ from robodyn.robot.errors import (
 )
 
 __all__ = ["DataFileError", "DescriptionError", "DescriptionWarning", "IdentificationError",
-           "RecordingError", "RecordingWarning", "RobodynError", "SimulationError",
+           "InputError", "RecordingError", "RecordingWarning", "RobodynError", "SimulationError",
            "SingularMassMatrixError", "StudyError", "ValidationError"]

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from robodyn.robot.errors import InputError
+
 __all__ = ["MAX_STEM_LENGTH", "check_stem", "output_path"]
 
 #: Longest stem accepted, characters (file systems allow 255 bytes per name, suffixes included).
@@ -48,7 +50,7 @@ def check_stem(stem: str, *, what: str = "--stem") -> str:
     elif len(stem) > MAX_STEM_LENGTH:
         reason = f"it is {len(stem)} characters long (at most {MAX_STEM_LENGTH})"
     if reason is not None:
-        raise ValueError(f"{what} {stem!r} is not a plain file name: {reason}")
+        raise InputError(f"{what} {stem!r} is not a plain file name: {reason}")
     return stem
 
 
@@ -77,5 +79,5 @@ def output_path(directory: str | Path, stem: str, suffix: str, *, what: str = "-
     """
     path = Path(directory) / (check_stem(stem, what=what) + suffix)
     if path.parent != Path(directory) or path.name != stem + suffix:
-        raise ValueError(f"{what} {stem!r} does not name a file inside {directory}")
+        raise InputError(f"{what} {stem!r} does not name a file inside {directory}")
     return path

@@ -116,7 +116,7 @@ def test_cli_sweep_where_every_case_failed_exits_1_with_the_table(tmp_path, caps
     path = _write(tmp_path, SIZING + "parameters:\n  payload: [-50, -60]\n")
     assert main(["sweep", str(path), "--workers", "1", "-o", str(tmp_path / "out")]) == 1
     err = capsys.readouterr().err
-    assert "every case failed (the first: ValueError: payload mass must be >= 0 kg" in err
+    assert "every case failed (the first: InputError: payload mass must be >= 0 kg" in err
     table = pd.read_parquet(tmp_path / "out" / "results.parquet")
     assert len(table) == 2 and table["error"].notna().all()
     failures = pd.read_csv(tmp_path / "out" / "failures.csv", index_col="case")

@@ -29,6 +29,7 @@ from robodyn.calibrate.nominal import (
     hayati_link,
     parallel_links,
 )
+from robodyn.robot.errors import InputError
 
 __all__ = [
     "CircleFit",
@@ -173,10 +174,10 @@ def joint_axis(q: np.ndarray, points: np.ndarray, joint_type: str, name: str = "
     points = np.asarray(points, dtype=float)
     need = 3 if joint_type == "revolute" else 2
     if len(points) < need:
-        raise ValueError(f"{name}: {len(points)} points; circle-point analysis of a {joint_type} joint "
+        raise InputError(f"{name}: {len(points)} points; circle-point analysis of a {joint_type} joint "
                          f"needs at least {need}")
     if not np.ptp(q) > 1e-6:
-        raise ValueError(f"{name}: the joint never moved in its circle-point data set "
+        raise InputError(f"{name}: the joint never moved in its circle-point data set "
                          f"(readings span {np.ptp(q):.3g}); its axis cannot be recovered")
     order = np.argsort(q)
     q, points = q[order], points[order]
@@ -190,7 +191,7 @@ def joint_axis(q: np.ndarray, points: np.ndarray, joint_type: str, name: str = "
         return JointAxis(name, joint_type, c, u, 0.0, rms, float(slope), len(points))
     _, _, _, spread = fit_plane(points)
     if not spread[1] > 1e-6 * spread[0] or not spread[0] > 0:
-        raise ValueError(f"{name}: the measured points are (nearly) collinear, so they fix no circle "
+        raise InputError(f"{name}: the measured points are (nearly) collinear, so they fix no circle "
                          "(the target is on the joint axis, or the arc is too short)")
     circle = fit_circle(points)
     n = circle.normal
@@ -237,7 +238,7 @@ def arc_angles(q: np.ndarray, phi: np.ndarray, tol: float = 0.5) -> np.ndarray:
 
 def _check_scale(name: str, scale: float, unit: str, hint: str = "") -> None:
     if not 0.8 < scale < 1.25:
-        raise ValueError(
+        raise InputError(
             f"{name}: the target moved {scale:.3g} {unit}, not about 1: the data set does not move "
             "this joint alone, the readings have the wrong scale, or the target is too close to "
             f"the axis for its circle to be measured{hint}"
@@ -381,20 +382,20 @@ def circle_point(
     n = geometry.dof
     names, types = geometry.joint_names, geometry.joint_types
     if len(sets) != n:
-        raise ValueError(f"circle-point analysis needs one data set per joint ({n}), got {len(sets)}")
+        raise InputError(f"circle-point analysis needs one data set per joint ({n}), got {len(sets)}")
     checked = []
     for j, item in enumerate(sets):
         if len(item) != 2:
-            raise ValueError(f"circle-point set {j} ({names[j]}): expected (q, points)")
+            raise InputError(f"circle-point set {j} ({names[j]}): expected (q, points)")
         q, pts = (np.asarray(a, dtype=float) for a in item)
         if q.ndim != 2 or q.shape[1] != n or pts.ndim != 2 or pts.shape[1] != 3 or len(q) != len(pts):
-            raise ValueError(f"circle-point set {j} ({names[j]}): q must be (M, {n}) and points (M, 3) "
+            raise InputError(f"circle-point set {j} ({names[j]}): q must be (M, {n}) and points (M, 3) "
                              f"with the same M; got {q.shape} and {pts.shape}")
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(pts))):
-            raise ValueError(f"circle-point set {j} ({names[j]}): NaN or infinite values")
+            raise InputError(f"circle-point set {j} ({names[j]}): NaN or infinite values")
         others = [k for k in range(n) if k != j and np.ptp(q[:, k]) > still]
         if others:
-            raise ValueError(f"circle-point set {j} ({names[j]}) also moves "
+            raise InputError(f"circle-point set {j} ({names[j]}) also moves "
                              f"{', '.join(names[k] for k in others)}; each set must move one joint")
         checked.append((q, pts))
     axes, points, dirs, centres = [], np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))

@@ -29,6 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robodyn.robot.errors import InputError
+
 __all__ = [
     "Observability",
     "Unidentifiable",
@@ -237,10 +239,10 @@ def select_poses(
     """
     big_m, rows, big_l = jac.shape
     if not 0 < count <= big_m:
-        raise ValueError(f"count must be between 1 and the number of candidates ({big_m}), got {count}")
+        raise InputError(f"count must be between 1 and the number of candidates ({big_m}), got {count}")
     key = index.upper()
     if key not in ("O1", "O2", "O3", "O4", "O5"):
-        raise ValueError(f"unknown observability index {index!r}; use O1 to O5")
+        raise InputError(f"unknown observability index {index!r}; use O1 to O5")
     info = np.einsum("mri,mrj->ij", jac, jac)
     eps = 1e-9 * np.trace(info) / big_l / big_m
     a_inv = np.eye(big_l) / eps

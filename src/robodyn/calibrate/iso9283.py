@@ -37,6 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
+from robodyn.robot.errors import InputError
+
 __all__ = [
     "Overshoot",
     "PoseCharacteristics",
@@ -114,11 +116,11 @@ def pose_characteristics(commanded, attained, *, commanded_abc=None, attained_ab
     xc = np.asarray(commanded, dtype=float)
     x = np.asarray(attained, dtype=float)
     if x.ndim != 3 or x.shape[2] != 3 or xc.shape != (x.shape[0], 3):
-        raise ValueError(f"commanded must be (P, 3) and attained (P, n, 3); got {xc.shape} and {x.shape}")
+        raise InputError(f"commanded must be (P, 3) and attained (P, n, 3); got {xc.shape} and {x.shape}")
     if x.shape[1] < 2:
-        raise ValueError("repeatability needs at least 2 cycles per pose")
+        raise InputError("repeatability needs at least 2 cycles per pose")
     if not (np.all(np.isfinite(x)) and np.all(np.isfinite(xc))):
-        raise ValueError("pose data contain NaN or infinite values")
+        raise InputError("pose data contain NaN or infinite values")
     bar = x.mean(axis=1)
     ap_xyz = bar - xc  # AP_x = x_bar - x_c
     ap = np.linalg.norm(ap_xyz, axis=1)
@@ -160,7 +162,7 @@ def cube_points(center, size: float = 0.5, *, fraction: float = 0.1, rotation=No
         Orientation of the cube.
     """
     if not 0.08 <= fraction <= 0.12:
-        raise ValueError(f"ISO 9283 puts P2..P5 at 10 % +- 2 % of the diagonal; got {fraction:.3g}")
+        raise InputError(f"ISO 9283 puts P2..P5 at 10 % +- 2 % of the diagonal; got {fraction:.3g}")
     c = cube_corners(center, size, rotation)
     c1, c2, c7, c8 = c[0], c[1], c[6], c[7]
     p1 = (c1 + c7) / 2
@@ -221,13 +223,13 @@ def overshoot_stabilisation(t, x, *, band: float, attained=None, settle_fraction
     t = np.asarray(t, dtype=float)
     x = np.asarray(x, dtype=float)
     if t.ndim != 1 or x.shape != (len(t), 3) or len(t) < 3:
-        raise ValueError(f"t must be (T,) and x (T, 3) with T >= 3; got {t.shape} and {x.shape}")
+        raise InputError(f"t must be (T,) and x (T, 3) with T >= 3; got {t.shape} and {x.shape}")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(x))):
-        raise ValueError("trajectory contains NaN or infinite values")
+        raise InputError("trajectory contains NaN or infinite values")
     if np.any(np.diff(t) <= 0):
-        raise ValueError("trajectory times must increase")
+        raise InputError("trajectory times must increase")
     if not band > 0:
-        raise ValueError("band must be positive")
+        raise InputError("band must be positive")
     if attained is None:
         k = max(1, int(round(settle_fraction * len(t))))
         xa = x[-k:].mean(axis=0)

@@ -47,6 +47,7 @@ from robodyn.calibrate.nominal import (
     frame_on_line,
     parallel_links,
 )
+from robodyn.robot.errors import InputError
 
 if TYPE_CHECKING:
     from robodyn.calibrate.nongeometric import NonGeometric
@@ -366,7 +367,7 @@ def build_model(
     ErrorModel
     """
     if name not in MODELS:
-        raise ValueError(f"unknown error model {name!r}; choose one of {', '.join(MODELS)}")
+        raise InputError(f"unknown error model {name!r}; choose one of {', '.join(MODELS)}")
     base = np.eye(4) if base is None else np.asarray(base, dtype=float)
     par = parallel_links(geometry.directions, parallel_tol)
     kinds = ["hayati" if (p and name != "dh") else "dh" for p in par]
@@ -420,7 +421,7 @@ def extend_model(model: ErrorModel, offsets: np.ndarray | None = None,
         ``model`` is already extended.
     """
     if model.targets != 1 or model.nongeometric is not None:
-        raise ValueError("extend_model: the model is already extended")
+        raise InputError("extend_model: the model is already extended")
     offsets = np.zeros((0, 3)) if offsets is None else np.asarray(offsets, dtype=float).reshape(-1, 3)
     names, units, values = list(model.names), list(model.units), list(model.initial)
     placement = [k for k in model.priority if names[k].startswith(("base.", "tool."))]

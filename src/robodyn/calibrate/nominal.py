@@ -28,6 +28,7 @@ import numpy as np
 import sympy as sp
 
 from robodyn.calibrate.kinematics import hom, rot, trans
+from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 
 __all__ = [
@@ -109,7 +110,7 @@ def robot_geometry(robot: Robot) -> RobotGeometry:
         axis = numeric(joint.axis, subs).ravel()
         norm = np.linalg.norm(axis)
         if not norm > 0:
-            raise ValueError(f"{robot.source}: joint {joint.name!r} has a zero axis")
+            raise InputError(f"{robot.source}: joint {joint.name!r} has a zero axis")
         post = numeric(joint.post, subs)
         frame = w @ post
         joint_frames.append(w)
@@ -233,7 +234,7 @@ def hayati_link(prev: np.ndarray, point: np.ndarray, u: np.ndarray, x_ref: np.nd
     o, x0, z0 = prev[:3, 3], prev[:3, 0], prev[:3, 2]
     den = u @ z0
     if abs(den) < 0.5:
-        raise ValueError(f"{where}: Hayati's parametrisation needs (nearly) parallel axes; these are "
+        raise InputError(f"{where}: Hayati's parametrisation needs (nearly) parallel axes; these are "
                          f"{np.degrees(np.arccos(np.clip(abs(den), 0, 1))):.1f} degrees apart")
     # the axis meets the plane through o normal to z0 at o_i
     o_i = point + ((o - point) @ z0 / den) * u

@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 
 __all__ = ["DEFLECTIONS", "NONGEOMETRIC", "NonGeometric", "build_nongeometric", "gravity_torque",
@@ -410,16 +411,16 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
     """
     terms = tuple(dict.fromkeys(terms))
     if deflection not in DEFLECTIONS:
-        raise ValueError(f"deflection must be one of {', '.join(DEFLECTIONS)}, got {deflection!r}")
+        raise InputError(f"deflection must be one of {', '.join(DEFLECTIONS)}, got {deflection!r}")
     if deflection == "exact" and identify_payload:
-        raise ValueError("deflection='exact' cannot be combined with identify_payload: the exact "
+        raise InputError("deflection='exact' cannot be combined with identify_payload: the exact "
                          "Jacobian of the identified payload's terms is not implemented; identify the "
                          "payload with deflection='linear', then give it as a known payload")
     unknown = [t for t in terms if t not in NONGEOMETRIC]
     if unknown:
-        raise ValueError(f"unknown non-geometric term {unknown[0]!r}; choose from {', '.join(NONGEOMETRIC)}")
+        raise InputError(f"unknown non-geometric term {unknown[0]!r}; choose from {', '.join(NONGEOMETRIC)}")
     if identify_payload and "compliance" not in terms:
-        raise ValueError("identify_payload needs the 'compliance' term: the payload is seen only "
+        raise InputError("identify_payload needs the 'compliance' term: the payload is seen only "
                          "through the joints' deflection under its weight")
     subs = robot.defaults()
     n = robot.dof
@@ -438,7 +439,7 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
         if payload is not None:
             mass, com = float(payload[0]), np.asarray(payload[1], dtype=float).reshape(3)
             if not mass >= 0:
-                raise ValueError(f"payload mass must be >= 0 kg, got {mass}")
+                raise InputError(f"payload mass must be >= 0 kg, got {mass}")
             load = (mass, com)
         known = None if identify_payload else load
         types = [j.type for j in robot.joints]
@@ -455,7 +456,7 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
                 exact_torque, torque_jacobian = _compiled_gravity(robot, extra)
         else:
             if deflection == "exact":
-                raise ValueError(f"deflection='exact' needs the link masses of {robot.name}: its "
+                raise InputError(f"deflection='exact' needs the link masses of {robot.name}: its "
                                  "description has none, so the compliance torques are a gravity-shaped "
                                  "basis of unknown scale; use deflection='linear'")
             torque = _point_mass_torque(frames, types, gravity, [(k, 1.0) for k in range(1, n + 1)],

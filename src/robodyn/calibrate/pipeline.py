@@ -38,6 +38,7 @@ from robodyn.calibrate.nominal import RobotGeometry, default_frame0, robot_geome
 from robodyn.calibrate.result import Calibration, ErrorStats, Parameter
 from robodyn.calibrate.solve import LOSSES, Fit, fit, rotation_vector
 from robodyn.calibrate.to_robot import calibrated_robot
+from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 
 __all__ = ["calibrate", "check_data", "compensate", "identifiable_parameters", "inverse_kinematics",
@@ -52,12 +53,12 @@ def _array(name: str, value, shape_text: str) -> np.ndarray:
     try:
         a = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a numeric array of shape {shape_text}: {exc}") from None
+        raise InputError(f"{name} must be a numeric array of shape {shape_text}: {exc}") from None
     bad = np.argwhere(~np.isfinite(a))
     if bad.size:
         row = int(bad[0][0])
         col = f", column {int(bad[0][1])}" if bad.shape[1] > 1 else ""
-        raise ValueError(f"{name} has NaN or infinite values ({len(bad)} entries; first at row {row}{col})")
+        raise InputError(f"{name} has NaN or infinite values ({len(bad)} entries; first at row {row}{col})")
     return a
 
 
@@ -76,22 +77,22 @@ def check_data(robot: Robot, q, points, orientations=None, sigma=5e-5,
     q = _array("q", q, f"(N, {n})")
     points = _array("points", points, "(N, 3) or (N, K, 3)")
     if q.ndim != 2 or q.shape[1] != n:
-        raise ValueError(f"q must have shape (N, {n}) for {robot.name}'s {n} joints "
+        raise InputError(f"q must have shape (N, {n}) for {robot.name}'s {n} joints "
                          f"({', '.join(robot.joint_names)}); got {q.shape}")
     if points.ndim not in (2, 3) or points.shape[-1] != 3 or (points.ndim == 3 and points.shape[1] < 1):
-        raise ValueError(f"points must have shape (N, 3) or (N, K, 3) for K targets per pose; "
+        raise InputError(f"points must have shape (N, 3) or (N, K, 3) for K targets per pose; "
                          f"got {points.shape}")
     if len(q) != len(points):
-        raise ValueError(f"mismatched lengths: q has {len(q)} poses but points has {len(points)}")
+        raise InputError(f"mismatched lengths: q has {len(q)} poses but points has {len(points)}")
     if orientations is not None:  # one per pose: the frame of the body that carries the targets
         orientations = _array("orientations", orientations, "(N, 3, 3)")
         if orientations.shape != (len(q), 3, 3):
-            raise ValueError(f"orientations must have shape ({len(q)}, 3, 3); got {orientations.shape}")
+            raise InputError(f"orientations must have shape ({len(q)}, 3, 3); got {orientations.shape}")
         err = np.abs(orientations @ np.swapaxes(orientations, 1, 2) - np.eye(3)).max(axis=(1, 2))
         det = np.linalg.det(orientations)
         bad = np.flatnonzero((err > 1e-6) | (det < 0))
         if bad.size:
-            raise ValueError(f"orientations[{bad[0]}] is not a rotation matrix ({bad.size} such rows)")
+            raise InputError(f"orientations[{bad[0]}] is not a rotation matrix ({bad.size} such rows)")
     s = _array("sigma", sigma, "scalar, (N,), (N, 3) or the shape of points")
     if s.ndim == 1:
         s = s.reshape((-1,) + (1,) * (points.ndim - 1))
@@ -100,10 +101,10 @@ def check_data(robot: Robot, q, points, orientations=None, sigma=5e-5,
     try:
         s = np.broadcast_to(s, points.shape).copy()
     except ValueError:
-        raise ValueError(f"sigma must be a scalar, (N,), (N, 3) or {points.shape} for N = {len(points)}; "
+        raise InputError(f"sigma must be a scalar, (N,), (N, 3) or {points.shape} for N = {len(points)}; "
                          f"got shape {np.shape(sigma)}") from None
     if not np.all(s > 0):
-        raise ValueError("sigma must be positive")
+        raise InputError("sigma must be positive")
     return q, points, orientations, s
 
 
@@ -121,9 +122,9 @@ def convert_units(robot: Robot, q, points, sigma, sigma_rot, length_unit: str, a
         An unknown unit.
     """
     if length_unit not in LENGTH_UNITS:
-        raise ValueError(f"length_unit must be one of {', '.join(LENGTH_UNITS)}, got {length_unit!r}")
+        raise InputError(f"length_unit must be one of {', '.join(LENGTH_UNITS)}, got {length_unit!r}")
     if angle_unit not in ANGLE_UNITS:
-        raise ValueError(f"angle_unit must be one of {', '.join(ANGLE_UNITS)}, got {angle_unit!r}")
+        raise InputError(f"angle_unit must be one of {', '.join(ANGLE_UNITS)}, got {angle_unit!r}")
     if length_unit == "m" and angle_unit == "rad":
         return q, points, sigma, sigma_rot
     lf, af = LENGTH_UNITS[length_unit], ANGLE_UNITS[angle_unit]
@@ -162,7 +163,7 @@ def check_magnitude(geometry: RobotGeometry, q: np.ndarray, points: np.ndarray, 
                 if 300 < ratio < 3000 else
                 "the data look like metres: give length_unit='m'" if 3e-4 < ratio < 3e-3 else
                 "check the units of the points and of the joint readings (deg vs rad)")
-        raise ValueError(f"points contradict length_unit {length_unit!r}: the measured points spread "
+        raise InputError(f"points contradict length_unit {length_unit!r}: the measured points spread "
                          f"{spread_y:.4g} {'units' if length_unit != 'm' else 'm'} (as given, converted: "
                          f"{spread_y:.4g} m) where the nominal model's target spreads {spread_n:.4g} m over "
                          f"the same readings (ratio {ratio:.3g}); {hint}")
@@ -550,7 +551,7 @@ def _check_pose_count(robot: Robot, em: ErrorModel, model: str, unid: Sequence[U
     rows = q.shape[0] * per
     n_struct = em.n_params - sum(u.kind == "structural" for u in unid)
     if rows <= n_struct:
-        raise ValueError(
+        raise InputError(
             f"too few poses: {len(q)} poses give {rows} equations for {n_struct} identifiable "
             f"parameters of the {model} model of {robot.name}; at least {n_struct // per + 1} poses "
             "are needed (several times more for a useful calibration)"
@@ -610,22 +611,22 @@ def _check_options(model: str, loss: str, initial: str, nongeometric: Sequence[s
                    payload: Any, identify_payload: bool, deflection: str, circle_data: Any) -> None:
     """Refuse option values and combinations :func:`calibrate` cannot honour (ValueError)."""
     if model not in MODELS:
-        raise ValueError(f"unknown error model {model!r}; choose one of {', '.join(MODELS)}")
+        raise InputError(f"unknown error model {model!r}; choose one of {', '.join(MODELS)}")
     if loss not in LOSSES:
-        raise ValueError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
+        raise InputError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
     if initial not in ("nominal", "circle-point"):
-        raise ValueError(f"initial must be 'nominal' or 'circle-point', got {initial!r}")
+        raise InputError(f"initial must be 'nominal' or 'circle-point', got {initial!r}")
     if (identify_payload or payload is not None) and "compliance" not in tuple(nongeometric):
-        raise ValueError(f"{'identify_payload' if identify_payload else 'payload'} needs the "
+        raise InputError(f"{'identify_payload' if identify_payload else 'payload'} needs the "
                          "'compliance' term (nongeometric=('compliance', ...)): the payload is seen "
                          "only through the joints' deflection under its weight")
     if deflection not in ("linear", "exact"):
-        raise ValueError(f"deflection must be 'linear' or 'exact', got {deflection!r}")
+        raise InputError(f"deflection must be 'linear' or 'exact', got {deflection!r}")
     if deflection == "exact" and "compliance" not in tuple(nongeometric):
-        raise ValueError("deflection='exact' needs the 'compliance' term (nongeometric=('compliance', "
+        raise InputError("deflection='exact' needs the 'compliance' term (nongeometric=('compliance', "
                          "...)): it changes how the joints deflect under their load")
     if initial == "circle-point" and circle_data is None:
-        raise ValueError("initial='circle-point' needs circle_data: one (q, points) set per joint")
+        raise InputError("initial='circle-point' needs circle_data: one (q, points) set per joint")
 
 
 def _error_model(robot: Robot, geometry: RobotGeometry, model: str, initial: str, circle_data: Any,
@@ -698,7 +699,7 @@ def validate_orientation(calibration: Calibration, q, orientations) -> ErrorStat
         Of the rotation vectors ``log(R_measured R_predicted^T)``: angles in rad.
     """
     if not calibration.model.orientation:
-        raise ValueError("validate_orientation: the calibration was fitted without orientations")
+        raise InputError("validate_orientation: the calibration was fitted without orientations")
     q = np.atleast_2d(np.asarray(q, dtype=float))
     dummy = np.zeros((len(q), 3))
     q, _, orientations, _ = check_data(calibration.robot, q, dummy, orientations)
@@ -745,13 +746,13 @@ def compensate(
     """
     q, pts, _, _ = check_data(calibration.robot, q_seed, points)
     if pts.ndim != 2:
-        raise ValueError(f"compensate: points must have shape (M, 3) (positions of the first target); "
+        raise InputError(f"compensate: points must have shape (M, 3) (positions of the first target); "
                          f"got {pts.shape}")
     if frame == "base":
         b = calibration.base()
         pts = pts @ b[:3, :3].T + b[:3, 3]
     elif frame != "instrument":
-        raise ValueError(f"frame must be 'instrument' or 'base', got {frame!r}")
+        raise InputError(f"frame must be 'instrument' or 'base', got {frame!r}")
     return inverse_kinematics(calibration.model, calibration.params, pts, q, tol=tol, max_iter=max_iter)
 
 
@@ -778,6 +779,6 @@ def inverse_kinematics(model: ErrorModel, params: np.ndarray, points: np.ndarray
     err = np.linalg.norm(points - model.evaluate(params, q, derivatives=False).position[::step], axis=1)
     bad = np.flatnonzero(err >= tol)
     if bad.size:
-        raise ValueError(f"compensate: {bad.size} point(s) not reached (first: index {bad[0]}, "
+        raise InputError(f"compensate: {bad.size} point(s) not reached (first: index {bad[0]}, "
                          f"{err[bad[0]] * 1e3:.3g} mm away); out of reach or a poor seed")
     return q

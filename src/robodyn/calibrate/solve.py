@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robodyn.calibrate.models import ErrorModel
+from robodyn.robot.errors import InputError
 
 __all__ = ["LOSSES", "Fit", "covariance", "fit", "rotation_vector"]
 
@@ -210,7 +211,7 @@ def fit(
     from scipy.optimize import least_squares  # 0.3-0.8 s to import: only when solving
 
     if loss not in LOSSES:
-        raise ValueError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
+        raise InputError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
     weights = np.broadcast_to(1.0 / np.asarray(sigma, dtype=float).reshape(
         (-1, 1) if np.ndim(sigma) == 1 else np.shape(sigma)), points.shape).copy()
     problem = Problem(model, params, free, q, points, weights, orientations,

@@ -29,7 +29,7 @@ from robodyn.codegen.mex import mex_files
 from robodyn.codegen.octave import octave_files
 from robodyn.codegen.python import python_files
 from robodyn.codegen.singular import structural_singularity
-from robodyn.robot.errors import SingularMassMatrixError
+from robodyn.robot.errors import InputError, SingularMassMatrixError
 from robodyn.robot.model import Robot
 
 LANGUAGES = ("c", "python", "octave", "fortran", "julia", "latex", "mex")
@@ -170,10 +170,10 @@ def generate(robot_or_kset: Robot | KernelSet, lang: str, directory: str | Path,
         The files written, in a fixed order.
     """
     if lang not in _WRITERS:
-        raise ValueError(f"unknown language {lang!r}; choose one of {', '.join(LANGUAGES)}")
+        raise InputError(f"unknown language {lang!r}; choose one of {', '.join(LANGUAGES)}")
     if isinstance(robot_or_kset, KernelSet):
         if parameters:
-            raise ValueError("parameters are folded in when kernels are built: pass the Robot, or "
+            raise InputError("parameters are folded in when kernels are built: pass the Robot, or "
                              "build_kernels(robot, parameters) yourself")
         kset = robot_or_kset
     elif isinstance(robot_or_kset, Robot):
@@ -189,7 +189,7 @@ def generate(robot_or_kset: Robot | KernelSet, lang: str, directory: str | Path,
     written = []
     for f in _WRITERS[lang](kset):
         if Path(f.name).name != f.name or f.name in ("", ".", ".."):
-            raise ValueError(f"generated file name {f.name!r} is not a plain file name")
+            raise InputError(f"generated file name {f.name!r} is not a plain file name")
         path = out / f.name
         path.write_text(f.text)
         written.append(path)

@@ -28,6 +28,7 @@ from sympy.printing.fortran import FCodePrinter
 
 from robodyn.codegen.base import GeneratedFile, Printer, identifier
 from robodyn.codegen.kernels import Argument, Kernel, KernelSet
+from robodyn.robot.errors import InputError
 
 #: Longest line written before the printer's own wrapping (Fortran free form allows 132).
 _WIDTH = 100
@@ -180,7 +181,7 @@ class FortranPrinter(Printer):
         names = [f"{self.prefix}{k.name}{suffix}" for k in kset.kernels for suffix in ("", "_batch")]
         too_long = [nm for nm in [mod, *names] if len(nm) > _NAME_LIMIT]
         if too_long:
-            raise ValueError(f"Fortran names are at most {_NAME_LIMIT} characters: {', '.join(too_long)}; "
+            raise InputError(f"Fortran names are at most {_NAME_LIMIT} characters: {', '.join(too_long)}; "
                              "pass a shorter prefix to fortran_files or rename the robot")
         parts = [
             self.header(kset).rstrip(),

@@ -44,6 +44,7 @@ import sympy as sp
 
 from robodyn.codegen import optimize as opt
 from robodyn.hydro.terms import HydroTerms, hydro_terms
+from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 from robodyn.symbolic import crba, forward_mode
 from robodyn.symbolic import newton_euler as ne
@@ -171,7 +172,7 @@ def kernel_signature(name: str, n: int) -> tuple[tuple[tuple[str, int], ...], tu
         "regressor_derivatives": ((q, qd, qdd), (15 * n * n, 3 * n)),
     }
     if name not in table:
-        raise ValueError(f"unknown kernel {name!r}; choose from "
+        raise InputError(f"unknown kernel {name!r}; choose from "
                          f"{', '.join(KERNEL_NAMES + DERIVATIVE_KERNEL_NAMES)}, "
                          "regressor_derivatives")
     return table[name]
@@ -199,11 +200,11 @@ def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
     """
     unknown = [k for k in (*(parameters or {}), *runtime) if k not in robot.parameters]
     if unknown:
-        raise ValueError(f"robot {robot.name!r} has no parameter(s) {', '.join(unknown)}; "
+        raise InputError(f"robot {robot.name!r} has no parameter(s) {', '.join(unknown)}; "
                          f"it has {', '.join(robot.parameters) or 'none'}")
     runtime = tuple(runtime)
     if len(set(runtime)) != len(runtime):
-        raise ValueError(f"runtime parameters named twice: {', '.join(runtime)}")
+        raise InputError(f"runtime parameters named twice: {', '.join(runtime)}")
     merged = {**robot.parameters, **(parameters or {})}
     values = {sp.Symbol(k, real=True): float(v) for k, v in merged.items() if k not in runtime}
     # runtime parameters: renamed (a parameter may share a name with an output array, e.g. g)
@@ -277,7 +278,7 @@ def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
     kernels = []
     for name in names:
         if name not in builders:
-            raise ValueError(f"unknown kernel {name!r}; choose from "
+            raise InputError(f"unknown kernel {name!r}; choose from "
                              f"{', '.join(KERNEL_NAMES + DERIVATIVE_KERNEL_NAMES)}, "
                              "regressor_derivatives")
         summary, ins, out_name, shape, build = builders[name]

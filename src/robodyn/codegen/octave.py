@@ -18,6 +18,7 @@ from sympy.printing.octave import OctaveCodePrinter
 from robodyn.codegen.base import NATURAL, GeneratedFile, Printer, identifier, provenance
 from robodyn.codegen.fortran import float_literal
 from robodyn.codegen.kernels import Argument, Kernel, KernelSet
+from robodyn.robot.errors import InputError
 
 
 class _OctaveExpr(OctaveCodePrinter):
@@ -101,7 +102,7 @@ class OctavePrinter(Printer):
         """One function file per kernel; the provenance header is part of each help text."""
         too_long = [f"{self.prefix}{k}" for k in kset.names if len(f"{self.prefix}{k}") > 63]
         if too_long:
-            raise ValueError(f"MATLAB names are at most 63 characters (namelengthmax): "
+            raise InputError(f"MATLAB names are at most 63 characters (namelengthmax): "
                              f"{', '.join(too_long)}; pass a shorter prefix to octave_files")
         self._provenance = [*provenance(kset, self.language, self.layout),
                             "In this file matrices are indexed naturally, M(i, j, k) (column-major)."]

@@ -15,6 +15,7 @@ from typing import Any
 
 from robodyn.export.mjcf import to_mjcf
 from robodyn.export.urdf import to_urdf
+from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 
 __all__ = ["FORMATS", "export", "to_mjcf", "to_urdf"]
@@ -49,5 +50,5 @@ def export(robot: Robot, format: str, path: str | Path | None = None, **options:
     """
     key = str(format).lower()
     if key not in FORMATS:
-        raise ValueError(f"unknown export format {format!r}; choose one of {', '.join(FORMATS)}")
+        raise InputError(f"unknown export format {format!r}; choose one of {', '.join(FORMATS)}")
     return FORMATS[key](robot, path, **options)

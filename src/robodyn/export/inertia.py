@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robodyn.export import numeric as nm
+from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 
 __all__ = [
@@ -146,7 +147,7 @@ def engine_inertial(mass: float, inertia: np.ndarray, axis: np.ndarray | None) -
         If ``mass`` is negative.
     """
     if mass < 0:
-        raise ValueError(f"negative mass {mass} kg")
+        raise InputError(f"negative mass {mass} kg")
     inertia = np.asarray(inertia, dtype=float)
     inertia = (inertia + inertia.T) / 2
     moments, vectors = np.linalg.eigh(inertia)

@@ -46,7 +46,7 @@ from lxml import etree
 from robodyn.export import numeric as nm
 from robodyn.export.inertia import engine_inertial, rotation_axes
 from robodyn.robot.chain import with_parameters
-from robodyn.robot.errors import DescriptionWarning
+from robodyn.robot.errors import DescriptionWarning, InputError
 from robodyn.robot.model import Friction, Joint, Link, Robot
 
 __all__ = ["INTEGRATORS", "mjcf_robot", "to_mjcf"]
@@ -136,13 +136,13 @@ def to_mjcf(
         joint-space dynamics, naming the joints or links.
     """
     if integrator not in INTEGRATORS:
-        raise ValueError(f"unknown integrator {integrator!r}; choose one of {', '.join(INTEGRATORS)}")
+        raise InputError(f"unknown integrator {integrator!r}; choose one of {', '.join(INTEGRATORS)}")
     try:
         step = float(timestep)
     except (TypeError, ValueError):
-        raise ValueError(f"timestep must be a positive number of seconds, got {timestep!r}") from None
+        raise InputError(f"timestep must be a positive number of seconds, got {timestep!r}") from None
     if not (math.isfinite(step) and step > 0):
-        raise ValueError(f"timestep must be a positive number of seconds, got {timestep!r}")
+        raise InputError(f"timestep must be a positive number of seconds, got {timestep!r}")
     model, notes = _prepare(robot, parameters)
     values = nm.values_of(model)
     root = etree.Element("mujoco", model=robot.name)
@@ -236,7 +236,7 @@ def _link(link: Link, axis: np.ndarray | None, values: nm.Values, where: str,
     """The link with a mass and inertia MuJoCo accepts, and without hydro data."""
     mass = nm.number(link.mass, values, f"{where}.mass")
     if mass < 0:
-        raise ValueError(f"{where}.mass: negative mass {nm.text(mass)} kg")
+        raise InputError(f"{where}.mass: negative mass {nm.text(mass)} kg")
     fixed = engine_inertial(mass, nm.array(link.inertia, values, f"{where}.inertia"), axis)
     if link.hydro:
         dropped.setdefault("hydro", []).append(link.name)

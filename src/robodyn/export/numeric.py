@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
+from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 from robodyn.robot.yaml_writer import matrix_to_rpy
 
@@ -69,7 +70,7 @@ def values_of(robot: Robot, parameters: Mapping[str, float] | None = None) -> Va
     unknown = sorted(set(given) - set(robot.parameters))
     if unknown:
         declared = ", ".join(robot.parameters) or "none"
-        raise ValueError(
+        raise InputError(
             f"{robot.source}: unknown parameter(s) {unknown} for robot {robot.name!r} "
             f"(declared: {declared})"
         )
@@ -78,9 +79,9 @@ def values_of(robot: Robot, parameters: Mapping[str, float] | None = None) -> Va
         try:
             value = float(default)
         except (TypeError, ValueError):
-            raise ValueError(f"{robot.source}: parameter {name!r}: {default!r} is not a number") from None
+            raise InputError(f"{robot.source}: parameter {name!r}: {default!r} is not a number") from None
         if not math.isfinite(value):
-            raise ValueError(f"{robot.source}: parameter {name!r}: {value} is not finite")
+            raise InputError(f"{robot.source}: parameter {name!r}: {value} is not finite")
         out[sp.Symbol(name, real=True)] = sp.Float(value)
     return out
 
@@ -116,9 +117,9 @@ def exact(value: sp.Expr | sp.MatrixBase, values: Values, where: str) -> sp.Expr
     for e in entries:
         if e.free_symbols:
             names = ", ".join(sorted(str(s) for s in e.free_symbols))
-            raise ValueError(f"{where}: {e} depends on {names}, which is not a declared parameter")
+            raise InputError(f"{where}: {e} depends on {names}, which is not a declared parameter")
         if not (e.is_real and e.is_finite):
-            raise ValueError(f"{where}: value {e} is not a finite real number")
+            raise InputError(f"{where}: value {e} is not a finite real number")
     return out
 
 
@@ -136,7 +137,7 @@ def text(x: float) -> str:
     """``repr`` of a double (``-0.0`` written as ``0.0``); reads back as the same double."""
     x = float(x)
     if not math.isfinite(x):
-        raise ValueError(f"cannot write the non-finite number {x}")
+        raise InputError(f"cannot write the non-finite number {x}")
     return repr(x + 0.0)
 
 
@@ -175,9 +176,9 @@ def check_names(robot: Robot) -> None:
         seen: set[str] = set()
         for name in names:
             if not name or not name.strip():
-                raise ValueError(f"{robot.source}: robot {robot.name!r} has a {kind} with an empty name")
+                raise InputError(f"{robot.source}: robot {robot.name!r} has a {kind} with an empty name")
             if name in seen:
-                raise ValueError(
+                raise InputError(
                     f"{robot.source}: robot {robot.name!r} has two {kind}s named {name!r}; "
                     "the export formats need unique names"
                 )

@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from robodyn.robot.errors import InputError
+
 __all__ = ["DEFAULT_POINTS", "gauss_legendre"]
 
 #: Quadrature points per cylinder when the hydro block does not set ``quadrature``.
@@ -40,7 +42,7 @@ def gauss_legendre(n: int, length: sp.Expr) -> list[tuple[sp.Expr, sp.Expr]]:
         Nodes xi (m) and weights w (m), ``sum(w) == L``; Float multiples of ``L``.
     """
     if n < 1:
-        raise ValueError(f"quadrature needs at least one point, got {n}")
+        raise InputError(f"quadrature needs at least one point, got {n}")
     x, w = np.polynomial.legendre.leggauss(n)
     # xi = L (x + 1) / 2,  w_xi = L w / 2
     return [(length * sp.Float((xk + 1) / 2, 17), length * sp.Float(wk / 2, 17))

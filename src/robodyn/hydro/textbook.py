@@ -42,6 +42,7 @@ from robodyn.hydro.added_mass import added_mass_matrix, current_energy_terms, cu
 from robodyn.hydro.geometry import CylinderMotion, cylinder_motion
 from robodyn.hydro.quadrature import gauss_legendre
 from robodyn.hydro.schema import fluid_of, hydro_of
+from robodyn.robot.errors import InputError
 from robodyn.symbolic.coriolis import christoffel_coriolis
 
 if TYPE_CHECKING:
@@ -210,7 +211,7 @@ def underwater_textbook(eom: EquationsOfMotion) -> UnderwaterTextbook:
     """
     hydro = eom.hydro
     if hydro is None:
-        raise ValueError(f"{eom.robot.name}: no fluid block, so no hydrodynamic terms to print")
+        raise InputError(f"{eom.robot.name}: no fluid block, so no hydrodynamic terms to print")
     robot, n = eom.robot, eom.dof
     q, qd = list(eom.q), list(eom.qd)
     fluid = fluid_of(robot)

@@ -18,6 +18,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from robodyn.numeric.model import Model
+from robodyn.robot.errors import InputError
 
 __all__ = ["CHUNK", "identification_matrix"]
 
@@ -51,7 +52,7 @@ def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.n
     if columns is None:
         # (N, n, 15 n) C-order is (N n, 15 n): a view, not a copy
         if out is not None and out.shape != (count * n, 15 * n):
-            raise ValueError(f"identification_matrix(out=...): expected shape {(count * n, 15 * n)}, "
+            raise InputError(f"identification_matrix(out=...): expected shape {(count * n, 15 * n)}, "
                              f"got {out.shape}")
         return model.regressor(q, qd, qdd, threads=threads, out=out).reshape(count * n, -1)
     cols = np.asarray(columns, dtype=int)
@@ -59,7 +60,7 @@ def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.n
         out = np.empty((count * n, cols.size))
     elif (not isinstance(out, np.ndarray) or out.shape != (count * n, cols.size)
           or out.dtype != np.float64 or not out.flags.writeable):
-        raise ValueError(f"identification_matrix(out=...): expected a writeable float64 array of "
+        raise InputError(f"identification_matrix(out=...): expected a writeable float64 array of "
                          f"shape {(count * n, cols.size)}, got "
                          f"{getattr(out, 'shape', type(out).__name__)}")
     for start in range(0, count, CHUNK):

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from robodyn.robot.errors import InputError
+
 __all__ = ["counts_to_angle", "current_to_torque", "estimate_period", "unwrap_counter",
            "volts_to_current"]
 
@@ -117,7 +119,7 @@ def estimate_period(q: np.ndarray, qd: np.ndarray) -> float:
     ok = np.isfinite(dq) & np.isfinite(vbar)
     dq, vbar = dq[ok], vbar[ok]
     if not np.any(vbar != 0.0):
-        raise ValueError("cannot estimate the sample period: the measured velocity is zero throughout")
+        raise InputError("cannot estimate the sample period: the measured velocity is zero throughout")
     clear = np.abs(vbar) >= 0.1 * np.max(np.abs(vbar))
     ratio = dq[clear] / vbar[clear]
     t0 = float(np.median(ratio))

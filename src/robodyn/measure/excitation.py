@@ -58,6 +58,7 @@ from scipy.interpolate import BPoly, PPoly
 from scipy.optimize import minimize
 
 from robodyn.numeric.model import Model, compile_model
+from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 from robodyn.robot.sizes import time_grid_steps
 from robodyn.simulate.trajectory import JointTrajectory
@@ -135,7 +136,7 @@ def excitation_limits(robot: Robot, *, lower: Sequence[float] | None = None,
     """
     n = robot.dof
     if not 0.0 <= margin < 0.5:
-        raise ValueError(f"excitation_limits: margin must be in [0, 0.5), got {margin!r}")
+        raise InputError(f"excitation_limits: margin must be in [0, 0.5), got {margin!r}")
     lo = np.array([-DEFAULT_RANGE if j.lower is None else float(j.lower) for j in robot.joints])
     hi = np.array([DEFAULT_RANGE if j.upper is None else float(j.upper) for j in robot.joints])
     span = hi - lo
@@ -146,7 +147,7 @@ def excitation_limits(robot: Robot, *, lower: Sequence[float] | None = None,
         hi = _finite_vector(upper, n, "upper")
     if np.any(hi <= lo):
         bad = int(np.argmax(hi <= lo))
-        raise ValueError(f"excitation_limits: joint {robot.joint_names[bad]!r}: upper limit "
+        raise InputError(f"excitation_limits: joint {robot.joint_names[bad]!r}: upper limit "
                          f"{hi[bad]:g} is not above lower limit {lo[bad]:g}")
     vel = np.array([DEFAULT_VELOCITY if j.velocity_limit is None
                     else (1.0 - margin) * float(j.velocity_limit) for j in robot.joints])
@@ -533,28 +534,28 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
     model = robot if isinstance(robot, Model) else compile_model(robot)
     n = model.dof
     if not isinstance(harmonics, int | np.integer) or harmonics < 3:
-        raise ValueError(f"excitation: harmonics must be an integer >= 3, got {harmonics!r}")
+        raise InputError(f"excitation: harmonics must be an integer >= 3, got {harmonics!r}")
     f = float(base_frequency)
     if not np.isfinite(f) or f <= 0:
-        raise ValueError(f"excitation: base_frequency must be a positive number of Hz, "
+        raise InputError(f"excitation: base_frequency must be a positive number of Hz, "
                          f"got {base_frequency!r}")
     period = 1.0 / f
     total = period if duration is None else float(duration)
     periods = total / period
     if not np.isfinite(periods) or periods < 1 - 1e-9 or abs(periods - round(periods)) > 1e-6:
-        raise ValueError(f"excitation: duration {duration!r} s must be a whole number of periods "
+        raise InputError(f"excitation: duration {duration!r} s must be a whole number of periods "
                          f"(1 / base_frequency = {period:g} s)")
     time_grid_steps(total, dt, "excitation", duration_name="duration (whole periods)")
     if criterion not in ("cond", "logdet"):
-        raise ValueError(f"excitation: unknown criterion {criterion!r}; choose 'cond' or 'logdet'")
+        raise InputError(f"excitation: unknown criterion {criterion!r}; choose 'cond' or 'logdet'")
     if starts < 1:
-        raise ValueError(f"excitation: starts must be >= 1, got {starts!r}")
+        raise InputError(f"excitation: starts must be >= 1, got {starts!r}")
     if gradient not in ("analytic", "finite_difference"):
-        raise ValueError(f"excitation: unknown gradient {gradient!r}; choose 'analytic' or "
+        raise InputError(f"excitation: unknown gradient {gradient!r}; choose 'analytic' or "
                          "'finite_difference'")
     lim = excitation_limits(model.robot) if limits is None else limits
     if lim.dof != n:
-        raise ValueError(f"excitation: limits are for {lim.dof} joints, the robot has {n}")
+        raise InputError(f"excitation: limits are for {lim.dof} joints, the robot has {n}")
     rng = np.random.default_rng(seed)
     cols = base_columns(model, rng) if columns is None else tuple(int(c) for c in columns)
     k = int(design_samples or 20 * harmonics)
@@ -748,7 +749,7 @@ def _frozen(a: np.ndarray) -> np.ndarray:
 def _finite_vector(v: Sequence[float], n: int, name: str) -> np.ndarray:
     arr = np.asarray(v, dtype=float)
     if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-        raise ValueError(f"excitation_limits: {name} must be a finite ({n},) array, got {v!r}")
+        raise InputError(f"excitation_limits: {name} must be a finite ({n},) array, got {v!r}")
     return arr
 
 
@@ -757,7 +758,7 @@ def _positive_vector(v: float | Sequence[float], n: int, name: str) -> np.ndarra
     if arr.ndim == 0:
         arr = np.full(n, float(arr))
     if arr.shape != (n,) or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-        raise ValueError(f"excitation_limits: {name} must be positive: a scalar or a ({n},) array, got {v!r}")
+        raise InputError(f"excitation_limits: {name} must be positive: a scalar or a ({n},) array, got {v!r}")
     return arr
 
 

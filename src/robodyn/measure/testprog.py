@@ -30,6 +30,7 @@ import numpy as np
 from robodyn.calibrate.iso9283 import cube_points
 from robodyn.measure.excitation import excitation_limits, write_trajectory_csv
 from robodyn.numeric.model import Model, compile_model
+from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 from robodyn.simulate.ik import UnreachableError, inverse_kinematics
 from robodyn.simulate.trajectory import JointTrajectory, concatenate, trapezoidal
@@ -146,7 +147,7 @@ def _vector(v: float | Sequence[float] | None, default: np.ndarray, name: str) -
     if arr.ndim == 0:
         arr = np.full(default.shape, float(arr))
     if arr.shape != default.shape or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-        raise ValueError(f"{name} must be positive: a scalar or a {default.shape} array, got {v!r}")
+        raise InputError(f"{name} must be positive: a scalar or a {default.shape} array, got {v!r}")
     return arr
 
 
@@ -159,7 +160,7 @@ MAX_CYCLES = 10_000
 def _speeds(speeds: Sequence[float]) -> tuple[float, ...]:
     out = tuple(float(s) for s in speeds)
     if not out or any(not (MIN_SPEED <= s <= 1.0) for s in out):
-        raise ValueError(f"speeds must be fractions in [{MIN_SPEED:g}, 1] of the velocity limit, "
+        raise InputError(f"speeds must be fractions in [{MIN_SPEED:g}, 1] of the velocity limit, "
                          f"got {speeds!r}")
     return out
 
@@ -210,13 +211,13 @@ def jointwise(robot: Robot | Model, *, speeds: Sequence[float] = (0.5, 1.0), str
     acc = _vector(acceleration, lim.acceleration, "acceleration")
     fracs = _speeds(speeds)
     if not np.isfinite(stroke) or stroke <= 0:
-        raise ValueError(f"jointwise: stroke must be a positive angle (rad), got {stroke!r}")
+        raise InputError(f"jointwise: stroke must be a positive angle (rad), got {stroke!r}")
     if dwell < 0:
-        raise ValueError(f"jointwise: dwell must be >= 0 s, got {dwell!r}")
+        raise InputError(f"jointwise: dwell must be >= 0 s, got {dwell!r}")
     has = np.array([j.lower is not None and j.upper is not None for j in rob.joints])
     q_home = np.where(has, 0.5 * (lim.lower + lim.upper), 0.0) if home is None else np.asarray(home, float)
     if q_home.shape != (n,) or np.any(q_home < lim.lower) or np.any(q_home > lim.upper):
-        raise ValueError(f"jointwise: home must be a ({n},) array within the joint limits, got {home!r}")
+        raise InputError(f"jointwise: home must be a ({n},) array within the joint limits, got {home!r}")
     names = rob.joint_names
     order = list(range(n)) if joints is None else [_joint_index(names, j) for j in joints]
     parts: list[JointTrajectory] = []
@@ -325,14 +326,14 @@ def iso_cube(robot: Robot | Model, *, size: float = 0.5, center: Sequence[float]
     acc = _vector(acceleration, lim.acceleration, "acceleration")
     (s,) = _speeds([speed])
     if isinstance(cycles, bool) or not isinstance(cycles, int) or not 1 <= cycles <= MAX_CYCLES:
-        raise ValueError(f"iso_cube: cycles must be an integer in [1, {MAX_CYCLES}] (ISO 9283 "
+        raise InputError(f"iso_cube: cycles must be an integer in [1, {MAX_CYCLES}] (ISO 9283 "
                          f"uses 30), got {cycles!r}")
     if dwell < 0:
-        raise ValueError(f"iso_cube: dwell must be >= 0 s, got {dwell!r}")
+        raise InputError(f"iso_cube: dwell must be >= 0 s, got {dwell!r}")
     has = np.array([j.lower is not None and j.upper is not None for j in rob.joints])
     q_home = np.where(has, 0.5 * (lim.lower + lim.upper), 0.0) if home is None else np.asarray(home, float)
     if q_home.shape != (n,):
-        raise ValueError(f"iso_cube: home must have shape ({n},), got {q_home.shape}")
+        raise InputError(f"iso_cube: home must have shape ({n},), got {q_home.shape}")
     c = default_cube_center(model) if center is None else np.asarray(center, dtype=float)
     points = cube_points(c, size, fraction=fraction, rotation=rotation)
     poses = np.empty((5, n))
@@ -364,7 +365,7 @@ def iso_cube(robot: Robot | Model, *, size: float = 0.5, center: Sequence[float]
 
 def _joint_index(names: tuple[str, ...], name: str) -> int:
     if name not in names:
-        raise ValueError(f"unknown joint {name!r}; the robot's joints are {', '.join(names)}")
+        raise InputError(f"unknown joint {name!r}; the robot's joints are {', '.join(names)}")
     return names.index(name)
 
 

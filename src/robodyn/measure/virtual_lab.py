@@ -33,6 +33,7 @@ from robodyn.measure.excitation import Excitation
 from robodyn.measure.recording import Recording
 from robodyn.measure.testprog import TestProgram
 from robodyn.numeric.model import Model, compile_model
+from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 from robodyn.simulate.controllers import ComputedTorque, Controller
 from robodyn.simulate.simulation import simulate
@@ -81,14 +82,14 @@ class Sensors:
     def __post_init__(self) -> None:
         for name in ("sample_period",):
             if not getattr(self, name) > 0:
-                raise ValueError(f"Sensors.{name} must be > 0, got {getattr(self, name)!r}")
+                raise InputError(f"Sensors.{name} must be > 0, got {getattr(self, name)!r}")
         for name in ("jitter", "counts_per_rev", "current_noise", "current_offset",
                      "torque_constant_error", "tracker_noise", "tracker_latency", "tracker_period"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v >= 0):
-                raise ValueError(f"Sensors.{name} must be a finite number >= 0, got {v!r}")
+                raise InputError(f"Sensors.{name} must be a finite number >= 0, got {v!r}")
         if self.torque_noise is not None and not (np.isfinite(self.torque_noise) and self.torque_noise >= 0):
-            raise ValueError(f"Sensors.torque_noise must be >= 0 or None, got {self.torque_noise!r}")
+            raise InputError(f"Sensors.torque_noise must be >= 0 or None, got {self.torque_noise!r}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -192,7 +193,7 @@ def virtual_lab(robot: Robot | Model, trajectory: JointTrajectory | TestProgram 
     ref = _reference(trajectory)
     n = model.dof
     if ref.dof != n:
-        raise ValueError(f"virtual_lab: the trajectory has {ref.dof} joints, robot "
+        raise InputError(f"virtual_lab: the trajectory has {ref.dof} joints, robot "
                          f"{model.robot.name!r} has {n}")
     rng = np.random.default_rng(seed)
     dt = sens.sample_period

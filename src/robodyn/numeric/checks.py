@@ -8,7 +8,7 @@ import numpy as np
 
 from robodyn.codegen.kernels import KernelSet
 from robodyn.codegen.singular import structural_singularity, without_infinities
-from robodyn.robot.errors import SingularMassMatrixError
+from robodyn.robot.errors import InputError, SingularMassMatrixError
 from robodyn.robot.model import Robot
 
 __all__ = ["check_structure", "out_buffer", "structural_singularity", "without_infinities"]
@@ -19,15 +19,15 @@ def out_buffer(out: np.ndarray, shape: tuple[int, ...], inputs: Sequence[np.ndar
     """``out`` as a view of ``shape``, checked: float64, C-contiguous, writeable, right size."""
     if not isinstance(out, np.ndarray) or out.dtype != np.float64 or not out.flags.c_contiguous \
             or not out.flags.writeable:
-        raise ValueError(f"{name}(out=...): expected a writeable C-contiguous float64 NumPy array, "
+        raise InputError(f"{name}(out=...): expected a writeable C-contiguous float64 NumPy array, "
                          f"got {type(out).__name__}"
                          + (f" of dtype {out.dtype}" if isinstance(out, np.ndarray) else ""))
     size = int(np.prod(shape))
     if out.size != size:
-        raise ValueError(f"{name}(out=...): the result has shape {shape} ({size} values), out has "
+        raise InputError(f"{name}(out=...): the result has shape {shape} ({size} values), out has "
                          f"shape {out.shape} ({out.size} values)")
     if any(np.shares_memory(out, a) for a in inputs):
-        raise ValueError(f"{name}(out=...): out overlaps an input array")
+        raise InputError(f"{name}(out=...): out overlaps an input array")
     return out.reshape(shape)
 
 

@@ -13,6 +13,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import sympy as sp
 
+from robodyn.robot.errors import InputError
 from robodyn.robot.expressions import parameter_symbol
 from robodyn.robot.model import Robot
 from robodyn.robot.overrides import checked_parameter_values
@@ -42,21 +43,21 @@ def runtime_names(robot: Robot, runtime: bool | Sequence[str]) -> tuple[str, ...
         return ()
     if runtime is True:
         if not robot.parameters:
-            raise ValueError(f"compile_model(runtime_parameters=True): robot {robot.name!r} "
+            raise InputError(f"compile_model(runtime_parameters=True): robot {robot.name!r} "
                              f"({robot.source}) declares no named parameters (a 'parameters:' "
                              "block); nothing can stay a runtime input")
         return tuple(robot.parameters)
     if isinstance(runtime, str):
-        raise ValueError("compile_model(runtime_parameters=...): give a sequence of names or True, "
+        raise InputError("compile_model(runtime_parameters=...): give a sequence of names or True, "
                          f"not the string {runtime!r}")
     names = tuple(runtime)
     unknown = [k for k in names if k not in robot.parameters]
     if unknown:
-        raise ValueError(f"compile_model(runtime_parameters=...): robot {robot.name!r} has no "
+        raise InputError(f"compile_model(runtime_parameters=...): robot {robot.name!r} has no "
                          f"parameter(s) {', '.join(map(repr, unknown))}; it has "
                          f"{', '.join(robot.parameters) or 'none'}")
     if len(set(names)) != len(names):
-        raise ValueError(f"compile_model(runtime_parameters=...): a name is repeated in {names}")
+        raise InputError(f"compile_model(runtime_parameters=...): a name is repeated in {names}")
     return names
 
 
@@ -98,23 +99,23 @@ def parameter_array(names: tuple[str, ...], defaults: Mapping[str, float], value
         try:
             rows = np.array(value, dtype=np.float64)
         except (TypeError, ValueError) as exc:
-            raise ValueError(f"{where}: expected a mapping of parameter values, a sequence of "
+            raise InputError(f"{where}: expected a mapping of parameter values, a sequence of "
                              f"them, or an array of shape ({count},) or (N, {count}) in the order "
                              f"{', '.join(names)}: {exc}") from None
         if rows.ndim not in (1, 2) or rows.shape[-1] != count:
-            raise ValueError(f"{where}: an array of parameter values must have shape ({count},) "
+            raise InputError(f"{where}: an array of parameter values must have shape ({count},) "
                              f"or (N, {count}) (columns {', '.join(names)}), got {rows.shape}")
     if rows.ndim == 2:
         if not batch:
-            raise ValueError(f"{where}: {rows.shape[0]} parameter sets for one state; give one "
+            raise InputError(f"{where}: {rows.shape[0]} parameter sets for one state; give one "
                              "set, or a batch of states")
         if rows.shape[0] != batch[0]:
-            raise ValueError(f"{where}: {rows.shape[0]} parameter sets for a batch of {batch[0]} "
+            raise InputError(f"{where}: {rows.shape[0]} parameter sets for a batch of {batch[0]} "
                              "states; give one set, or one per state")
     bad = np.argwhere(~np.isfinite(np.atleast_2d(rows)))
     if bad.size:
         i, j = (int(v) for v in bad[0])
-        raise ValueError(f"{where}: parameter {names[j]!r} is not finite "
+        raise InputError(f"{where}: parameter {names[j]!r} is not finite "
                          f"({np.atleast_2d(rows)[i, j]}) in row {i}")
     if batch and rows.ndim == 1:
         rows = np.broadcast_to(rows, (*batch, count))
@@ -204,7 +205,7 @@ def _row(names: tuple[str, ...], base: np.ndarray, value: Mapping[str, object],
     """Defaults overridden by a mapping of runtime parameter values."""
     unknown = [k for k in value if k not in names]
     if unknown:
-        raise ValueError(f"{where}: {', '.join(map(repr, unknown))} is not a runtime parameter of "
+        raise InputError(f"{where}: {', '.join(map(repr, unknown))} is not a runtime parameter of "
                          f"this model (runtime: {', '.join(names)}); compile it with "
                          "runtime_parameters naming it, or compile_model(parameters=...) for a "
                          "fixed value")
@@ -213,5 +214,5 @@ def _row(names: tuple[str, ...], base: np.ndarray, value: Mapping[str, object],
         try:
             row[names.index(k)] = float(v)  # type: ignore[arg-type]
         except (TypeError, ValueError):
-            raise ValueError(f"{where}: parameter {k!r} must be a number, got {v!r}") from None
+            raise InputError(f"{where}: parameter {k!r} must be a number, got {v!r}") from None
     return row

@@ -20,6 +20,7 @@ import jinja2
 from markupsafe import Markup
 
 from robodyn.report.text import is_number
+from robodyn.robot.errors import InputError
 
 __all__ = ["CSS", "data_uri", "figure", "html_table", "page", "render"]
 
@@ -79,7 +80,7 @@ def data_uri(path: str | Path) -> str:
     path = Path(path)
     media = _MEDIA_TYPES.get(path.suffix.lower())
     if media is None:
-        raise ValueError(f"{path}: cannot embed a {path.suffix or 'suffix-less'} file as an image "
+        raise InputError(f"{path}: cannot embed a {path.suffix or 'suffix-less'} file as an image "
                          f"(known: {', '.join(sorted(_MEDIA_TYPES))})")
     return f"data:{media};base64,{base64.b64encode(path.read_bytes()).decode('ascii')}"
 

@@ -16,6 +16,7 @@ from typing import Any
 import sympy as sp
 
 from robodyn import spatial as S
+from robodyn.robot.errors import InputError
 from robodyn.robot.model import IDENTITY4, Joint, Link, Robot
 
 
@@ -115,7 +116,7 @@ def assemble(
         links.append(el.link)
         pending = sp.ImmutableMatrix(sp.eye(4))
     if not joints:
-        raise ValueError(f"{source}: robot {name!r} has no moving joint")
+        raise InputError(f"{source}: robot {name!r} has no moving joint")
     kwargs: dict[str, Any] = {}
     if gravity is not None:
         kwargs["gravity"] = gravity

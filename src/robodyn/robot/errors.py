@@ -10,6 +10,7 @@ __all__ = [
     "DescriptionError",
     "DescriptionWarning",
     "IdentificationError",
+    "InputError",
     "SimulationError",
     "SingularMassMatrixError",
     "StudyError",
@@ -21,6 +22,14 @@ class RobodynError(Exception):
     """Base of every error robodyn raises about its input: catch this to handle them all.
 
     Each subclass is also a :class:`ValueError` (bad input), as before.
+    """
+
+
+class InputError(RobodynError, ValueError):
+    """An argument a robodyn function cannot use (a shape, a range, an unknown name or option).
+
+    The message names the argument and the reason. The command line reports it as bad input
+    (exit 2); anything that is not a :class:`RobodynError` is a bug (exit 1).
     """
 
 

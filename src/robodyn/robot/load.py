@@ -13,7 +13,7 @@ from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
 
-from robodyn.robot.errors import DescriptionError, DescriptionWarning
+from robodyn.robot.errors import DescriptionError, DescriptionWarning, InputError
 from robodyn.robot.model import Robot
 
 __all__ = ["ALIASES", "KNOWN_PROPERTIES", "builtin_names", "load"]
@@ -97,7 +97,7 @@ def load(source: str | Path, *, strict: bool = False, tool: str | None = None) -
         from robodyn.robot import urdf  # yourdfpy and trimesh: only for URDF files
 
         return urdf.load_urdf(path, strict=strict, tool=tool)
-    raise ValueError(f"{path}: unknown description format {suffix!r} (expected .yaml, .yml or .urdf)")
+    raise InputError(f"{path}: unknown description format {suffix!r} (expected .yaml, .yml or .urdf)")
 
 
 def _load_builtin(name: str, *, strict: bool) -> Robot:

@@ -28,6 +28,8 @@ from typing import Any, Literal
 
 import sympy as sp
 
+from robodyn.robot.errors import InputError
+
 JointType = Literal["revolute", "prismatic"]
 
 #: The identity transform, shared.
@@ -205,7 +207,7 @@ class Robot:
 
     def __post_init__(self) -> None:
         if len(self.joints) != len(self.links):
-            raise ValueError(
+            raise InputError(
                 f"{self.source}: robot {self.name!r} has {len(self.joints)} joints but "
                 f"{len(self.links)} links; every joint moves exactly one link"
             )

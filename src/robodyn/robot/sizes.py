@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 import os
 
+from robodyn.robot.errors import InputError
+
 __all__ = ["MAX_GRID_SAMPLES", "env_limit", "max_grid_samples", "time_grid_steps"]
 
 #: Default largest time grid, samples (``$ROBODYN_MAX_GRID_SAMPLES`` raises it): 10^7 samples of a
@@ -30,7 +32,7 @@ def env_limit(name: str, default: int, scale: int = 1) -> int:
         value = -1
     if not 0 < value < float("inf"):
         kind = "a positive integer" if scale == 1 else "a positive number"
-        raise ValueError(f"{name}={text!r}: expected {kind}")
+        raise InputError(f"{name}={text!r}: expected {kind}")
     return int(value * scale)
 
 
@@ -64,11 +66,11 @@ def time_grid_steps(duration: float, dt: float, where: str, *, duration_name: st
     for name, value in ((duration_name, duration), (dt_name, dt)):
         if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) \
                 or value <= 0:
-            raise ValueError(f"{where}: {name} must be a positive number of seconds, got {value!r}")
+            raise InputError(f"{where}: {name} must be a positive number of seconds, got {value!r}")
     steps = duration / dt
     limit = max_grid_samples()
     if steps + 1 > limit:
-        raise ValueError(f"{where}: {duration_name} {duration:g} s at {dt_name} {dt:g} s is "
+        raise InputError(f"{where}: {duration_name} {duration:g} s at {dt_name} {dt:g} s is "
                          f"{steps + 1:.3g} samples, more than {limit:g} (a larger {dt_name} or a "
                          "shorter run; or set ROBODYN_MAX_GRID_SAMPLES)")
     return int(round(steps))

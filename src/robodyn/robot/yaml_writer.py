@@ -40,7 +40,7 @@ import yaml
 from sympy.printing.str import StrPrinter
 
 from robodyn import spatial as S
-from robodyn.robot.errors import DescriptionError
+from robodyn.robot.errors import DescriptionError, InputError
 from robodyn.robot.expressions import parse_value
 from robodyn.robot.model import IDENTITY4, Joint, Link, Robot
 
@@ -126,7 +126,7 @@ def _is_identity(t: sp.MatrixBase) -> bool:
 def _moved_link(link: Link, post: sp.MatrixBase, joint: Joint) -> Link:
     """``link``'s inertial data re-expressed in the frame before ``post``."""
     if link.hydro:
-        raise ValueError(
+        raise InputError(
             f"link {link.name!r} has hydro data, given in its own frame, but joint "
             f"{joint.name!r} has a post transform that the origin form moves that frame by; "
             "such a robot cannot be written as a robodyn YAML description yet"
@@ -229,17 +229,17 @@ class _Scalars:
             return str(int(e))
         if e.is_Float:
             if not math.isfinite(float(e)):
-                raise ValueError(f"{where}: value {e} is not finite")
+                raise InputError(f"{where}: value {e} is not finite")
             return _float_text(float(e))
         text = _PRINTER.doprint(e)
         try:
             back = parse_value(text, self.symbols, where=where)
         except DescriptionError as exc:
-            raise ValueError(
+            raise InputError(
                 f"{where}: {e} cannot be written as a description expression: {exc}"
             ) from None
         if back != e and not self._same(back, e):
-            raise ValueError(f"{where}: {e} would read back as {back}")
+            raise InputError(f"{where}: {e} would read back as {back}")
         return _string(text)
 
     def _same(self, a: sp.Expr, b: sp.Expr) -> bool:

@@ -45,6 +45,7 @@ import numpy as np
 import sympy as sp
 
 from robodyn.numeric.model import Model, compile_model
+from robodyn.robot.errors import InputError
 from robodyn.robot.load import load
 from robodyn.robot.model import Link, Robot
 from robodyn.simulate.controllers import PD, GravityCompensation
@@ -156,7 +157,7 @@ class AA300Study:
 def with_payload(robot: Robot, mass: float) -> Robot:
     """``robot`` carrying a point mass ``mass`` (kg) at its tool point (merged into the last link)."""
     if mass < 0 or not np.isfinite(mass):
-        raise ValueError(f"payload mass must be >= 0 kg, got {mass!r}")
+        raise InputError(f"payload mass must be >= 0 kg, got {mass!r}")
     if mass == 0:
         return robot
     link = robot.links[-1]

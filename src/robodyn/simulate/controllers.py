@@ -26,6 +26,7 @@ import numpy as np
 from scipy.linalg import solve_continuous_are
 
 from robodyn.numeric.model import Model
+from robodyn.robot.errors import InputError
 from robodyn.simulate.linearize import Linearization, linearize
 from robodyn.simulate.trajectory import JointTrajectory
 
@@ -96,7 +97,7 @@ def _gain(k: Any, n: int, name: str) -> np.ndarray:
         return np.diag(arr)
     if arr.shape == (n, n):
         return arr
-    raise ValueError(f"{name} must be a scalar, an ({n},) diagonal or an ({n}, {n}) matrix, "
+    raise InputError(f"{name} must be a scalar, an ({n},) diagonal or an ({n}, {n}) matrix, "
                      f"got shape {arr.shape}")
 
 
@@ -104,11 +105,11 @@ def _reference_at(ref: Reference, t: float | np.ndarray, n: int) -> tuple[np.nda
     """``(q_ref, qd_ref, qdd_ref)`` at t: (n,) for a scalar t, (K, n) for a (K,) array."""
     if isinstance(ref, JointTrajectory):
         if ref.dof != n:
-            raise ValueError(f"the reference trajectory has {ref.dof} joints, the model {n}")
+            raise InputError(f"the reference trajectory has {ref.dof} joints, the model {n}")
         return ref.at(t)
     q = np.asarray(ref, dtype=float)
     if q.shape != (n,):
-        raise ValueError(f"q_ref must have shape ({n},) (or be a JointTrajectory), got {q.shape}")
+        raise InputError(f"q_ref must have shape ({n},) (or be a JointTrajectory), got {q.shape}")
     shape = np.shape(t) + (n,)
     return np.broadcast_to(q, shape).copy(), np.zeros(shape), np.zeros(shape)
 
@@ -118,7 +119,7 @@ def _check_ref(ref: Any) -> Reference:
         return ref
     arr = np.asarray(ref, dtype=float)
     if arr.ndim != 1 or not np.all(np.isfinite(arr)):
-        raise ValueError(f"q_ref must be a finite (n,) array or a JointTrajectory, got {ref!r}")
+        raise InputError(f"q_ref must be a finite (n,) array or a JointTrajectory, got {ref!r}")
     return _freeze(arr)  # type: ignore[return-value]
 
 
@@ -127,7 +128,7 @@ def _limit(v: Any) -> np.ndarray | None:
         return None
     arr = np.atleast_1d(np.asarray(v, dtype=float))
     if arr.ndim != 1 or np.any(~np.isfinite(arr)) or np.any(arr <= 0):
-        raise ValueError(f"tau_limit must be positive (a scalar or an (n,) array), got {v!r}")
+        raise InputError(f"tau_limit must be positive (a scalar or an (n,) array), got {v!r}")
     return _freeze(arr)
 
 
@@ -194,7 +195,7 @@ class PID(Controller):
         object.__setattr__(self, "tau_limit", _limit(self.tau_limit))
         ki = np.asarray(self.ki, dtype=float)
         if ki.ndim > 1:
-            raise ValueError("PID: ki must be a scalar or an (n,) diagonal (the integral gain acts "
+            raise InputError("PID: ki must be a scalar or an (n,) diagonal (the integral gain acts "
                              "joint by joint)")
 
     @property
@@ -351,7 +352,7 @@ class LQR(Controller):
         K, x_eq, u_eq = (np.asarray(v, dtype=float) for v in (self.K, self.x_eq, self.u_eq))
         n = u_eq.size
         if u_eq.shape != (n,) or x_eq.shape != (2 * n,) or K.shape != (n, 2 * n):
-            raise ValueError(f"LQR: K must be (n, 2 n), x_eq (2 n,) and u_eq (n,); got {K.shape}, "
+            raise InputError(f"LQR: K must be (n, 2 n), x_eq (2 n,) and u_eq (n,); got {K.shape}, "
                              f"{x_eq.shape}, {u_eq.shape}")
         for name, v in (("K", K), ("x_eq", x_eq), ("u_eq", u_eq)):
             object.__setattr__(self, name, _freeze(v))
@@ -390,11 +391,11 @@ class LQR(Controller):
         lin = linearize(model, q_eq)
         act = list(range(n)) if actuated is None else [int(i) for i in actuated]
         if not act or len(set(act)) != len(act) or not all(0 <= i < n for i in act):
-            raise ValueError(f"LQR: actuated must list distinct joint indices in 0..{n - 1}, "
+            raise InputError(f"LQR: actuated must list distinct joint indices in 0..{n - 1}, "
                              f"got {actuated!r}")
         passive = [i for i in range(n) if i not in act]
         if passive and np.max(np.abs(lin.u0[passive])) > 1e-9 * max(1.0, np.max(np.abs(lin.u0))):
-            raise ValueError(f"LQR: q_eq is not an equilibrium without torque on the unactuated joints "
+            raise InputError(f"LQR: q_eq is not an equilibrium without torque on the unactuated joints "
                              f"{passive} (it needs {lin.u0[passive]})")
         b = lin.B[:, act]
         q_mat, r_mat = _gain(Q, 2 * n, "Q"), _gain(R, len(act), "R")
@@ -402,7 +403,7 @@ class LQR(Controller):
         try:
             p = solve_continuous_are(lin.A, b, q_mat, r_mat)
         except (np.linalg.LinAlgError, ValueError) as exc:
-            raise ValueError(f"LQR: no stabilising solution of the Riccati equation ({exc})") from exc
+            raise InputError(f"LQR: no stabilising solution of the Riccati equation ({exc})") from exc
         # K = R^-1 B^T P (zero rows for the unactuated joints)
         k = np.zeros((n, 2 * n))
         k[act] = np.linalg.solve(r_mat, b.T @ p)
@@ -414,7 +415,7 @@ class LQR(Controller):
     def closed_loop_poles(self) -> np.ndarray:
         """Eigenvalues of ``A - B K`` (1/s), when built by :meth:`about`."""
         if self.linearization is None:
-            raise ValueError("LQR: closed_loop_poles needs the linearisation (build with LQR.about)")
+            raise InputError("LQR: closed_loop_poles needs the linearisation (build with LQR.about)")
         lin = self.linearization
         return np.linalg.eigvals(lin.A - lin.B @ self.K)
 
@@ -428,7 +429,7 @@ class LQR(Controller):
     def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
         steps, n = t.size, model.dof
         if self.u_eq.size != n:
-            raise ValueError(f"LQR was built for {self.u_eq.size} joints, the model has {n}")
+            raise InputError(f"LQR was built for {self.u_eq.size} joints, the model has {n}")
         return {"feedforward": np.tile(self.u_eq, (steps, 1)), "reference": np.tile(self.x_eq, (steps, 1)),
                 "gain": np.array(self.K), "mode": "feedback"}
 
@@ -437,7 +438,7 @@ def _need_model(ctrl: Controller, model: Model | None) -> Model:
     """The controller's own ``model=`` when it has one (its belief about the plant), else ``model``."""
     model = ctrl.model if ctrl.model is not None else model
     if model is None:
-        raise ValueError(f"{ctrl.name} needs the robot's dynamics: construct it with model=... to "
+        raise InputError(f"{ctrl.name} needs the robot's dynamics: construct it with model=... to "
                          f"call it directly (simulate() passes its model itself)")
     return model
 

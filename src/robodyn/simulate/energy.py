@@ -26,6 +26,7 @@ import sympy as sp
 from robodyn import spatial as S
 from robodyn.hydro.schema import fluid_of, hydro_of
 from robodyn.numeric.model import Model
+from robodyn.robot.errors import InputError
 from robodyn.symbolic.kinematics import forward_kinematics, joint_symbols
 
 _MEMO: dict[tuple, Callable[..., object]] = {}
@@ -102,7 +103,7 @@ def frame_origins(model: Model, q: np.ndarray) -> np.ndarray:
 def _states(model: Model, q: np.ndarray) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     if q.ndim not in (1, 2) or q.shape[-1] != model.dof:
-        raise ValueError(f"q must have shape ({model.dof},) or (N, {model.dof}), got {q.shape}")
+        raise InputError(f"q must have shape ({model.dof},) or (N, {model.dof}), got {q.shape}")
     return q
 
 

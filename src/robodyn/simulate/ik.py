@@ -20,6 +20,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from robodyn.numeric.model import Model
+from robodyn.robot.errors import InputError
 
 
 class UnreachableError(ValueError):
@@ -115,14 +116,14 @@ def inverse_kinematics(model: Model, target: np.ndarray, q0: np.ndarray | None =
     n = model.dof
     target = np.asarray(target, dtype=float)
     if target.shape not in ((3,), (4, 4)) or not np.all(np.isfinite(target)):
-        raise ValueError(f"inverse_kinematics: target must be a finite (3,) position or (4, 4) pose, "
+        raise InputError(f"inverse_kinematics: target must be a finite (3,) position or (4, 4) pose, "
                          f"got shape {target.shape}")
     lower, upper = joint_limits(model)
     if q0 is None:
         q0 = np.where(np.isfinite(lower) & np.isfinite(upper), 0.5 * (lower + upper), 0.0)
     q0 = np.asarray(q0, dtype=float)
     if q0.shape != (n,) or not np.all(np.isfinite(q0)):
-        raise ValueError(f"inverse_kinematics: q0 must be a finite ({n},) array, got shape {q0.shape}")
+        raise InputError(f"inverse_kinematics: q0 must be a finite ({n},) array, got shape {q0.shape}")
     rng = np.random.default_rng(seed)
     lo = np.where(np.isfinite(lower), lower, -np.pi)
     hi = np.where(np.isfinite(upper), upper, np.pi)

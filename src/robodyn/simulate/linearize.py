@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robodyn.numeric.model import Model
+from robodyn.robot.errors import InputError
 
 
 @dataclass(frozen=True, eq=False)
@@ -97,7 +98,7 @@ def linearize(model: Model, q0: np.ndarray, qd0: np.ndarray | None = None,
 def _vec(v: np.ndarray, n: int, name: str) -> np.ndarray:
     arr = np.asarray(v, dtype=float)
     if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-        raise ValueError(f"linearize: {name} must be a finite ({n},) array, got shape {arr.shape}")
+        raise InputError(f"linearize: {name} must be a finite ({n},) array, got shape {arr.shape}")
     return arr
 
 

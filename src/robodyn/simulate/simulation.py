@@ -26,7 +26,7 @@ from scipy.integrate import solve_ivp
 
 from robodyn.numeric.model import MAX_INTEGRATE_BYTES, Model, ParameterValues
 from robodyn.numeric.runtime_parameters import check_physics
-from robodyn.robot.errors import SimulationError
+from robodyn.robot.errors import InputError, SimulationError
 from robodyn.simulate.controllers import Controller
 from robodyn.simulate.energy import potential_energy
 
@@ -114,7 +114,7 @@ class Trajectory:
     def member(self, i: int) -> Trajectory:
         """Trajectory ``i`` of a batch run, as a single-run :class:`Trajectory` (views)."""
         if self.batch is None:
-            raise ValueError("member: this trajectory is a single run, not a batch")
+            raise InputError("member: this trajectory is a single run, not a batch")
         if not -self.batch <= i < self.batch:
             raise IndexError(f"member: index {i} out of range for a batch of {self.batch}")
         return dataclasses.replace(
@@ -268,12 +268,12 @@ def _step_count(duration: float, dt: float, decimate: int) -> tuple[float, float
     duration = _positive(duration, "duration")
     steps = round(duration / dt)
     if steps < 1 or abs(steps * dt - duration) > 1e-9 * duration:
-        raise ValueError(f"duration {duration:g} s is not a whole number of steps dt = {dt:g} s")
+        raise InputError(f"duration {duration:g} s is not a whole number of steps dt = {dt:g} s")
     if isinstance(decimate, bool) or not isinstance(decimate, int | np.integer) or decimate < 1:
-        raise ValueError(f"simulate: decimate must be a positive integer, got {decimate!r}")
+        raise InputError(f"simulate: decimate must be a positive integer, got {decimate!r}")
     decimate = int(decimate)
     if steps % decimate:
-        raise ValueError(f"simulate: duration {duration:g} s is {steps} steps of {dt:g} s, not a "
+        raise InputError(f"simulate: duration {duration:g} s is {steps} steps of {dt:g} s, not a "
                          f"whole number of decimate = {decimate} steps")
     return dt, duration, steps, decimate
 
@@ -290,7 +290,7 @@ def _check_samples(steps: int, decimate: int, count: int, n: int, duration: floa
         per_run = max_samples // count
         each = f"{count} x {samples:,}" if batch else f"{samples:,}"
         k_min = -(-steps // (per_run - 1)) if per_run > 1 else steps
-        raise ValueError(
+        raise InputError(
             f"simulate: {duration:g} s at dt = {dt:g} s keeps {each} samples (about "
             f"{output_bytes(count * samples, n) / 1e6:,.0f} MB of arrays), above max_samples = "
             f"{max_samples:,}; keep every k-th step with decimate=k (k >= {k_min}), shorten the "
@@ -300,17 +300,17 @@ def _check_samples(steps: int, decimate: int, count: int, n: int, duration: floa
 def _check_options(method: str, control: str, substeps: int, controller: ControllerLike) -> None:
     """Refuse an unknown or inconsistent ``substeps``, ``method``, ``control`` or controller."""
     if isinstance(substeps, bool) or not isinstance(substeps, int | np.integer) or substeps < 1:
-        raise ValueError(f"simulate: substeps must be a positive integer, got {substeps!r}")
+        raise InputError(f"simulate: substeps must be a positive integer, got {substeps!r}")
     if substeps > 1 and (control != "sampled" or method not in FIXED_STEP):
-        raise ValueError("simulate: substeps needs a fixed-step method and control='sampled' (a "
+        raise InputError("simulate: substeps needs a fixed-step method and control='sampled' (a "
                          "continuous law or a SciPy method already evaluates the law wherever it "
                          "evaluates the dynamics)")
     if method not in FIXED_STEP + ADAPTIVE:
-        raise ValueError(f"unknown method {method!r}; choose one of {', '.join(FIXED_STEP + ADAPTIVE)}")
+        raise InputError(f"unknown method {method!r}; choose one of {', '.join(FIXED_STEP + ADAPTIVE)}")
     if control not in ("sampled", "continuous"):
-        raise ValueError(f"unknown control {control!r}; choose 'sampled' or 'continuous'")
+        raise InputError(f"unknown control {control!r}; choose 'sampled' or 'continuous'")
     if control == "continuous" and method == "semi_implicit":
-        raise ValueError("control='continuous' needs method='rk4' or a SciPy method (semi-implicit "
+        raise InputError("control='continuous' needs method='rk4' or a SciPy method (semi-implicit "
                          "Euler evaluates the law once per step: use control='sampled')")
     if controller is not None and not callable(controller):
         raise TypeError(f"controller must be a built-in controller, a callable (t, q, qd) -> tau or "
@@ -416,7 +416,7 @@ def _controller_model(controller: ControllerLike, model: Model) -> Model | None:
     if own is None or own is model:
         return None
     if own.dof != model.dof:
-        raise ValueError(f"simulate: the controller's model ({own.robot.name}) has {own.dof} "
+        raise InputError(f"simulate: the controller's model ({own.robot.name}) has {own.dof} "
                          f"joints, the simulated robot ({model.robot.name}) {model.dof}")
     same = (own.robot.description_hash and own.robot.description_hash == model.robot.description_hash
             and own.parameter_values == model.parameter_values)
@@ -437,7 +437,7 @@ def _fixed_step_c(model: Model, x0: np.ndarray, steps: int, dt: float, decimate:
     chunk = CHUNK_STEPS
     if integral and continuous:
         if max_samples is not None and steps > max(max_samples, CHUNK_STEPS):
-            raise ValueError(f"simulate: a PID with control='continuous' runs in one piece, at "
+            raise InputError(f"simulate: a PID with control='continuous' runs in one piece, at "
                              f"most {max(max_samples, CHUNK_STEPS):,} steps (this run has "
                              f"{steps:,}); use control='sampled', a SciPy method or a larger dt")
         chunk = steps
@@ -495,7 +495,7 @@ def _check_batch(method: str, control: str, substeps: int, controller: Controlle
     elif own is not None:
         why = f"a {controller.name} with its own model (its law steps in Python)"
     if why is not None:
-        raise ValueError(
+        raise InputError(
             "simulate: a batch of initial states (q0 of shape (N, n)) runs in one generated-C "
             "call per piece, with method 'rk4' or 'semi_implicit', control='sampled', "
             f"substeps=1 and no controller or a built-in one on the plant's model; {why} is not "
@@ -526,7 +526,7 @@ def _fixed_step_batch(model: Model, x0: np.ndarray, steps: int, dt: float, decim
     chunk = steps if integral else max(1, CHUNK_STEPS // count)
     size = 8 * (steps + 1) * 3 * n * count
     if integral and size > MAX_INTEGRATE_BYTES:
-        raise ValueError(f"simulate: a batch under a PID runs in one call, and {count} x {steps:,} "
+        raise InputError(f"simulate: a batch under a PID runs in one call, and {count} x {steps:,} "
                          f"steps need {size / 2**20:,.0f} MiB, above {MAX_INTEGRATE_BYTES / 2**20:,.0f} "
                          "MiB; split the batch or shorten the run")
     keep = steps // decimate + 1
@@ -723,7 +723,7 @@ def _result(model: Model, t: np.ndarray, x: np.ndarray, tau: np.ndarray, method:
 def _call(controller: Callable, t: float, x: np.ndarray, n: int) -> np.ndarray:
     tau = np.asarray(controller(float(t), x[:n].copy(), x[n:].copy()), dtype=float)
     if tau.shape != (n,):
-        raise ValueError(f"the controller returned shape {tau.shape}; it must return ({n},) torques")
+        raise InputError(f"the controller returned shape {tau.shape}; it must return ({n},) torques")
     if not np.all(np.isfinite(tau)):
         raise FloatingPointError(f"the controller returned non-finite torques at t = {t:g} s")
     return tau
@@ -744,9 +744,9 @@ def _name(controller: ControllerLike) -> str:
 def _vector(v: np.ndarray, n: int, name: str) -> np.ndarray:
     arr = np.asarray(v, dtype=float)
     if arr.shape != (n,):
-        raise ValueError(f"simulate: {name} must have shape ({n},), got {arr.shape}")
+        raise InputError(f"simulate: {name} must have shape ({n},), got {arr.shape}")
     if not np.all(np.isfinite(arr)):
-        raise ValueError(f"simulate: {name} contains non-finite values")
+        raise InputError(f"simulate: {name} contains non-finite values")
     return arr
 
 
@@ -756,10 +756,10 @@ def _states(v: np.ndarray, n: int, name: str, count: int | None = None) -> np.nd
     if arr.ndim != 2 or arr.shape[1] != n or arr.shape[0] < 1 or (count is not None
                                                                    and arr.shape[0] != count):
         want = f"({count}, {n})" if count is not None else f"(N, {n}) with N >= 1"
-        raise ValueError(f"simulate: {name} must have shape {want}, got {arr.shape}")
+        raise InputError(f"simulate: {name} must have shape {want}, got {arr.shape}")
     bad = np.flatnonzero(~np.all(np.isfinite(arr), axis=1))
     if bad.size:
-        raise ValueError(f"simulate: {name} contains non-finite values (row {int(bad[0])})")
+        raise InputError(f"simulate: {name} contains non-finite values (row {int(bad[0])})")
     return arr
 
 
@@ -767,9 +767,9 @@ def _positive(v: float, name: str) -> float:
     try:
         val = float(v)
     except (TypeError, ValueError):
-        raise ValueError(f"simulate: {name} must be a positive number, got {v!r}") from None
+        raise InputError(f"simulate: {name} must be a positive number, got {v!r}") from None
     if not np.isfinite(val) or val <= 0:
-        raise ValueError(f"simulate: {name} must be a positive finite number, got {v!r}")
+        raise InputError(f"simulate: {name} must be a positive finite number, got {v!r}")
     return val
 
 
@@ -778,7 +778,7 @@ def _tau_limit(v: float | np.ndarray, n: int) -> np.ndarray:
     if arr.size == 1:
         arr = np.full(n, float(arr.ravel()[0]))
     if arr.shape != (n,) or np.any(~np.isfinite(arr)) or np.any(arr <= 0):
-        raise ValueError(f"simulate: tau_limit must be positive, a scalar or ({n},), got {v!r}")
+        raise InputError(f"simulate: tau_limit must be positive, a scalar or ({n},), got {v!r}")
     return np.ascontiguousarray(arr)
 
 

@@ -16,6 +16,7 @@ from scipy.interpolate import BSpline, PPoly, make_interp_spline
 from scipy.spatial.transform import Rotation
 
 from robodyn.numeric.model import Model
+from robodyn.robot.errors import InputError
 from robodyn.simulate.ik import UnreachableError, inverse_kinematics
 
 
@@ -150,7 +151,7 @@ def trapezoidal(q0: Sequence[float], q1: Sequence[float], vmax: float | Sequence
     if duration is not None:
         T = _positive(duration, "duration")
         if T < t_min * (1 - 1e-12):
-            raise ValueError(f"trapezoidal: duration {T:g} s is shorter than the minimum {t_min:g} s "
+            raise InputError(f"trapezoidal: duration {T:g} s is shorter than the minimum {t_min:g} s "
                              f"the velocity and acceleration limits allow")
         # T = 1/V + V/A  ->  V^2 - A T V + A = 0, the smaller root
         V = 0.5 * (A * T - np.sqrt(max(A * A * T * T - 4 * A, 0.0)))
@@ -194,13 +195,13 @@ def via_points(points: Sequence[Sequence[float]], times: Sequence[float], *, kin
     pts = np.asarray(points, dtype=float)
     tk = np.asarray(times, dtype=float)
     if pts.ndim != 2 or pts.shape[0] < 2:
-        raise ValueError(f"via_points: points must be (K, n) with K >= 2, got shape {pts.shape}")
+        raise InputError(f"via_points: points must be (K, n) with K >= 2, got shape {pts.shape}")
     if tk.shape != (pts.shape[0],):
-        raise ValueError(f"via_points: times must have shape ({pts.shape[0]},), got {tk.shape}")
+        raise InputError(f"via_points: times must have shape ({pts.shape[0]},), got {tk.shape}")
     if not (np.all(np.isfinite(pts)) and np.all(np.isfinite(tk))):
-        raise ValueError("via_points: points and times must be finite")
+        raise InputError("via_points: points and times must be finite")
     if tk[0] != 0.0 or np.any(np.diff(tk) <= 0):
-        raise ValueError("via_points: times must start at 0 and be strictly increasing")
+        raise InputError("via_points: times must start at 0 and be strictly increasing")
     n = pts.shape[1]
     if kind == "quintic":
         ends = [(1, np.zeros(n)), (2, np.zeros(n))]
@@ -209,7 +210,7 @@ def via_points(points: Sequence[Sequence[float]], times: Sequence[float], *, kin
         ends = [(1, np.zeros(n))]
         spline = make_interp_spline(tk, pts, k=3, bc_type=(ends, ends))
     else:
-        raise ValueError(f"via_points: unknown kind {kind!r}; choose 'quintic' or 'cubic'")
+        raise InputError(f"via_points: unknown kind {kind!r}; choose 'quintic' or 'cubic'")
     return _from_ppoly(_spline_ppoly(spline), float(tk[-1]), dt, f"{kind} spline")
 
 
@@ -257,10 +258,10 @@ def cartesian_line(model: Model, q_start: Sequence[float], target: np.ndarray, d
     """
     q0 = np.asarray(q_start, dtype=float)
     if q0.shape != (model.dof,):
-        raise ValueError(f"cartesian_line: q_start must have shape ({model.dof},), got {q0.shape}")
+        raise InputError(f"cartesian_line: q_start must have shape ({model.dof},), got {q0.shape}")
     target = np.asarray(target, dtype=float)
     if target.shape not in ((3,), (4, 4)):
-        raise ValueError(f"cartesian_line: target must be (3,) or (4, 4), got {target.shape}")
+        raise InputError(f"cartesian_line: target must be (3,) or (4, 4), got {target.shape}")
     T = _positive(duration, "duration")
     start = model.forward_kinematics(q0)
     p0 = start[:3, 3]
@@ -270,7 +271,7 @@ def cartesian_line(model: Model, q_start: Sequence[float], target: np.ndarray, d
     _steps(T, dt)
     count = max(11, int(np.ceil(T / 0.01)) + 1) if knots is None else int(knots)
     if count < 2:
-        raise ValueError("cartesian_line: knots must be >= 2")
+        raise InputError("cartesian_line: knots must be >= 2")
     tk = np.linspace(0.0, T, count)
     tau = tk / T
     s = 10 * tau**3 - 15 * tau**4 + 6 * tau**5
@@ -306,11 +307,11 @@ def concatenate(*parts: JointTrajectory, dt: float | None = None) -> JointTrajec
         Sampling step (default: the first part's).
     """
     if not parts:
-        raise ValueError("concatenate: give at least one trajectory")
+        raise InputError("concatenate: give at least one trajectory")
     for prev, nxt in zip(parts, parts[1:], strict=False):
         gap = np.max(np.abs(prev.at(prev.duration)[0] - nxt.at(0.0)[0]))
         if gap > 1e-9:
-            raise ValueError(f"concatenate: a {nxt.kind} part starts {gap:.3g} away from where the "
+            raise InputError(f"concatenate: a {nxt.kind} part starts {gap:.3g} away from where the "
                              f"previous {prev.kind} part ends")
     order = max(p._pp.c.shape[0] for p in parts)
     breaks, coeffs, offset = [0.0], [], 0.0
@@ -351,28 +352,28 @@ def _steps(duration: float, dt: float) -> int:
 def _positive(value: float, name: str) -> float:
     v = float(value)
     if not np.isfinite(v) or v <= 0:
-        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+        raise InputError(f"{name} must be a positive finite number, got {value!r}")
     return v
 
 
 def _vector(v: Sequence[float], n: int, name: str) -> np.ndarray:
     arr = np.asarray(v, dtype=float)
     if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be a finite ({n},) array, got shape {arr.shape}")
+        raise InputError(f"{name} must be a finite ({n},) array, got shape {arr.shape}")
     return arr
 
 
 def _vectors(q0: Sequence[float], q1: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
     a = np.asarray(q0, dtype=float)
     if a.ndim != 1 or a.size == 0:
-        raise ValueError(f"q0 must be a 1-D array of joint values, got shape {a.shape}")
+        raise InputError(f"q0 must be a 1-D array of joint values, got shape {a.shape}")
     return _vector(a, a.size, "q0"), _vector(q1, a.size, "q1")
 
 
 def _limit_vector(v: float | Sequence[float], n: int, name: str) -> np.ndarray:
     arr = np.broadcast_to(np.asarray(v, dtype=float), (n,)) if np.ndim(v) == 0 else np.asarray(v, float)
     if arr.shape != (n,) or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-        raise ValueError(f"{name} must be positive: a scalar or a ({n},) array, got {v!r}")
+        raise InputError(f"{name} must be positive: a scalar or a ({n},) array, got {v!r}")
     return arr
 
 

@@ -21,6 +21,7 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
 from robodyn.hydro.terms import HydroTerms, hydro_terms
+from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 from robodyn.symbolic import crba
 from robodyn.symbolic import kane as kane_mod
@@ -235,7 +236,7 @@ class EquationsOfMotion:
         Program
         """
         if name not in _NUMERIC:
-            raise ValueError(f"unknown quantity {name!r}; choose one of {', '.join(_NUMERIC)}")
+            raise InputError(f"unknown quantity {name!r}; choose one of {', '.join(_NUMERIC)}")
         key = f"straight_line_{name}"
         if key not in self._extra:
             self._extra[key] = self._straight_line(name)
@@ -401,12 +402,12 @@ class _NumericFunction:
         arrays = [np.asarray(a, dtype=float) for a in args]
         for label, a in zip(("q", "qd", "qdd"), arrays, strict=False):
             if a.ndim not in (1, 2) or a.shape[-1] != self.n or a.shape[:-1] != arrays[0].shape[:-1]:
-                raise ValueError(f"{self.name}: {label} must be ({self.n},) or (N, {self.n}) like q, "
+                raise InputError(f"{self.name}: {label} must be ({self.n},) or (N, {self.n}) like q, "
                                  f"got {a.shape}")
         merged = {**self.defaults, **(values or {})}
         missing = [p for p in self.parameters if p not in merged]
         if missing:
-            raise ValueError(f"{self.name}: no value for the parameter(s) {', '.join(missing)}")
+            raise InputError(f"{self.name}: no value for the parameter(s) {', '.join(missing)}")
         batch = arrays[0].shape[:-1]
         out = self._fn(*(a.T for a in arrays), [float(merged[p]) for p in self.parameters])
         flat = np.stack([np.broadcast_to(np.asarray(v, dtype=float), batch) for v in out], axis=-1)
@@ -453,10 +454,10 @@ def derive(robot: Robot, method: Method = "newton_euler", *,
     EquationsOfMotion
     """
     if method not in METHODS:
-        raise ValueError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+        raise InputError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     n = robot.dof
     if symbolic_inertia and method != "newton_euler":
-        raise ValueError(
+        raise InputError(
             f"symbolic_inertia=True is supported by method='newton_euler' (the barycentric "
             f"parameters enter it linearly), not by {method!r}"
         )

@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robodyn.robot.errors import InputError
+
 __all__ = ["ErrorMetrics", "error_metrics"]
 
 
@@ -62,16 +64,16 @@ def error_metrics(measured: np.ndarray, predicted: np.ndarray) -> ErrorMetrics:
     y = np.asarray(measured, dtype=float)
     p = np.asarray(predicted, dtype=float)
     if y.ndim != 2 or y.shape != p.shape:
-        raise ValueError(f"error_metrics: measured and predicted must both be (N, n), got {y.shape} "
+        raise InputError(f"error_metrics: measured and predicted must both be (N, n), got {y.shape} "
                          f"and {p.shape}")
     if y.shape[0] == 0:
-        raise ValueError("error_metrics: no samples")
+        raise InputError("error_metrics: no samples")
     absent = np.all(np.isnan(y), axis=0)  # a joint without this sensor
     for name, arr in (("measured", y), ("predicted", p)):
         bad = np.argwhere(~np.isfinite(arr) & ~absent)
         if bad.size:
             row, col = bad[0]
-            raise ValueError(f"error_metrics: {name} is not finite at row {row}, column {col}")
+            raise InputError(f"error_metrics: {name} is not finite at row {row}, column {col}")
     e = p - y
     # rms_j = sqrt(mean_k e_kj^2)
     rms = np.sqrt(np.mean(e**2, axis=0))

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robodyn.numeric.model import Model
+from robodyn.robot.errors import InputError
 
 __all__ = ["WindowDrift", "simulate_windows"]
 
@@ -116,14 +117,14 @@ def simulate_windows(model: Model, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
     q_ref = q if q_measured is None else np.asarray(q_measured, dtype=float)
     dt = float(np.median(np.diff(t)))
     if not window > 0:
-        raise ValueError(f"simulation window must be positive, got {window:g} s")
+        raise InputError(f"simulation window must be positive, got {window:g} s")
     steps = int(round(window / dt))
     if steps < 2:
-        raise ValueError(f"simulation window {window:g} s is shorter than two sample periods "
+        raise InputError(f"simulation window {window:g} s is shorter than two sample periods "
                          f"({dt:g} s each)")
     span = steps * dt
     if t[-1] - t[0] < span:
-        raise ValueError(f"the recording ({t[-1] - t[0]:.4g} s) is shorter than one simulation "
+        raise InputError(f"the recording ({t[-1] - t[0]:.4g} s) is shorter than one simulation "
                          f"window ({span:.4g} s)")
     n = model.dof
     starts, finals, rmss, vfinals, bases = [], [], [], [], []
