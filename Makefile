@@ -5,7 +5,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: venv demo test bench clean distclean
+.PHONY: venv demo test quick bench clean distclean
 
 ## venv: create .venv and install robodyn (editable) with its test tools; reruns are instant
 venv: $(STAMP)
@@ -29,6 +29,11 @@ demo: $(STAMP)
 ## counted at the end; ROBODYN_REQUIRE_ALL=1 make test turns those skips into failures, as in CI)
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks && $(BIN)/pytest -q
+
+## quick: lint, then the suite without the tests marked slow (each over ~3 s: large models
+## compiled, whole command-line workflows); the full `make test` is what CI runs
+quick: $(STAMP)
+	$(BIN)/ruff check src tests benchmarks && $(BIN)/pytest -q -m "not slow"
 
 ## bench: timing suites in benchmarks/; bench_kernels.py writes benchmarks/results/<machine>.json
 ## (CPU, flags, load, min/median of every figure), then README's marked section is rendered from it

@@ -182,6 +182,7 @@ def test_help_has_examples(argv, capsys):
 
 
 @pytest.mark.slow
+@pytest.mark.slow
 def test_demo_writes_report(tmp_path, capsys):
     assert run(["demo", "-o", str(tmp_path), "--samples", "3"]) == 0
     out = capsys.readouterr().out

@@ -83,6 +83,7 @@ def tracker_data(tmp_path_factory):
     return d, out
 
 
+@pytest.mark.slow
 def test_calibrate_command_writes_a_description_that_reproduces_the_residuals(tracker_data, tmp_path,
                                                                               capsys):
     d, data = tracker_data

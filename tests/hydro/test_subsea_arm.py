@@ -88,6 +88,7 @@ def _potential(q: np.ndarray) -> float:
     return energy
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1])
 def test_gravity_with_buoyancy_is_the_gradient_of_an_independent_potential(seed: int) -> None:
     model = rd.compile_model(rd.load(NAME), backend="numpy")
@@ -118,6 +119,7 @@ def test_net_weight_torques_at_the_zero_pose_by_hand(rho: float) -> None:
         assert elbow == pytest.approx(-0.028192, abs=1e-6)
 
 
+@pytest.mark.slow
 def test_three_formulations_agree_with_every_effect_on() -> None:
     # each formulation's own straight-line M, C, g and tau (with the shared hydrodynamic terms)
     robot = rd.load(NAME)
@@ -134,6 +136,7 @@ def test_three_formulations_agree_with_every_effect_on() -> None:
         assert e.hydro is not None and e.hydro.drag != sp.zeros(4, 1)
 
 
+@pytest.mark.slow
 def test_compiled_c_model_equals_the_numpy_backend() -> None:
     robot = rd.load(NAME)
     c = rd.compile_model(robot, backend="c", parameters=WET)

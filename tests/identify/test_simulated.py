@@ -102,6 +102,7 @@ def test_rigid_body_columns_and_base_count_match_pinocchio(tmp_path, seed):
     assert len(inertial) == pin_rank
 
 
+@pytest.mark.slow
 def test_reported_std_intervals_cover_95_percent():
     """Monte Carlo: white torque noise, 100 runs; coverage of value +- 1.96 std measured."""
     robot = load_quiet("planar_2r")

@@ -57,6 +57,7 @@ def test_base_columns_planar_2r_closed_form(planar):
     assert len(base_columns(planar, 7)) == 13
 
 
+@pytest.mark.slow
 def test_puma_design_meets_target_and_limits(puma, puma_design):
     ex = puma_design
     print(f"PUMA 560 excitation: cond = {ex.condition_number:.1f} (starts {np.round(ex.history, 1)}), "
@@ -84,6 +85,7 @@ def test_puma_design_meets_target_and_limits(puma, puma_design):
     assert s[0] / s[-1] == pytest.approx(ex.condition_number, rel=1e-6)
 
 
+@pytest.mark.slow
 def test_puma_design_beats_best_of_100_random(puma, puma_design):
     ex = puma_design
     rng = np.random.default_rng(2024)

@@ -237,6 +237,7 @@ def test_generated_numpy_module_of_the_derivatives_runs(tmp_path):
     np.testing.assert_allclose(d[:, :2], model.inverse_dynamics_derivatives(q, qd, qdd)[0], rtol=1e-12)
 
 
+@pytest.mark.slow
 @pytest.mark.oracle("pinocchio")
 @pytest.mark.parametrize("seed", range(4))
 def test_random_chain_derivatives_match_pinocchio(tmp_path, seed):

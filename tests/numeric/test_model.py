@@ -18,7 +18,8 @@ from robodyn.symbolic.regressor import reflected_rotor_inertia
 from tests.numeric_eval import evaluator, program_evaluator
 from tests.urdf_chains import pin_q, random_urdf
 
-ROBOTS = ["puma560", "puma560_akb", "aa300", "planar_2r", "trolley_double_pendulum", "kinova_gen3"]
+ROBOTS = ["puma560", "puma560_akb", "aa300", "planar_2r", "trolley_double_pendulum",
+          pytest.param("kinova_gen3", marks=pytest.mark.slow)]
 
 
 def load_quiet(name):

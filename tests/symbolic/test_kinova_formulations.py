@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from functools import cache
 
 import numpy as np
+import pytest
 import sympy as sp
 
 import robodyn as rd
@@ -69,6 +70,7 @@ def quantities(method: str) -> tuple[sp.ImmutableMatrix, ...]:
     return eom.M, eom.g, eom.tau, eom.C
 
 
+@pytest.mark.slow
 def test_formulations_agree_numerically_on_kinova_gen3():
     count = 4
     states = list(random_states(7, count, seed=2))

@@ -47,6 +47,7 @@ def test_validate_command_writes_metrics_report_and_figures(files, tmp_path, cap
     assert "whole arm: relative error 0.000" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_identify_command_writes_a_loadable_robot_and_tables(files, tmp_path, capsys):
     train, held = files
     rc = main(["identify", "puma560", "--data", str(train), "--validate", str(held),
@@ -226,6 +227,7 @@ def test_validate_and_underwater_without_a_c_compiler(files, tmp_path, monkeypat
     assert err[-1].startswith("robodyn: error: no C compiler found") and "--backend numpy" in err[-1]
 
 
+@pytest.mark.slow
 def test_validate_on_the_written_description_gives_identify_figures(files, tmp_path, capsys):
     # issue 25 item 3: one model, one verdict
     train, held = files
