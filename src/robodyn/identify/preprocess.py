@@ -43,6 +43,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from robodyn.identify.stacking import regressor_rows_of
 from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass
 from robodyn.robot.errors import IdentificationError
 
@@ -216,7 +217,7 @@ def coulomb_dead_band(y: np.ndarray, qd: np.ndarray, band: float) -> np.ndarray:
 def prediction_rows(model: Any, s: Samples, settings: Preprocess) -> np.ndarray:
     """Regressor (N, n, 15 n) of processed samples for a prediction: the compiled regressor of
     ``model`` at ``(s.q, s.qd, s.qdd)`` with the Coulomb dead band (:func:`coulomb_dead_band`)."""
-    return coulomb_dead_band(model.regressor(s.q, s.qd, s.qdd), s.qd, settings.dead_band)
+    return coulomb_dead_band(regressor_rows_of(model, s.q, s.qd, s.qdd), s.qd, settings.dead_band)
 
 
 def regressor_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool = True) -> np.ndarray:
@@ -236,9 +237,10 @@ def regressor_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool 
     d = settings.decimate if decimate else 1
     band = settings.dead_band
     if settings.cutoff is None:
-        return coulomb_dead_band(model.regressor(s.q[::d], s.qd[::d], s.qdd[::d]), s.qd[::d], band)
+        return coulomb_dead_band(regressor_rows_of(model, s.q[::d], s.qd[::d], s.qdd[::d]), s.qd[::d],
+                                 band)
     m = evaluation_step(s.t, settings, d)
-    y = coulomb_dead_band(model.regressor(s.q[::m], s.qd[::m], s.qdd[::m]), s.qd[::m], band)
+    y = coulomb_dead_band(regressor_rows_of(model, s.q[::m], s.qd[::m], s.qdd[::m]), s.qd[::m], band)
     return filtered_rows(s.t[::m], y, settings, d // m)
 
 

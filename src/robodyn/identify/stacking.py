@@ -20,7 +20,7 @@ import numpy as np
 from robodyn.numeric.model import Model
 from robodyn.robot.errors import InputError
 
-__all__ = ["CHUNK", "identification_matrix"]
+__all__ = ["CHUNK", "identification_matrix", "regressor_rows_of"]
 
 CHUNK = 4096
 
@@ -68,3 +68,14 @@ def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.n
         y = model.regressor(q[start:stop], qd[start:stop], qdd[start:stop], threads=threads)
         out[start * n:stop * n] = y.reshape((stop - start) * n, -1)[:, cols]
     return out
+
+
+def regressor_rows_of(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+    """The full stacked regressor as one block per sample, shape (N, n, 15 n).
+
+    :func:`identification_matrix` with every column (the path ``benchmarks/bench_identify.py``
+    times), viewed per sample: what :func:`robodyn.identify` filters and fits.
+    """
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    count, n = q.shape
+    return identification_matrix(model, q, qd, qdd).reshape(count, n, -1)
