@@ -35,8 +35,9 @@ test: $(STAMP)
 quick: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks && $(BIN)/pytest -q -m "not slow"
 
-## bench: timing suites in benchmarks/; bench_kernels.py writes benchmarks/results/<machine>.json
-## (CPU, flags, load, min/median of every figure), then README's marked section is rendered from it
+## bench: timing suites in benchmarks/; bench_kernels.py, bench_simulation.py and bench_hydro.py
+## merge theirs into benchmarks/results/<machine>.json (CPU, flags, load, min/median of every
+## figure), then README's marked sections are rendered from it
 bench: $(STAMP)
 	@set -e; for f in benchmarks/bench_*.py; do echo "== $$f"; $(BIN)/python $$f; done
 	$(BIN)/python benchmarks/render_readme.py --results "$$($(BIN)/python benchmarks/results.py)"

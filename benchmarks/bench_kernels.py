@@ -12,21 +12,29 @@ Prints (PUMA 560, 100,000 random states, ns per state):
      native build (ID >= 25x, FD >= 25x, FD derivatives >= 15x) printed as met or not. Full
      runs merge these figures into ``benchmarks/results/<machine>.json`` (``results.py``),
      from which ``render_readme.py`` renders the README's table.
-  1. Single thread: robodyn inverse dynamics (with the PUMA's joint friction, and a copy of the
-     robot without friction) against CasADi-generated C of the same inverse dynamics
-     (robodyn's recorded Newton-Euler program evaluated on CasADi SX symbols, ``CodeGenerator``
-     C, compiled with robodyn's flags ``-O3 -march=native ...`` and driven by a C loop over the
-     states, one state per call); mass matrix against ``crba`` called from Python (the no-op
-     loop's own cost is measured and printed).
-  2. Two threads: robodyn's ``threads=2`` against itself (scaling efficiency) and against
-     ``rneaInParallel``/``abaInParallel`` on 2 threads. The machine may be shared: the ratios
-     of one run are comparable, absolute times are not.
-  3. Ensemble RK4: 1000 trolley double-pendulum trajectories of 5 s at 1 ms: one
-     ``model.integrate`` call with x0 (1000, 6) against 1000 one-at-a-time calls and against
-     MuJoCo's ``rollout`` with 1000 initial states (its own RK4 at 1 ms, one thread); and the
-     same ensemble with one parameter set per trajectory (``compile_model(robot,
-     runtime_parameters=True)``, ``integrate(..., parameters=(1000, 6))``) against the ensemble
-     with the parameters compiled in (the cost of keeping them runtime inputs).
+  1. ``--only kernels``, single thread (``casadi_peer.py``, issue 22 item 1c): robodyn's
+     inverse dynamics (the PUMA with its joint friction) against CasADi-generated C of the same
+     program (robodyn's recorded Newton-Euler program evaluated on CasADi SX symbols,
+     ``CodeGenerator`` C compiled with robodyn's flags ``-O3 ... -march=native``) evaluated
+     per state, by CasADi's batched ``map`` (serial; 16 states expanded into one SX function),
+     with ``sin q``/``cos q`` as precomputed inputs (the generated arithmetic only, not libm),
+     and by ``map(N, "thread", 2)`` against robodyn on 2 threads; then robodyn's ``threads=2``
+     against itself (scaling efficiency) and Pinocchio's ``rneaInParallel``/``abaInParallel``
+     on 1 and 2 threads, and the mass matrix against ``crba`` called from Python (the no-op
+     loop's own cost is measured). Results entries ``casadi`` and ``threads``.
+  2. ``--only ensemble``: 1000 trolley double-pendulum trajectories of 5 s, RK4 at 1 ms: one
+     ``model.integrate`` call with x0 (1000, 6) on 1 and 2 threads, against 1000
+     one-at-a-time calls, against the same ensemble with one parameter set per trajectory
+     (``compile_model(robot, runtime_parameters=True)``, ``integrate(..., parameters=(1000,
+     6))``), and against MuJoCo's ``rollout`` from the same 1000 initial states (its own RK4 at
+     1 ms, contacts disabled) on 1 thread and on its 2-thread pool. Results entry ``ensemble``.
+
+Every section times its rows in turns (``timing.interleaved``: each round runs every row once,
+so that load from other processes hits all alike) and records min and median over the rounds.
+The machine may be shared: the ratios of one run are comparable, absolute times less so. Full
+runs merge the figures into ``benchmarks/results/<machine>.json`` (``results.py``); ``--quick``
+(10,000 states, 3 rounds, 100 trajectories) writes only with ``--results PATH``, and its
+command line, recorded with the figures, says so.
 
 Run: ``.venv/bin/python benchmarks/bench_kernels.py [--quick] [--only pinocchio|kernels|ensemble]
 [--results PATH | --no-results]``.
@@ -37,198 +45,212 @@ from __future__ import annotations
 import argparse
 import sys
 import warnings
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
-import sympy as sp
 
 import robodyn as rd
-from robodyn.codegen.build import CFLAGS, compile_library
-from robodyn.numeric.model import _kernels_cached
 
 sys.path.insert(0, str(Path(__file__).parent))
+import casadi_peer  # noqa: E402
 import kernel_peers  # noqa: E402
 import results  # noqa: E402
+import timing  # noqa: E402
 from bench_simulation import pinocchio_puma, trolley_mjcf  # noqa: E402
-from kernel_peers import without_friction  # noqa: E402
-from timing import best_of  # noqa: E402
+from peers import pinocchio_loop  # noqa: E402
 
 
-def casadi_inverse_dynamics(robot: rd.Robot):
-    """CasADi C of robodyn's PUMA inverse-dynamics program, compiled with robodyn's flags.
-
-    Returns ``run(q, qd, qdd, tau)``: a C loop calling CasADi's one-state function per state.
-    """
-    import casadi as ca
-
-    kernel = _kernels_cached(robot, robot.parameters)["inverse_dynamics"]
-    n = robot.dof
-    q, qd, qdd = (ca.SX.sym(s, n) for s in ("q", "qd", "qdd"))
-    env: dict[sp.Symbol, object] = {}
-    for arg, sym in zip(kernel.inputs, (q, qd, qdd), strict=True):
-        env.update({e: sym[k] for k, e in enumerate(arg.entries)})
-    modules = [{"sin": ca.sin, "cos": ca.cos, "sqrt": ca.sqrt, "ifelse": ca.if_else}, "math"]
-    ifelse = sp.Function("ifelse")
-
-    def value(expr):
-        # Coulomb friction's steps: CasADi's if_else (a select in the generated C)
-        expr = expr.replace(lambda e: isinstance(e, sp.Piecewise),
-                            lambda e: ifelse(e.args[0].cond, e.args[0].expr, e.args[1].expr))
-        free = sorted(expr.free_symbols, key=lambda s: s.name)
-        return sp.lambdify(free, expr, modules=modules)(*(env[s] for s in free))
-
-    for sym, expr in kernel.body:
-        env[sym] = value(expr)
-    tau = ca.vertcat(*[value(sp.sympify(e)) for e in kernel.outputs[0].entries])
-    f = ca.Function("cs_id", [q, qd, qdd], [tau])
-    gen = ca.CodeGenerator("cs_id.c", {"with_header": False})
-    gen.add(f)
-    driver = f"""
-void cs_id_batch(long count, const double *q, const double *qd, const double *qdd, double *tau) {{
-    casadi_int iw[1]; casadi_real w[{f.sz_w()}];
-    for (long k = 0; k < count; ++k) {{
-        const casadi_real *arg[3] = {{q + {n} * k, qd + {n} * k, qdd + {n} * k}};
-        casadi_real *res[1] = {{tau + {n} * k}};
-        cs_id(arg, res, iw, w, 0);
-    }}
-}}
-"""
-    lib = compile_library(gen.dump() + driver,
-                          "void cs_id_batch(long, const double *, const double *, const double *, double *);",
-                          flags=CFLAGS)
-    ffi = lib.ffi
-
-    def run(qa, qda, qdda, out):
-        lib.lib.cs_id_batch(len(qa), *(ffi.from_buffer("double[]", a) for a in (qa, qda, qdda, out)))
-
-    return run, f.n_instructions()
-
-
-def bench_kernels(quick: bool) -> None:
-    import pinocchio as pin
-
+def _puma() -> rd.Robot:
+    """The built-in PUMA 560 (its load-time warnings silenced)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        robot = rd.load("puma560")
+        return rd.load("puma560")
+
+
+def threads_and_crba(robot: rd.Robot, count: int, repeats: int) -> dict[str, Any]:
+    """Two-thread scaling (robodyn and Pinocchio's wheel) and the mass matrix against ``crba``.
+
+    Returns
+    -------
+    dict
+        The ``threads`` results entry: ``efficiency`` per kernel and library (t1 / (2 t2) of the
+        minima), ns per state min/median for every timing, the Python loop's own cost.
+    """
+    import pinocchio as pin
+
+    start_load = results.load_average()
     model = rd.compile_model(robot)
-    rigid = rd.compile_model(without_friction(robot))
-    count = 10_000 if quick else 100_000
     rng = np.random.default_rng(0)
     q, qd, qdd = rng.uniform(-np.pi, np.pi, (3, count, 6))
     tau = model.inverse_dynamics(q, qd, qdd)
-    ns = 1e9 / count
-    print(f"== PUMA 560, {count:,} states, ns per state (robodyn C: {' '.join(CFLAGS)}) ==")
-    t = {
-        "id": best_of(lambda: model.inverse_dynamics(q, qd, qdd), 7),
-        "id_rigid": best_of(lambda: rigid.inverse_dynamics(q, qd, qdd), 7),
-        "fd": best_of(lambda: model.forward_dynamics(q, qd, tau), 7),
-        "fd_rigid": best_of(lambda: rigid.forward_dynamics(q, qd, tau), 7),
-        "m": best_of(lambda: model.mass_matrix(q), 7),
-        "id2": best_of(lambda: model.inverse_dynamics(q, qd, qdd, threads=2), 7),
-        "fd2": best_of(lambda: model.forward_dynamics(q, qd, tau, threads=2), 7),
-        "m2": best_of(lambda: model.mass_matrix(q, threads=2), 7),
-    }
-    pmodel, source = pinocchio_puma(robot)
+    pmodel, _ = pinocchio_puma(robot)
     pdata = pmodel.createData()
-    tau_rigid = rigid.inverse_dynamics(q, qd, qdd)
-    d_id = max(np.max(np.abs(pin.rnea(pmodel, pdata, q[k], qd[k], qdd[k]) - tau_rigid[k])) for k in range(50))
-    qt, qdt, qddt, taut = (np.asfortranarray(a.T) for a in (q, qd, qdd, tau_rigid))
+    qt, qdt, qddt, taut = (np.asfortranarray(a.T) for a in (q, qd, qdd, tau))
     out = np.empty((6, count), order="F")
+    fns: dict[str, Callable[[], Any]] = {}
     for k in (1, 2):
+        fns[f"robodyn ID {k}"] = lambda k=k: model.inverse_dynamics(q, qd, qdd, threads=k)
+        fns[f"robodyn FD {k}"] = lambda k=k: model.forward_dynamics(q, qd, tau, threads=k)
+        fns[f"robodyn M {k}"] = lambda k=k: model.mass_matrix(q, threads=k)
         pool = pin.ModelPool(pmodel, k)
-        t[f"pin_rnea{k}"] = best_of(lambda k=k, pool=pool: pin.rneaInParallel(k, pool, qt, qdt, qddt, out), 5)
-        t[f"pin_aba{k}"] = best_of(lambda k=k, pool=pool: pin.abaInParallel(k, pool, qt, qdt, taut, out), 5)
+        fns[f"pinocchio wheel ID {k}"] = (
+            lambda k=k, pool=pool: pin.rneaInParallel(k, pool, qt, qdt, qddt, out))
+        fns[f"pinocchio wheel FD {k}"] = (
+            lambda k=k, pool=pool: pin.abaInParallel(k, pool, qt, qdt, taut, out))
     loops = min(count, 20_000)
+    loop_fns = {"crba loop": pinocchio_loop(pin.crba, pmodel, pdata, loops, q),
+                "python loop": pinocchio_loop(lambda *_: None, pmodel, pdata, loops, q)}
+    t = timing.interleaved(fns, repeats)
+    t.update(timing.interleaved(loop_fns, repeats))
+    ns = {k: results.summary(v, 1e9 / (loops if "loop" in k else count)) for k, v in t.items()}
+    bare = [a - min(t["python loop"]) for a in t["crba loop"]]
+    ns["crba minus loop"] = results.summary(bare, 1e9 / loops)
+    eff = {f"{lib} {kern}": round(ns[f"{lib} {kern} 1"]["min"] / (2 * ns[f"{lib} {kern} 2"]["min"]), 2)
+           for lib in ("robodyn", "pinocchio wheel") for kern in ("ID", "FD", "M")
+           if f"{lib} {kern} 1" in ns}
+    return {"states": count, "repeats": repeats, "load_average_at_start": start_load,
+            "ns_per_state": ns, "efficiency": eff, "loop_states": loops,
+            "mass_matrix_vs_crba": {
+                "with_loop": round(ns["crba loop"]["min"] / ns["robodyn M 1"]["min"], 2),
+                "minus_loop": round(ns["crba minus loop"]["min"] / ns["robodyn M 1"]["min"], 2)},
+            "peers": {"robodyn": "Model methods with threads=1 and threads=2 (OpenMP), PUMA "
+                                 "friction included in ID and FD",
+                      "pinocchio wheel": f"pinocchio {pin.__version__} wheel: rneaInParallel / "
+                                         "abaInParallel with 1 and 2 threads (no friction); crba "
+                                         f"called per state from a Python loop over {loops:,} "
+                                         "states (no batched form), the loop's own cost measured "
+                                         "around a no-op"}}
 
-    def crba_loop():
-        for k in range(loops):
-            pin.crba(pmodel, pdata, q[k])
 
-    def noop_loop():
-        for k in range(loops):
-            _ = q[k]
-
-    t["pin_crba"] = best_of(crba_loop, 3) * count / loops
-    t["noop"] = best_of(noop_loop, 3) * count / loops
-    run_cs, ops = casadi_inverse_dynamics(robot)
-    run_cs_rigid, _ = casadi_inverse_dynamics(without_friction(robot))
-    out_cs = np.empty((count, 6))
-    run_cs(q, qd, qdd, out_cs)
-    d_cs = np.max(np.abs(out_cs - model.inverse_dynamics(q, qd, qdd))) / np.max(np.abs(out_cs))
-    t["cs"] = best_of(lambda: run_cs(q, qd, qdd, out_cs), 7)
-    t["cs_rigid"] = best_of(lambda: run_cs_rigid(q, qd, qdd, out_cs), 7)
-    print(f"Pinocchio {pin.__version__} ({source}) vs robodyn without friction: max |tau diff| = {d_id:.1e}")
-    print(f"CasADi C of the same program: {ops} SX instructions, max rel. diff vs robodyn = {d_cs:.1e}")
-    print(f"{'single thread':34s}{'robodyn':>9s}{'peer':>9s}{'ratio':>8s}  (target)")
-
-    def row(label, ours, theirs, target=""):
-        print(f"{label:34s}{ours * ns:9.1f}{theirs * ns:9.1f}{theirs / ours:7.1f}x  {target}")
-
-    # robodyn against Pinocchio natively compiled and its wheel on one thread: bench_pinocchio
-    row("ID (friction) / CasADi C", t["id"], t["cs"], ">= 3x")
-    row("ID (no friction) / CasADi C", t["id_rigid"], t["cs_rigid"], "")
-    row("M / crba from a Python loop", t["m"], t["pin_crba"],
-        f"(the loop alone: {t['noop'] * ns:.0f} ns/state)")
-    row("M / crba minus the loop", t["m"], t["pin_crba"] - t["noop"], "")
-    print("two threads (machine shared: efficiency = t1 / (2 t2))")
-    for name, pin_name in (("id", "pin_rnea"), ("fd", "pin_aba"), ("m", None)):
-        eff = t[name] / (2 * t[name + "2"])
-        line = f"  {name.upper():3s} robodyn {t[name + '2'] * ns:7.1f} ns/state, efficiency {eff:5.2f}"
-        if pin_name:
-            line += (f"; Pinocchio 2 threads {t[pin_name + '2'] * ns:7.1f} ns/state "
-                     f"(efficiency {t[pin_name + '1'] / (2 * t[pin_name + '2']):.2f}), "
-                     f"ratio {t[pin_name + '2'] / t[name + '2']:.1f}x")
-        print(line)
+def print_threads(entry: dict[str, Any]) -> None:
+    """Print the two-thread efficiencies and the mass matrix against ``crba``."""
+    ns = entry["ns_per_state"]
+    print(f"== two threads (efficiency t1 / (2 t2) of the minima; machine shared) and M vs crba, "
+          f"{entry['states']:,} states ==")
+    for name, eff in entry["efficiency"].items():
+        print(f"  {name:22s} 1 thread {ns[name + ' 1']['min']:8.1f}  2 threads "
+              f"{ns[name + ' 2']['min']:8.1f} ns/state  efficiency {eff:.2f}")
+    m = entry["mass_matrix_vs_crba"]
+    print(f"  M {ns['robodyn M 1']['min']:.1f} ns/state; crba from a Python loop "
+          f"{ns['crba loop']['min']:.0f} ({m['with_loop']:.1f}x), minus the loop's own "
+          f"{ns['python loop']['min']:.0f} ns: {m['minus_loop']:.1f}x")
     print()
 
 
-def bench_ensemble(quick: bool) -> None:
-    """Ensemble RK4 against one-at-a-time runs and MuJoCo's rollout; with parameter sets too."""
+def bench_kernels(quick: bool, results_path: Path | None, command: str) -> None:
+    """CasADi peers of the inverse dynamics, two-thread scaling and M against ``crba``.
+
+    Parameters
+    ----------
+    quick : bool
+        10,000 states and 3 rounds instead of 100,000 and 7.
+    results_path : Path or None
+        Results file (benchmark names ``casadi`` and ``threads``); None: not written.
+    command : str
+        The command line, recorded with the figures.
+    """
+    robot = _puma()
+    count, repeats = (10_000, 3) if quick else (100_000, 7)
+    entry = casadi_peer.measure(robot, count, repeats)
+    casadi_peer.print_entry(entry)
+    threads = threads_and_crba(robot, count, repeats)
+    print_threads(threads)
+    if results_path is not None:
+        for name, e in (("casadi", entry), ("threads", threads)):
+            print(f"figures written to {results.merge(results_path, name, {**e, 'command': command})}")
+
+
+def _mujoco_states(mj: Any, x0: np.ndarray) -> np.ndarray:
+    """MuJoCo full-physics initial states with ``qpos`` = the first half of each row of ``x0``."""
+    import mujoco
+
+    data = mujoco.MjData(mj)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    states = np.zeros((len(x0), mujoco.mj_stateSize(mj, spec)))
+    n = x0.shape[1] // 2
+    for i, x in enumerate(x0):
+        mujoco.mj_resetData(mj, data)
+        data.qpos[:], data.qvel[:] = x[:n], x[n:]
+        mujoco.mj_getState(mj, data, states[i], spec)
+    return states
+
+
+def bench_ensemble(quick: bool, results_path: Path | None, command: str) -> None:
+    """Ensemble RK4 against one-at-a-time runs and MuJoCo's rollout; with parameter sets too.
+
+    Parameters
+    ----------
+    quick : bool
+        100 trajectories instead of 1000.
+    results_path : Path or None
+        Results file (benchmark name ``ensemble``); None: not written.
+    command : str
+        The command line, recorded with the figures.
+    """
     import mujoco
     from mujoco import rollout
 
+    start_load = results.load_average()
     robot = rd.load("trolley_double_pendulum")
     model = rd.compile_model(robot)
-    count = 100 if quick else 1000
-    steps, dt = 5000, 1e-3
+    count, steps, dt, repeats = (100 if quick else 1000), 5000, 1e-3, 3
     rng = np.random.default_rng(1)
     x0 = np.hstack([rng.uniform(-0.3, 0.3, (count, 3)), np.zeros((count, 3))])
-    print(f"== Ensemble RK4: {count} trolley double-pendulum trajectories, 5 s at 1 ms ==")
-    t_ens = best_of(lambda: model.integrate(x0, steps, dt), 3)
-    t_ens2 = best_of(lambda: model.integrate(x0, steps, dt, threads=2), 3)
-
-    def one_at_a_time():
-        for x in x0:
-            model.integrate(x, steps, dt)
-
-    t_one = best_of(one_at_a_time, 2)
-    # every trajectory with its own parameter set (masses, lengths, g): runtime parameters
     runtime = rd.compile_model(robot, runtime_parameters=True)
     base = np.array([robot.parameters[k] for k in runtime.runtime_parameters])
     sets = base * rng.uniform(0.8, 1.2, (count, base.size))
-    t_par = best_of(lambda: runtime.integrate(x0, steps, dt, parameters=sets), 3)
     xml, source = trolley_mjcf(robot)
     mj = mujoco.MjModel.from_xml_string(xml)
-    data = mujoco.MjData(mj)
-    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    states = np.zeros((count, mujoco.mj_stateSize(mj, spec)))
-    for i in range(count):
-        mujoco.mj_resetData(mj, data)
-        data.qpos[:] = x0[i, :3]
-        mujoco.mj_getState(mj, data, states[i], spec)
-    rollout.rollout(mj, data, states[:2], nstep=10)
-    t_mj = best_of(lambda: rollout.rollout(mj, data, states, nstep=steps), 2)
-    per = 1e3 / count
-    print(f"robodyn ensemble, one call, 1 thread   {t_ens * per:8.3f} ms per trajectory")
-    print(f"robodyn ensemble, one call, 2 threads  {t_ens2 * per:8.3f} ms per trajectory "
-          f"(efficiency {t_ens / (2 * t_ens2):.2f})")
-    print(f"robodyn one integrate call each        {t_one * per:8.3f} ms per trajectory "
-          f"({t_one / t_ens:.1f}x the ensemble)")
-    print(f"robodyn ensemble, {count} parameter sets  {t_par * per:8.3f} ms per trajectory "
-          f"({t_par / t_ens:.2f}x the ensemble with compiled-in parameters; runtime_parameters)")
-    print(f"MuJoCo {mujoco.__version__} rollout, {count} initial states {t_mj * per:8.3f} ms per trajectory "
-          f"({t_mj / t_ens:.1f}x the ensemble; model: {source})")
+    states = _mujoco_states(mj, x0)
+    datas = [mujoco.MjData(mj) for _ in range(2)]
+    mj_states, _ = rollout.rollout(mj, datas[0], states, nstep=steps)
+    xs, _ = model.integrate(x0, steps, dt)
+    agree = float(np.max(np.abs(mj_states[:, :, 1:4] - xs[:, 1:, :3])))
+
+    def one_at_a_time() -> None:
+        for x in x0:
+            model.integrate(x, steps, dt)
+
+    fns = {"robodyn ensemble": lambda: model.integrate(x0, steps, dt),
+           "robodyn ensemble 2 threads": lambda: model.integrate(x0, steps, dt, threads=2),
+           "robodyn one call each": one_at_a_time,
+           "robodyn parameter sets": lambda: runtime.integrate(x0, steps, dt, parameters=sets),
+           "MuJoCo rollout": lambda: rollout.rollout(mj, datas[0], states, nstep=steps),
+           "MuJoCo rollout 2 threads": lambda: rollout.rollout(mj, datas, states, nstep=steps)}
+    times = timing.interleaved(fns, repeats)
+    rows = [{"library": k, "ms_per_trajectory": results.summary(v, 1e3 / count, 3),
+             "threads": 2 if "2 threads" in k else 1} for k, v in times.items()]
+    by = {r["library"]: r["ms_per_trajectory"] for r in rows}
+    for r in rows:
+        ref = by["robodyn ensemble 2 threads" if r["threads"] == 2 else "robodyn ensemble"]
+        r["vs_ensemble"] = {"min": round(r["ms_per_trajectory"]["min"] / ref["min"], 2),
+                            "median": round(r["ms_per_trajectory"]["median"] / ref["median"], 2)}
+    entry = {
+        "trajectories": count, "steps": steps, "dt": dt, "repeats": repeats,
+        "load_average_at_start": start_load, "rows": rows,
+        "mujoco_agreement_rad": agree, "mujoco_model": source, "command": command,
+        "peers": {
+            "robodyn": "Model.integrate: RK4 at 1 ms in generated C, x0 (N, 6), one call for the "
+                       "ensemble (threads=1, or threads=2 with OpenMP); 'one call each': N calls "
+                       "with one x0; 'parameter sets': compile_model(runtime_parameters=True), "
+                       "one set of the 6 parameters per trajectory (x0.8-1.2)",
+            "MuJoCo": f"MuJoCo {mujoco.__version__} mujoco.rollout.rollout from the same initial "
+                      "states: its RK4 at the same 1 ms, contacts disabled, no friction (none "
+                      "modelled), the full mj_step pipeline per stage, full-physics state "
+                      "recorded every step; 1 MjData (1 thread) or a list of 2 (its thread "
+                      "pool, 2 threads)"}}
+    print(f"== Ensemble RK4: {count} trolley double-pendulum trajectories, 5 s at 1 ms, "
+          f"ms per trajectory, min / median of {repeats} rounds ==")
+    for r in rows:
+        t, x = r["ms_per_trajectory"], r["vs_ensemble"]
+        print(f"  {r['library']:28s}{t['min']:9.3f}{t['median']:9.3f}  {x['min']:6.2f}x "
+              f"({x['median']:.2f}x) the robodyn ensemble on {r['threads']} thread(s)")
+    print(f"  |q_MuJoCo - q_robodyn| over all trajectories and steps: {agree:.1e} (model: {source})")
     print()
+    if results_path is not None:
+        print(f"figures written to {results.merge(results_path, 'ensemble', entry)}")
 
 
 def bench_pinocchio(quick: bool, results_path: Path | None, command: str) -> None:
@@ -257,26 +279,27 @@ def bench_pinocchio(quick: bool, results_path: Path | None, command: str) -> Non
 
 
 def main() -> None:
+    """Command line: run the chosen sections, merge their figures into the results file."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer states and trajectories")
     parser.add_argument("--only", choices=("pinocchio", "kernels", "ensemble"), action="append",
                         help="run only these sections (repeatable; default: all)")
     parser.add_argument("--results", type=Path, default=None,
-                        help="results file for the Pinocchio figures (default: "
-                             "benchmarks/results/<machine>.json on full runs, none with --quick)")
+                        help="results file (default: benchmarks/results/<machine>.json on full "
+                             "runs, none with --quick)")
     parser.add_argument("--no-results", action="store_true", help="write no results file")
     args = parser.parse_args()
     sections = set(args.only or ("pinocchio", "kernels", "ensemble"))
-    path = args.results or (None if args.quick else results.default_path())
+    path = None if args.no_results else (
+        args.results or (None if args.quick else results.default_path()))
+    command = " ".join(["python benchmarks/bench_kernels.py", *(["--quick"] if args.quick else []),
+                        *(f"--only {x}" for x in args.only or ())])
     if "pinocchio" in sections:
-        command = " ".join(["python benchmarks/bench_kernels.py", *(["--quick"] if args.quick else []),
-                            *(f"--only {x}" for x in args.only or ())])
-        bench_pinocchio(args.quick, None if args.no_results else path, command)
+        bench_pinocchio(args.quick, path, command)
     if "kernels" in sections:
-        bench_kernels(args.quick)
+        bench_kernels(args.quick, path, command)
     if "ensemble" in sections:
-        bench_ensemble(args.quick)
-
+        bench_ensemble(args.quick, path, command)
 
 if __name__ == "__main__":
     main()

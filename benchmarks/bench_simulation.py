@@ -1,12 +1,18 @@
 """Simulation speed against peers measured in the same run.
 
-Prints:
+Prints (and, on full runs, merges into ``benchmarks/results/<machine>.json`` as benchmark
+``simulation``: ``trolley``, ``puma`` and ``compile``):
   1. The thesis' benchmark (Table 3.1): the trolley with a double inverted pendulum, 5 s of
-     motion under its own weight, RK4 at 1 ms: robodyn (generated C, one call) against MuJoCo
-     stepping the same system (its own RK4 at 1 ms, looped from Python and with
-     ``mujoco.rollout`` in C) and against the usual Python route, SciPy ``solve_ivp`` over SymPy
-     ``lambdify`` of the equations (targets: >= 5x MuJoCo, >= 100x solve_ivp + lambdify); the
-     thesis' CPU seconds beside ours, for the record.
+     motion under its own weight, RK4 at 1 ms: robodyn (generated C, one call; and
+     ``rd.simulate``) against MuJoCo stepping the same system (its own RK4 at 1 ms, contacts
+     disabled, looped from Python with ``mj_step`` and with ``mujoco.rollout`` in C), against
+     the usual Python route, SciPy ``solve_ivp`` RK45 over SymPy ``lambdify`` of the equations,
+     against SciPy at its best, ``solve_ivp`` DOP853 over robodyn's compiled
+     ``Model.state_derivative`` (``scipy_peer.py``; both at matched accuracy: the loosest
+     tolerance of a sweep whose error against a DOP853 rtol 1e-13 reference is within 2x of
+     robodyn's), and against a Python RK4 loop over ``lambdify`` (targets: >= 5x MuJoCo,
+     >= 100x solve_ivp + lambdify). Rows timed in turns, min / median over the rounds; the
+     thesis' CPU seconds printed for the record.
   2. PUMA 560 batched kernels on 10^5 states (inverse dynamics, mass matrix, gravity, C qd,
      forward dynamics), ns per state, robodyn on one thread, against Pinocchio's rnea / crba /
      computeGeneralizedGravity / rnea without gravity at qdd = 0 / aba looped from Python (the
@@ -14,10 +20,12 @@ Prints:
      ``rneaInParallel`` / ``abaInParallel`` on ONE thread (a batch call with no Python per state:
      the like-for-like comparison) and on all cores. Not identical work: robodyn's tau includes
      the joint friction (viscous and Coulomb) of the PUMA description, Pinocchio's rnea does not;
-     robodyn's C is compiled for this CPU (``-O3 -march=native``), Pinocchio is the installed wheel.
-  3. Time to generate and compile the PUMA 560 model from scratch (fresh cache).
+     robodyn's C is compiled for this CPU (``-O3 -march=native``), Pinocchio is the installed
+     wheel (``bench_kernels.py`` compares against Pinocchio compiled natively).
+  3. Time to generate and compile the PUMA 560 model from scratch (fresh cache), one run.
 
-Run: ``.venv/bin/python benchmarks/bench_simulation.py [--quick]``.
+Run: ``.venv/bin/python benchmarks/bench_simulation.py [--quick] [--results PATH | --no-results]``
+(``--quick``: 3 rounds, 10,000 PUMA states; written only with ``--results``).
 """
 
 from __future__ import annotations
@@ -27,16 +35,21 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 import warnings
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import sympy as sp
-from peers import lambdified_rhs, pinocchio_loop  # noqa: E402
-from timing import best_of  # noqa: E402
 
 import robodyn as rd
-from robodyn.simulate import simulate
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import results  # noqa: E402
+import scipy_peer  # noqa: E402
+import timing  # noqa: E402
+from peers import lambdified_rhs, pinocchio_loop  # noqa: E402
 
 #: The thesis' Table 3.1 (CPU s for 5 s of the trolley double pendulum, 1990s workstations) and the a2m
 #: MEX figure from the text of section 3.7.
@@ -79,26 +92,27 @@ def trolley_mjcf(robot: rd.Robot) -> tuple[str, str]:
     return text, "hand-written MJCF (robodyn.export.mjcf not importable)"
 
 
-def bench_trolley(quick: bool) -> None:
-    import mujoco
-    from scipy.integrate import solve_ivp
+def _mujoco_trolley(robot: rd.Robot, q0: np.ndarray, steps: int,
+                    ) -> tuple[dict[str, Callable[[], Any]], np.ndarray, str]:
+    """MuJoCo's two routes for the trolley: a Python loop over ``mj_step`` and ``rollout``.
 
-    robot = rd.load("trolley_double_pendulum")
-    model = rd.compile_model(robot)
-    q0 = np.array([0.0, 0.3, -0.2])
-    x0 = np.concatenate([q0, np.zeros(3)])
-    steps, dt = 5000, 1e-3
-    print("== 1. Trolley + double inverted pendulum (thesis Fig. 3.1), 5 s, RK4 at 1 ms ==")
-    t_c = best_of(lambda: model.integrate(x0, steps, dt, "rk4"), 20)
-    t_sim = best_of(lambda: simulate(model, q0, None, 5.0, dt, "rk4"), 5)
-    print(f"robodyn  Model.integrate (one C call)          {t_c * 1e3:9.3f} ms")
-    print(f"robodyn  rd.simulate (+ qdd, energy, result)   {t_sim * 1e3:9.3f} ms")
+    Returns
+    -------
+    fns : dict
+        Row label to a callable running the 5 s.
+    x : ndarray (steps, 6)
+        MuJoCo's state (qpos, qvel) after each step (from ``rollout``).
+    source : str
+        Where the MJCF came from.
+    """
+    import mujoco
+    from mujoco import rollout
 
     xml, source = trolley_mjcf(robot)
     mj = mujoco.MjModel.from_xml_string(xml)
     data = mujoco.MjData(mj)
 
-    def mj_loop():
+    def mj_loop() -> None:
         mujoco.mj_resetData(mj, data)
         data.qpos[:] = q0
         for _ in range(steps):
@@ -106,69 +120,136 @@ def bench_trolley(quick: bool) -> None:
 
     mujoco.mj_resetData(mj, data)
     data.qpos[:] = q0
-    check = 500
-    ref, _ = model.integrate(x0, check, dt, "rk4")
-    mj_q = np.empty((check, 3))
-    for k in range(check):
-        mujoco.mj_step(mj, data)
-        mj_q[k] = data.qpos
-    agree = np.max(np.abs(mj_q - ref[1:, :3]))
-    t_mj = best_of(mj_loop, 3)
-    print(f"MuJoCo {mujoco.__version__} mj_step loop from Python       {t_mj * 1e3:9.3f} ms   "
-          f"(model: {source}; |q_mujoco - q_robodyn| over 0.5 s = {agree:.1e} rad)")
-    t_roll = None
-    try:
-        from mujoco import rollout
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state0 = np.empty(mujoco.mj_stateSize(mj, spec))
+    mujoco.mj_getState(mj, data, state0, spec)
+    states, _ = rollout.rollout(mj, data, state0[None], nstep=steps)
+    fns = {"MuJoCo mj_step loop": mj_loop,
+           "MuJoCo rollout": lambda: rollout.rollout(mj, data, state0[None], nstep=steps)}
+    return fns, states[0, :, 1:1 + 2 * len(q0)], source
 
-        mujoco.mj_resetData(mj, data)
-        data.qpos[:] = q0
-        spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-        state0 = np.empty(mujoco.mj_stateSize(mj, spec))
-        mujoco.mj_getState(mj, data, state0, spec)
-        rollout.rollout(mj, data, state0[None], nstep=steps)
-        t_roll = best_of(lambda: rollout.rollout(mj, data, state0[None], nstep=steps), 5)
-        print(f"MuJoCo mujoco.rollout (C loop)                 {t_roll * 1e3:9.3f} ms")
-    except (ImportError, AttributeError, TypeError) as exc:
-        print(f"MuJoCo rollout unavailable: {exc}")
 
-    # accuracy: every result against DOP853 at rtol 1e-13 on the compiled model
-    ref = simulate(model, q0, None, 5.0, dt, "DOP853", rtol=1e-13, atol=1e-13).x
-    x_c, _ = model.integrate(x0, steps, dt, "rk4")
-    print(f"  robodyn RK4 1 ms: max |x - x_ref| over the 5 s = {np.max(np.abs(x_c - ref)):.1e} "
-          f"(chaotic motion: errors grow with time)")
-    rhs = lambdified_rhs(robot)
-    t_eval = np.arange(steps + 1) * dt
-    ivp = {}
-    # rtol 1e-8 is about the accuracy of robodyn's RK4 at 1 ms on this chaotic motion
-    for rtol in ((1e-6, 1e-8, 1e-9) if quick else (1e-3, 1e-6, 1e-8, 1e-9)):
-        start = time.perf_counter()
-        sol = solve_ivp(rhs, (0.0, 5.0), x0, method="RK45", t_eval=t_eval, rtol=rtol, atol=rtol * 1e-2)
-        ivp[rtol] = time.perf_counter() - start
-        err = np.max(np.abs(sol.y.T - ref))
-        print(f"SciPy solve_ivp RK45 + lambdify, rtol {rtol:.0e}   {ivp[rtol] * 1e3:9.1f} ms   "
-              f"({sol.nfev} rhs calls, max |x - x_ref| = {err:.1e}; {ivp[rtol] / t_c:5.0f}x robodyn)")
-    start = time.perf_counter()
-    x = x0.copy()
-    for _ in range(steps):
+def _python_rk4(rhs: Callable[[float, np.ndarray], np.ndarray], x0: np.ndarray, steps: int,
+                dt: float) -> np.ndarray:
+    """RK4 at a fixed step in a Python loop over ``rhs``: the trajectory (steps + 1, n)."""
+    xs = np.empty((steps + 1, len(x0)))
+    xs[0] = x = x0.copy()
+    for k in range(steps):
         k1 = rhs(0, x)
         k2 = rhs(0, x + dt / 2 * k1)
         k3 = rhs(0, x + dt / 2 * k2)
         k4 = rhs(0, x + dt * k3)
-        x = x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-    t_py_rk4 = time.perf_counter() - start
-    print(f"Python RK4 loop at 1 ms + lambdify             {t_py_rk4 * 1e3:9.1f} ms   "
-          f"(same scheme as robodyn: |x - x_robodyn| at 5 s = {np.max(np.abs(x - x_c[-1])):.1e})")
-    print("ratios (robodyn one call):")
-    print(f"  vs MuJoCo mj_step loop      {t_mj / t_c:8.1f}x   (target >= 5x)")
-    if t_roll is not None:
-        print(f"  vs MuJoCo rollout           {t_roll / t_c:8.1f}x   (target >= 5x)")
-    for rtol, t_ivp in ivp.items():
-        print(f"  vs solve_ivp + lambdify     {t_ivp / t_c:8.0f}x   (rtol {rtol:.0e}; target >= 100x)")
-    print(f"  vs Python RK4 + lambdify    {t_py_rk4 / t_c:8.0f}x")
+        xs[k + 1] = x = x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return xs
+
+
+def bench_trolley(quick: bool) -> dict[str, Any]:
+    """The thesis' trolley benchmark against MuJoCo and SciPy; the ``trolley`` results entry.
+
+    Parameters
+    ----------
+    quick : bool
+        3 rounds instead of 5.
+
+    Returns
+    -------
+    dict
+        ``rows`` (label, ms min/median, max error against the reference, settings), ratios to
+        ``Model.integrate``, the two SciPy sweeps, robodyn's error and the reference's check.
+    """
+    robot = rd.load("trolley_double_pendulum")
+    model = rd.compile_model(robot)
+    q0 = np.array([0.0, 0.3, -0.2])
+    x0 = np.concatenate([q0, np.zeros(3)])
+    steps, dt, repeats = 5000, 1e-3, (3 if quick else 5)
+    t_eval = np.arange(steps + 1) * dt
+    print("== 1. Trolley + double inverted pendulum (thesis Fig. 3.1), 5 s, RK4 at 1 ms ==")
+    # reference: DOP853 at rtol = atol = 1e-13 on the compiled model, checked against RK4 at dt / 20
+    ref = rd.simulate(model, q0, None, 5.0, dt, "DOP853", rtol=1e-13, atol=1e-13).x
+    check = float(np.max(np.abs(model.integrate(x0, 20 * steps, dt / 20, "rk4")[0][::20] - ref)))
+    err_rd = float(np.max(np.abs(model.integrate(x0, steps, dt, "rk4")[0] - ref)))
+    print(f"reference: DOP853 rtol = atol = 1e-13 (compiled model); RK4 at {dt / 20:g} s differs "
+          f"by {check:.1e}; robodyn RK4 at 1 ms: max |x - x_ref| over 5 s = {err_rd:.1e} "
+          "(chaotic motion: errors grow with time)")
+    target = scipy_peer.MATCH_FACTOR * err_rd
+    lamb = lambdified_rhs(robot)
+    sweeps = {}
+    for label, rhs, method in (("RK45 + lambdify", lamb, "RK45"),
+                               ("DOP853 + compiled RHS", scipy_peer.compiled_rhs(model), "DOP853")):
+        trials, matched = scipy_peer.sweep(rhs, method, x0, t_eval, ref, target, label=label)
+        sweeps[label] = scipy_peer.sweep_record(trials, matched, method, label.split(" + ")[1],
+                                                target)
+        sweeps[label]["run"] = (rhs, *scipy_peer.timed_setting(trials, matched))
+    fns, mj_x, source = _mujoco_trolley(robot, q0, steps)
+    fns = {"robodyn Model.integrate": lambda: model.integrate(x0, steps, dt, "rk4"),
+           "robodyn rd.simulate": lambda: rd.simulate(model, q0, None, 5.0, dt, "rk4"), **fns}
+    errors = {"robodyn Model.integrate": err_rd, "robodyn rd.simulate": err_rd,
+              "MuJoCo mj_step loop": float(np.max(np.abs(mj_x - ref[1:])))}
+    errors["MuJoCo rollout"] = errors["MuJoCo mj_step loop"]
+    for label, s in sweeps.items():
+        rhs, timed, _ = s.pop("run")
+        fns[f"SciPy {label}"] = scipy_peer.solver(rhs, s["method"], x0, t_eval, timed.rtol)
+        errors[f"SciPy {label}"] = timed.max_error
+    fns["Python RK4 loop + lambdify"] = lambda: _python_rk4(lamb, x0, steps, dt)
+    errors["Python RK4 loop + lambdify"] = float(np.max(np.abs(_python_rk4(lamb, x0, steps, dt) - ref)))
+    times = timing.interleaved(fns, repeats)
+    rows = _trolley_rows(times, errors, sweeps, source)
+    entry = {"steps": steps, "dt": dt, "repeats": repeats, "robodyn_error": err_rd,
+             "reference": "DOP853 rtol = atol = 1e-13 on robodyn's compiled model",
+             "reference_vs_rk4_dt_over_20": check, "match_factor": scipy_peer.MATCH_FACTOR,
+             "rows": rows, "sweeps": sweeps, "mujoco_model": source,
+             # the issue's targets: robodyn's one call at least this many times faster
+             "targets": {"MuJoCo mj_step loop": 5.0, "MuJoCo rollout": 5.0,
+                         "SciPy RK45 + lambdify": 100.0}}
+    _print_trolley(entry)
+    return entry
+
+
+def _trolley_rows(times: dict[str, list[float]], errors: dict[str, float],
+                  sweeps: dict[str, dict[str, Any]], source: str) -> list[dict[str, Any]]:
+    """Rows of the trolley entry: times, errors, ratio to ``Model.integrate``, what differs."""
+    import mujoco
+
+    settings = {
+        "robodyn Model.integrate": "RK4 at 1 ms in robodyn's generated C, one call, the state "
+                                   "and torque recorded every step",
+        "robodyn rd.simulate": "the same call, plus qdd, energy and the Trajectory result",
+        "MuJoCo mj_step loop": f"MuJoCo {mujoco.__version__}: its RK4 at 1 ms, contacts disabled, "
+                               "the full mj_step pipeline, one mj_step per step from a Python "
+                               f"loop, nothing recorded (model: {source})",
+        "MuJoCo rollout": "the same model stepped by mujoco.rollout (its C loop, 1 thread), "
+                          "full-physics state recorded every step",
+        "Python RK4 loop + lambdify": "the same RK4 at 1 ms as robodyn, written in Python over "
+                                      "lambdify (M, h; np.linalg.solve per call)",
+    }
+    for label, s in sweeps.items():
+        rhs = ("sympy.lambdify of robodyn's own M(q), h(q, qd) and np.linalg.solve per call"
+               if s["rhs"] == "lambdify" else
+               "robodyn's compiled Model.state_derivative, one state per call from Python")
+        trial = scipy_peer.Trial(**s["timed"])
+        settings[f"SciPy {label}"] = (
+            f"{scipy_peer.describe(s['method'], trial, s['matched'] is not None)}: {rhs}")
+    base = times["robodyn Model.integrate"]
+    rows = []
+    for name, t in times.items():
+        rows.append({"label": name, "ms": results.summary(t, 1e3, 3),
+                     "max_error": errors[name], "vs_integrate": results.ratio(t, base, 1),
+                     "settings": settings[name]})
+    return rows
+
+
+def _print_trolley(entry: dict[str, Any]) -> None:
+    """Print the trolley rows: ms min / median, error, ratio to ``Model.integrate``."""
+    print(f"{'':34s}{'min ms':>9s}{'median':>9s}{'max err':>10s}  time / Model.integrate")
+    for r in entry["rows"]:
+        print(f"  {r['label']:32s}{r['ms']['min']:9.3f}{r['ms']['median']:9.3f}"
+              f"{r['max_error']:10.1e}  {r['vs_integrate']['min']:7.1f}x "
+              f"({r['vs_integrate']['median']:.1f}x)")
+    for r in entry["rows"]:
+        print(f"  {r['label']}: {r['settings']}")
     print("thesis Table 3.1, CPU seconds for the same 5 s (1990s hardware, for the record only):")
     for name, secs in THESIS_TABLE_3_1.items():
         print(f"  {name:24s}{secs:10.2f} s")
-    print(f"  {'robodyn (this machine)':24s}{t_c:10.5f} s")
     print()
 
 
@@ -219,25 +300,35 @@ def _pinocchio_from_robot(robot: rd.Robot):
     return model
 
 
-def bench_puma(quick: bool) -> None:
+def bench_puma(quick: bool) -> dict[str, Any]:
+    """PUMA 560 kernels against Pinocchio's wheel from Python; the ``puma`` results entry.
+
+    Parameters
+    ----------
+    quick : bool
+        10,000 states and 3 rounds instead of 100,000 and 5.
+
+    Returns
+    -------
+    dict
+        ``rows``: per kernel, ns per state (min/median) of robodyn, of the Pinocchio loop, of
+        the loop minus the Python loop's own cost, and of ``*InParallel`` on 1 and all threads.
+    """
     import pinocchio as pin
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         robot = rd.load("puma560")
     model = rd.compile_model(robot)
-    n_states = 10_000 if quick else 100_000
+    n_states, repeats = (10_000, 3) if quick else (100_000, 5)
     rng = np.random.default_rng(0)
     q, qd, qdd = rng.uniform(-np.pi, np.pi, (3, n_states, 6))
     tau = model.inverse_dynamics(q, qd, qdd)
     print(f"== 2. PUMA 560 kernels, {n_states} states (ns per state) ==")
-    ours = {
-        "inverse dynamics": best_of(lambda: model.inverse_dynamics(q, qd, qdd), 5),
-        "mass matrix": best_of(lambda: model.mass_matrix(q), 5),
-        "gravity": best_of(lambda: model.gravity(q), 5),
-        "coriolis C qd": best_of(lambda: model.coriolis(q, qd), 5),
-        "forward dynamics": best_of(lambda: model.forward_dynamics(q, qd, tau), 5),
-    }
+    ours = {"inverse dynamics": lambda: model.inverse_dynamics(q, qd, qdd),
+            "mass matrix": lambda: model.mass_matrix(q), "gravity": lambda: model.gravity(q),
+            "coriolis C qd": lambda: model.coriolis(q, qd),
+            "forward dynamics": lambda: model.forward_dynamics(q, qd, tau)}
     pmodel, source = pinocchio_puma(robot)
     pdata = pmodel.createData()
     # C(q, qd) qd is Pinocchio's RNEA at qdd = 0 without gravity
@@ -246,7 +337,7 @@ def bench_puma(quick: bool) -> None:
     pdata_c = pmodel_c.createData()
     zero = np.zeros(6)
 
-    def pin_coriolis(_model, _data, qk, qdk):
+    def pin_coriolis(_model: Any, _data: Any, qk: np.ndarray, qdk: np.ndarray) -> np.ndarray:
         return pin.rnea(pmodel_c, pdata_c, qk, qdk, zero)
 
     # same model? M (rotor inertia included), g and C qd against Pinocchio at a few states
@@ -259,54 +350,90 @@ def bench_puma(quick: bool) -> None:
           f"|g - g_pin| = {dg:.1e}, |C qd - (C qd)_pin| = {dc:.1e}")
     loops = min(n_states, 20_000)
 
-    def loop(fn, *arrays):
+    def loop(fn: Callable[..., Any], *arrays: np.ndarray) -> Callable[[], None]:
         return pinocchio_loop(fn, pmodel, pdata, loops, *arrays)
 
-    theirs = {
-        "inverse dynamics": best_of(loop(pin.rnea, q, qd, qdd), 3) * n_states / loops,
-        "mass matrix": best_of(loop(pin.crba, q), 3) * n_states / loops,
-        "gravity": best_of(loop(pin.computeGeneralizedGravity, q), 3) * n_states / loops,
-        "coriolis C qd": best_of(loop(pin_coriolis, q, qd), 3) * n_states / loops,
-        "forward dynamics": best_of(loop(pin.aba, q, qd, tau), 3) * n_states / loops,
-    }
-    # the Python loop alone: the same iteration and indexing around a call that does nothing
-    def nothing(_model, _data, *_states):
-        return None
-
-    overhead = best_of(loop(nothing, q, qd, qdd), 3) * n_states / loops
-    one, parallel = {}, {}
+    theirs = {"inverse dynamics": loop(pin.rnea, q, qd, qdd), "mass matrix": loop(pin.crba, q),
+              "gravity": loop(pin.computeGeneralizedGravity, q),
+              "coriolis C qd": loop(pin_coriolis, q, qd),
+              "forward dynamics": loop(pin.aba, q, qd, tau),
+              # the Python loop alone: the same iteration and indexing around a no-op
+              "python loop": loop(lambda *_: None, q, qd, qdd)}
     threads = os.cpu_count() or 1
-    if hasattr(pin, "rneaInParallel"):
-        qt, qdt, qddt, taut = (np.asfortranarray(a.T) for a in (q, qd, qdd, tau))
-        out = np.empty((6, n_states), order="F")
-        for k, into in ((1, one), (threads, parallel)):
-            pool = pin.ModelPool(pmodel, k)
-            into["inverse dynamics"] = best_of(
-                lambda k=k, pool=pool: pin.rneaInParallel(k, pool, qt, qdt, qddt, out), 5)
-            into["forward dynamics"] = best_of(
-                lambda k=k, pool=pool: pin.abaInParallel(k, pool, qt, qdt, taut, out), 5)
-    print("robodyn: one thread, C compiled with -O3 -march=native, tau includes joint friction; "
-          "Pinocchio: installed wheel, rigid body + armature (no friction)")
-    print(f"pin loop = Pinocchio called once per state from Python; {overhead / n_states * 1e9:.0f} ns "
-          "of each call is the Python loop itself (measured around a no-op), included in 'loop ratio'")
-    print(f"pin 1 thr / pin {threads} thr = rneaInParallel / abaInParallel on 1 / {threads} threads "
-          "(one call for the whole batch)")
+    qt, qdt, qddt, taut = (np.asfortranarray(a.T) for a in (q, qd, qdd, tau))
+    out = np.empty((6, n_states), order="F")
+    batch = {}
+    for k in (1, threads):
+        pool = pin.ModelPool(pmodel, k)
+        batch[f"inverse dynamics {k}"] = (
+            lambda k=k, pool=pool: pin.rneaInParallel(k, pool, qt, qdt, qddt, out))
+        batch[f"forward dynamics {k}"] = (
+            lambda k=k, pool=pool: pin.abaInParallel(k, pool, qt, qdt, taut, out))
+    t_ours = timing.interleaved(ours, repeats)
+    t_loop = timing.interleaved(theirs, repeats)
+    t_batch = timing.interleaved(batch, repeats)
+    entry = _puma_entry(t_ours, t_loop, t_batch, n_states, loops, threads, repeats)
+    entry.update(pinocchio=f"{pin.__version__} wheel, model from {source} with armature",
+                 agreement={"M": float(dm), "g": float(dg), "C qd": float(dc)})
+    _print_puma(entry)
+    return entry
+
+
+def _puma_entry(t_ours: dict[str, list[float]], t_loop: dict[str, list[float]],
+                t_batch: dict[str, list[float]], n_states: int, loops: int, threads: int,
+                repeats: int) -> dict[str, Any]:
+    """The ``puma`` entry from the three groups of timings (ns per state, ratios to robodyn)."""
+    ns_loop = results.summary(t_loop["python loop"], 1e9 / loops)
+    rows = []
+    for name, t in t_ours.items():
+        # per state: the loop covers `loops` states, the others all `n_states`
+        loop_t = [x * n_states / loops for x in t_loop[name]]
+        bare = [x - min(t_loop["python loop"]) * n_states / loops for x in loop_t]
+        row = {"kernel": name, "robodyn": results.summary(t, 1e9 / n_states),
+               "pinocchio_loop": results.summary(loop_t, 1e9 / n_states),
+               "loop_ratio": results.ratio(loop_t, t, 1),
+               "minus_loop_ratio": results.ratio(bare, t, 1)}
+        for k, key in ((1, "one_thread"), (threads, "all_threads")):
+            if f"{name} {k}" in t_batch:
+                row[key] = results.summary(t_batch[f"{name} {k}"], 1e9 / n_states)
+                row[key + "_ratio"] = results.ratio(t_batch[f"{name} {k}"], t, 1)
+        rows.append(row)
+    return {"states": n_states, "repeats": repeats, "loop_states": loops, "threads": threads,
+            "python_loop_ns": ns_loop, "rows": rows,
+            "settings": "robodyn: one thread, generated C (-O3 -march=native), tau includes the "
+                        "PUMA's joint friction; Pinocchio: the installed wheel (generic build), "
+                        "rigid body + armature, no friction; 'loop': one call per state from "
+                        "Python (the loop's own cost included; 'minus loop' takes it out); "
+                        f"rneaInParallel / abaInParallel: one call for the batch on 1 and "
+                        f"{threads} threads"}
+
+
+def _print_puma(entry: dict[str, Any]) -> None:
+    """Print the PUMA table (minima; ratios of minima)."""
+    print(entry["settings"])
+    print(f"the Python loop alone: {entry['python_loop_ns']['min']:.0f} ns per call (min)")
+    th = entry["threads"]
     print(f"{'kernel':20s}{'robodyn':>9s}{'pin loop':>10s}{'loop ratio':>12s}{'minus loop':>12s}"
-          f"{'pin 1 thr':>11s}{'ratio':>7s}{f'pin {threads} thr':>12s}{'ratio':>7s}")
-    for name, t in ours.items():
-        ns = t / n_states * 1e9
-        pl = theirs[name] / n_states * 1e9
-        bare = (theirs[name] - overhead) / n_states * 1e9
-        line = f"{name:20s}{ns:9.1f}{pl:10.1f}{pl / ns:11.1f}x{bare / ns:11.1f}x"
-        if name in one:
-            p1, pp = one[name] / n_states * 1e9, parallel[name] / n_states * 1e9
-            line += f"{p1:11.1f}{p1 / ns:6.1f}x{pp:12.1f}{pp / ns:6.1f}x"
+          f"{'pin 1 thr':>11s}{'ratio':>7s}{f'pin {th} thr':>12s}{'ratio':>7s}")
+    for r in entry["rows"]:
+        line = (f"{r['kernel']:20s}{r['robodyn']['min']:9.1f}{r['pinocchio_loop']['min']:10.1f}"
+                f"{r['loop_ratio']['min']:11.1f}x{r['minus_loop_ratio']['min']:11.1f}x")
+        if "one_thread" in r:
+            line += (f"{r['one_thread']['min']:11.1f}{r['one_thread_ratio']['min']:6.1f}x"
+                     f"{r['all_threads']['min']:12.1f}{r['all_threads_ratio']['min']:6.1f}x")
         print(line)
     print()
 
 
 # --- 3. generation + compilation ---------------------------------------------------------------
-def bench_compile() -> None:
+def bench_compile() -> dict[str, float]:
+    """Load, derive, generate and compile the PUMA 560 in a fresh process with an empty cache.
+
+    Returns
+    -------
+    dict
+        ``imports_s``, ``first_s`` and ``cached_s`` (one run each).
+    """
     code = ("import time, warnings; warnings.simplefilter('ignore'); t0 = time.perf_counter(); "
             "import robodyn as rd; t1 = time.perf_counter(); r = rd.load('puma560'); "
             "m = rd.compile_model(r); t2 = time.perf_counter(); "
@@ -320,17 +447,32 @@ def bench_compile() -> None:
                                check=True)
         _, cached = (float(v) for v in again.stdout.split())
     print("== 3. PUMA 560: load + derive + generate + compile C, fresh ROBODYN_CACHE ==")
-    print(f"first time {build:.2f} s (after {imp:.2f} s of imports); from the cache {cached:.2f} s")
+    print(f"first time {build:.2f} s (`import robodyn` before it: {imp:.2f} s); from the cache "
+          f"{cached:.2f} s")
+    return {"imports_s": imp, "first_s": build, "cached_s": cached}
 
 
 def main() -> None:
+    """Command line: run the three parts, merge their figures into the results file."""
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="fewer repetitions and states")
+    parser.add_argument("--results", type=Path, default=None,
+                        help="results file (default: benchmarks/results/<machine>.json on full "
+                             "runs, none with --quick)")
+    parser.add_argument("--no-results", action="store_true", help="write no results file")
     args = parser.parse_args()
-    bench_trolley(args.quick)
-    bench_puma(args.quick)
-    bench_compile()
+    path = None if args.no_results else (
+        args.results or (None if args.quick else results.default_path()))
+    start_load = results.load_average()
+    entry: dict[str, Any] = {"command": " ".join(["python benchmarks/bench_simulation.py",
+                                                  *(["--quick"] if args.quick else [])]),
+                             "load_average_at_start": start_load}
+    entry["trolley"] = bench_trolley(args.quick)
+    entry["puma"] = bench_puma(args.quick)
+    entry["compile"] = bench_compile()
+    if path is not None:
+        print(f"figures written to {results.merge(path, 'simulation', entry)}")
 
 
 if __name__ == "__main__":

@@ -118,7 +118,210 @@ def render_kernels(data: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-RENDERERS: dict[str, Callable[[dict[str, Any]], str]] = {"kernels": render_kernels}
+def _machine(m: dict[str, Any]) -> str:
+    """``"<CPU>, <n> logical CPUs, <SIMD>"`` of the machine record."""
+    simd = "AVX-512F" if "avx512f" in m.get("simd", []) else "/".join(m.get("simd", [])).upper()
+    return f"{m['cpu_model']}, {m['logical_cpus']} logical CPUs, {simd or 'no AVX'}"
+
+
+def _run(data: dict[str, Any], e: dict[str, Any], what: str) -> str:
+    """The sentence opening a section: what ran, the command, the machine, load and date."""
+    quick = " (quick mode)" if "--quick" in e["command"] else ""
+    return (f"{what} (`{e['command']}`{quick}; {_machine(data['machine'])}; load average "
+            f"{' '.join(map(str, e['load_average_at_start']))} at the start and "
+            f"{' '.join(map(str, e['load_average_at_end']))} at the end; {e['date']}).")
+
+
+def _sig(x: float) -> str:
+    """About three significant digits, without exponent (1234, 123, 12.3, 1.23, 0.123)."""
+    return f"{x:.0f}" if x >= 100 else f"{x:.1f}" if x >= 10 else f"{x:.2f}" if x >= 1 else f"{x:.3f}"
+
+
+def _mm(s: dict[str, float]) -> tuple[str, str]:
+    """Min and median cells."""
+    return _sig(s["min"]), _sig(s["median"])
+
+
+def _x(r: dict[str, float], digits: int = 1) -> str:
+    """``"min / median"`` of a ratio."""
+    return f"{r['min']:.{digits}f}x / {r['median']:.{digits}f}x"
+
+
+def _table(header: list[str], rows: list[list[str]], text_last: bool = True) -> list[str]:
+    """A Markdown table: first column left-aligned, the others right-aligned (but the last,
+    with ``text_last``)."""
+    align = ["---"] + ["---:"] * (len(header) - 1 - text_last) + ["---"] * text_last
+    return ([f"| {' | '.join(header)} |", f"|{'|'.join(align)}|"]
+            + [f"| {' | '.join(r)} |" for r in rows])
+
+
+def render_casadi(data: dict[str, Any]) -> str:
+    """Markdown of the ``casadi`` entry (and of ``threads`` when the file has it)."""
+    e = data["benchmarks"]["casadi"]
+    lines = _wrap(_run(data, e, (
+        f"PUMA 560 inverse dynamics against CasADi {e['casadi_version']}-generated C of the same "
+        f"program, {e['states']:,} random states, ns per state, min / median of {e['repeats']} "
+        "rounds in which the rows take turns")) + (
+        " Both sides evaluate robodyn's recorded Newton-Euler program of the PUMA as described "
+        f"(viscous and Coulomb friction; CasADi counts {e['instructions']['one state']} SX "
+        f"instructions per state), CasADi's C compiled with robodyn's flags "
+        f"`{' '.join(e['flags'])}`. Speed-up = the row's time / robodyn's on as many threads."))
+    ratio = {r["peer"]: r for r in e["ratios"]}
+    rows = []
+    for r in e["rows"]:
+        err = r["max_rel_error"]
+        speed = _x(ratio[r["library"]]) if r["library"] in ratio else ""
+        rows.append([r["library"], str(r["threads"]), *_mm(r["ns_per_state"]), speed,
+                     "reference" if err is None else f"{err:.1e}", r["note"]])
+    lines += [""] + _table(["evaluation", "threads", "min", "median",
+                            "robodyn's speed-up (min / median)", "max rel. error", "what differs"],
+                           rows)
+    if "threads" in data["benchmarks"]:
+        lines += [""] + _wrap(_threads_text(data))
+    return "\n".join(lines) + "\n"
+
+
+def _threads_text(data: dict[str, Any]) -> str:
+    """The sentence on two-thread efficiencies and the mass matrix against ``crba``."""
+    t = data["benchmarks"]["threads"]
+    ns, eff, m = t["ns_per_state"], t["efficiency"], t["mass_matrix_vs_crba"]
+    effs = "; ".join(f"{k} {v:.2f}" for k, v in eff.items())
+    return (_run(data, t, f"Two threads and the mass matrix, {t['states']:,} states, min of "
+                          f"{t['repeats']} rounds") +
+            f" Two-thread efficiency t1 / (2 t2): {effs} (robodyn: {t['peers']['robodyn']}; "
+            f"Pinocchio: {t['peers']['pinocchio wheel']}; the logical CPUs may be shared with "
+            f"other jobs, which the two-thread figures feel first). Mass matrix: robodyn "
+            f"{_fmt(ns['robodyn M 1']['min'])} ns per state against `crba` from a Python loop "
+            f"{_fmt(ns['crba loop']['min'])} ns ({m['with_loop']:.1f}x), of which the loop "
+            f"itself {_fmt(ns['python loop']['min'])} ns ({m['minus_loop']:.1f}x without it).")
+
+
+def render_ensemble(data: dict[str, Any]) -> str:
+    """Markdown of the ``ensemble`` entry."""
+    e = data["benchmarks"]["ensemble"]
+    lines = _wrap(_run(data, e, (
+        f"Ensemble RK4: {e['trajectories']:,} trolley double-pendulum trajectories of "
+        f"{e['steps'] * e['dt']:g} s at {e['dt'] * 1e3:g} ms, ms per trajectory, min / median of "
+        f"{e['repeats']} rounds in which the rows take turns")) + (
+        " Ratio = the row's time / robodyn's ensemble on as many threads; MuJoCo and robodyn "
+        f"agree to {e['mujoco_agreement_rad']:.1e} rad over all trajectories and steps."))
+    rows = [[r["library"], str(r["threads"]), *_mm(r["ms_per_trajectory"]),
+             _x(r["vs_ensemble"], 2)] for r in e["rows"]]
+    lines += [""] + _table(["run", "threads", "min", "median", "ratio (min / median)"], rows,
+                           text_last=False)
+    lines += ["", "What each row is and differs in:", ""]
+    for k, v in e["peers"].items():
+        lines += _wrap(f"{k}: {v}.", bullet=True)
+    return "\n".join(lines) + "\n"
+
+
+def _sweeps_text(sweeps: dict[str, dict[str, Any]]) -> str:
+    """One sentence per SciPy sweep: rtol, error and time of each trial (one run each)."""
+    parts = []
+    for label, s in sweeps.items():
+        trials = ", ".join(f"{t['rtol']:.0e}: {t['max_error']:.1e} in {_fmt(t['ms'])} ms"
+                           for t in s["trials"])
+        parts.append(f"{label} (rtol: max error in one run) {trials}")
+        if s["matched"] is None:
+            parts[-1] += " (none within the target: the most accurate is timed)"
+    return "SciPy's sweeps, loose to tight until the error is within the target: " + \
+        "; ".join(parts) + "."
+
+
+def _route_table(rows: list[dict[str, Any]], key: str, targets: dict[str, float],
+                 digits: int = 2) -> list[str]:
+    """Table of a simulation entry: times, error, ratio, target (if any), what differs."""
+    header = ["route", "min ms", "median ms", "max error", "ratio (min / median)",
+              *(["target"] if targets else []), "what differs"]
+    out = []
+    for r in rows:
+        cells = [r["label"], f"{r['ms']['min']:.{digits}f}", f"{r['ms']['median']:.{digits}f}",
+                 f"{r['max_error']:.1e}", _x(r[key])]
+        if targets:
+            goal = targets.get(r["label"])
+            met = goal is not None and r[key]["min"] >= goal
+            cells.append("" if goal is None else f">= {goal:g}x: {'met' if met else 'not met'}")
+        out.append([*cells, r["settings"]])
+    return _table(header, out)
+
+
+def render_simulation(data: dict[str, Any]) -> str:
+    """Markdown of the ``simulation`` entry: trolley, PUMA kernels, generation time."""
+    e = data["benchmarks"]["simulation"]
+    t = e["trolley"]
+    lines = _wrap(_run(data, e, (
+        f"The thesis' trolley double pendulum, {t['steps'] * t['dt']:g} s of motion, ms per run, "
+        f"min / median of {t['repeats']} rounds in which the rows take turns")) + (
+        f" Max error: over the whole state and every 1 ms against {t['reference']} (which "
+        f"differs from RK4 at 0.05 ms by {t['reference_vs_rk4_dt_over_20']:.1e}); the motion "
+        f"is chaotic, so errors grow with time. Each SciPy route runs at the loosest tolerance "
+        f"whose error is within {t['match_factor']:g}x robodyn's ({t['robodyn_error']:.1e}). "
+        "Ratio = the row's time / `Model.integrate`'s; targets judged on the minima."))
+    lines += [""] + _route_table(t["rows"], "vs_integrate", t["targets"], 3)
+    lines += [""] + _wrap(_sweeps_text(t["sweeps"]))
+    p = e["puma"]
+    lines += [""] + _wrap(
+        f"PUMA 560 kernels against Pinocchio's wheel called from Python ({p['states']:,} states, "
+        f"ns per state, minima of {p['repeats']} rounds; ratios of minima; the Python loop "
+        f"alone costs {_fmt(p['python_loop_ns']['min'])} ns per call). {p['settings']}.")
+    th = p["threads"]
+    rows = []
+    for r in p["rows"]:
+        cells = [r["kernel"], _fmt(r["robodyn"]["min"]), _fmt(r["pinocchio_loop"]["min"]),
+                 f"{r['loop_ratio']['min']:.1f}x", f"{r['minus_loop_ratio']['min']:.1f}x"]
+        for key in ("one_thread", "all_threads"):
+            cells += ([_fmt(r[key]["min"]), f"{r[key + '_ratio']['min']:.1f}x"] if key in r
+                      else ["", ""])
+        rows.append(cells)
+    lines += [""] + _table(["kernel", "robodyn", "Pinocchio loop", "ratio", "minus the loop",
+                            "*InParallel 1 thread", "ratio", f"{th} threads", "ratio"], rows,
+                           text_last=False)
+    c = e["compile"]
+    lines += [""] + _wrap(
+        f"Generating and compiling the PUMA 560 model in a fresh process with an empty cache "
+        f"(one run): {c['first_s']:.2f} s; from the cache: {c['cached_s']:.2f} s.")
+    return "\n".join(lines) + "\n"
+
+
+def render_hydro(data: dict[str, Any]) -> str:
+    """Markdown of the ``hydro`` entry: wet/dry cost, drag against strip sums, simulation."""
+    e = data["benchmarks"]["hydro"]
+    lines = _wrap(_run(data, e, "The underwater two-link arm `underwater_2r`"))
+    if "wet_dry" in e:
+        w = e["wet_dry"]
+        ns, r = w["ns_per_state"], w["ratio"]
+        lines += [""] + _wrap(
+            f"Compiled inverse dynamics with every hydrodynamic term against the same arm dry "
+            f"({w['states']:,} states, min / median of {w['repeats']} rounds): "
+            f"{_fmt(ns['ID wet']['min'])} against {_fmt(ns['ID dry']['min'])} ns per state, "
+            f"{_x(r['ID'], 2)} the cost (target at most {w['target']:g}x: "
+            f"{'met' if r['ID']['min'] <= w['target'] else 'not met'}); forward dynamics "
+            f"{_x(r['FD'], 2)}.")
+    if "drag" in e:
+        d = e["drag"]
+        lines += [""] + _wrap(
+            f"Drag with a {d['current_m_s']:g} m/s current, {d['states']:,} states, min / median "
+            f"of {d['repeats']} rounds: {d['settings']}.")
+        rows = [[r["label"], *_mm(r["ns_per_state"]), f"{r['max_error']:.1e}", _x(r["vs_robodyn"])]
+                for r in d["rows"]]
+        lines += [""] + _table(["drag by", "min ns", "median ns", "max error", "time / robodyn"],
+                               rows, text_last=False)
+    s = e["simulation"]
+    lines += [""] + _wrap(
+        f"{s['steps'] * s['dt']:g} s released from rest, every effect on, min / median of "
+        f"{s['repeats']} rounds in which the rows take turns; max error over the whole state "
+        f"against {s['reference']} (which differs from SciPy DOP853 at rtol 1e-12 by "
+        f"{s['reference_vs_dop853_1e-12']:.1e}); each SciPy route at the loosest tolerance "
+        f"whose error is within 2x robodyn's ({s['robodyn_error']:.1e}). Ratio = the row's "
+        "time / `rd.simulate`'s.")
+    lines += [""] + _route_table(s["rows"], "vs_simulate", {})
+    lines += [""] + _wrap(_sweeps_text(s["sweeps"]))
+    return "\n".join(lines) + "\n"
+
+
+RENDERERS: dict[str, Callable[[dict[str, Any]], str]] = {
+    "kernels": render_kernels, "casadi": render_casadi, "ensemble": render_ensemble,
+    "simulation": render_simulation, "hydro": render_hydro}
 
 
 def render(text: str, root: Path = ROOT, results: str | None = None) -> str:

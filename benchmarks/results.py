@@ -94,6 +94,24 @@ def summary(seconds: Sequence[float], scale: float = 1.0, digits: int = 1) -> di
             "repeats": len(seconds)}
 
 
+def ratio(seconds: Sequence[float], reference: Sequence[float], digits: int = 2,
+          ) -> dict[str, float]:
+    """How many times ``reference`` the repeated timings ``seconds`` take.
+
+    Parameters
+    ----------
+    seconds, reference : sequence of float
+        Wall times of the repeats of a row and of the row it is compared with (the same rounds).
+
+    Returns
+    -------
+    dict
+        ``{"min": min(seconds) / min(reference), "median": median / median}``, rounded.
+    """
+    return {"min": round(min(seconds) / min(reference), digits),
+            "median": round(statistics.median(seconds) / statistics.median(reference), digits)}
+
+
 def simd() -> list[str]:
     """The vector instruction sets among AVX, AVX2, FMA and AVX-512F that the CPU reports."""
     try:
