@@ -42,10 +42,12 @@ from sympy.printing.c import C99CodePrinter
 
 from robodyn.codegen.base import GeneratedFile, Printer, identifier
 from robodyn.codegen.c_outputs import STREAM_MIN_BYTES, copy_out_source, output_lines, staged_outputs
+from robodyn.codegen.cpu import block_width
 from robodyn.codegen.kernels import Argument, Kernel, KernelSet
 
-#: States per block of the batch functions (one vector loop evaluates the block's sines/cosines).
-BLOCK = 16
+#: States per block of the batch functions (one vector loop evaluates the block's sines/cosines):
+#: 16 with AVX-512, else 8, or ``ROBODYN_BLOCK`` (:mod:`robodyn.codegen.cpu`).
+BLOCK = block_width()
 
 #: Cores with more assignments than this are not inlined into their batch loop (compile time).
 INLINE_LIMIT = 400

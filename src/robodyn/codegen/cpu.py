@@ -1,0 +1,65 @@
+"""The block width of the generated C kernels, chosen for the processor they are built on.
+
+The batch kernels evaluate :data:`robodyn.codegen.c.BLOCK` states at a time, structure-of-arrays,
+so that one loop over the block becomes vector instructions. The width that fills the vector
+registers depends on the processor: with AVX-512 (8 doubles per register) 16 states, two
+registers per quantity; with AVX2 or narrower (4 or 2 doubles) 8 states. Measured on an AVX-512
+Xeon (2 cores, shared with other jobs; PUMA 560, 10^5 states, ns per state, min of 7), the code
+built for AVX-512 (``-march=native``) and for AVX2 (``-march=haswell``) at each width:
+
+=========  =================  ==================
+width      AVX-512 ID / FD    AVX2 ID / FD
+=========  =================  ==================
+4          29.9 / 91.7        34.1-35.3 / 57-58
+8          28.9-30.9 / 49-88  34.4-35.1 / 56-59
+16         31.5-33.6 / 49-94  37.7-38.4 / 56-58
+32         45.7 / 91.3        40.7 / 56.9
+=========  =================  ==================
+
+(the spread within a cell is the machine's load: runs of the same build differed by up to 2x in
+forward dynamics). Wider than 16 is slower everywhere; between 8 and 16 the difference is
+within that noise on AVX-512 and about 8 % in favour of 8 for AVX2's inverse dynamics. The
+environment variable ``ROBODYN_BLOCK`` (1, 2, 4, 8, 16 or 32) overrides the choice: 1 gives
+scalar code (one state per loop), which the CI runs the kernel tests with too. The width is
+part of the generated source, so each width has its own entry in the compiled-model cache.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from robodyn.robot.errors import InputError
+
+__all__ = ["WIDTHS", "block_width", "cpu_flags"]
+
+#: Block widths the generator accepts.
+WIDTHS = (1, 2, 4, 8, 16, 32)
+
+
+def cpu_flags() -> frozenset[str]:
+    """The processor's feature flags (``/proc/cpuinfo``; empty where there is none)."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith(("flags", "Features")):
+                return frozenset(line.split(":", 1)[1].split())
+    except OSError:
+        pass
+    return frozenset()
+
+
+def block_width() -> int:
+    """States per block: ``ROBODYN_BLOCK`` when set, else 16 with AVX-512 and 8 otherwise.
+
+    Raises
+    ------
+    InputError
+        ``ROBODYN_BLOCK`` is not one of :data:`WIDTHS`.
+    """
+    text = os.environ.get("ROBODYN_BLOCK", "").strip()
+    if text:
+        if text not in {str(w) for w in WIDTHS}:
+            raise InputError(f"ROBODYN_BLOCK={text!r}: the block width of the generated kernels "
+                             f"must be one of {', '.join(map(str, WIDTHS))} (1: scalar code)")
+        return int(text)
+    return 16 if "avx512f" in cpu_flags() else 8
