@@ -21,6 +21,10 @@ def _positive(text: str) -> int:
     return value
 
 
+#: ``--ship`` choices and ``sweep(ship=...)``.
+_SHIP = {"auto": None, "always": True, "never": False}
+
+
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from robodyn.report.html import page
     from robodyn.report.study_report import study_figures, study_section
@@ -32,7 +36,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     try:
         table = sweep(study.task, study.cases, scheduler=args.scheduler, workers=args.workers,
                       batch=args.batch or study.batch, seed=study.seed, progress=True,
-                      timeout=args.timeout)
+                      timeout=args.timeout, ship=_SHIP[args.ship])
     except SweepInterrupted as stop:
         parquet, csv = write_table(stop.table, out, "results.partial")
         print(f"interrupted: {len(stop.table)} finished cases kept in {parquet} and {csv}",
@@ -73,7 +77,9 @@ def add_sweep_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
                     "error message of a failed case), figures and study.html to DIR. The same file "
                     "and seed give the same table whatever the workers or batch size. Ctrl-C keeps "
                     "the finished cases in results.partial.parquet/.csv; failed cases are also "
-                    "listed in failures.csv. Exit code 1 when every case failed.",
+                    "listed in failures.csv. The compiled models the cases use are built here and "
+                    "sent to the workers with the tasks (--ship), so workers need no compiler. "
+                    "Exit code 1 when every case failed.",
         epilog="examples:\n  robodyn sweep examples/studies/aa300_sizing.yaml -o out/sweep\n"
                "  robodyn sweep study.yaml --scheduler tcp://10.0.0.5:8786 -o out/sweep")
     p.add_argument("study", metavar="STUDY.yaml", help="study file")
@@ -83,7 +89,12 @@ def add_sweep_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--workers", type=_positive, metavar="N",
                    help="worker processes of the local cluster (default: the CPU cores)")
     p.add_argument("--batch", type=_positive, metavar="N",
-                   help="cases per Dask task (default: the study file's, else ~4 tasks per worker)")
+                   help="cases per Dask task (default: the study file's, else at least 256 tasks, "
+                        "4 per worker thread on a bigger cluster)")
+    p.add_argument("--ship", choices=tuple(_SHIP), default="auto",
+                   help="send the compiled models the cases use to the workers with the tasks, so "
+                        "that workers need no compiler: auto (up to 16 distinct models), always, "
+                        "never (default: %(default)s)")
     p.add_argument("--timeout", type=float, default=10.0, metavar="S",
                    help="seconds to wait for --scheduler (default: %(default)s)")
     p.set_defaults(func=_cmd_sweep)

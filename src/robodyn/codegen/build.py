@@ -33,6 +33,8 @@ from pathlib import Path
 
 import cffi
 
+from robodyn.robot.errors import InputError
+
 __all__ = [
     "CFLAGS",
     "DEFAULT_CACHE_MAX_MB",
@@ -154,7 +156,7 @@ def cache_limit() -> int:
     except ValueError:
         mb = -1.0
     if not mb >= 0 or mb == float("inf"):
-        raise ValueError(f"ROBODYN_CACHE_MAX_MB={text!r}: expected a non-negative number of "
+        raise InputError(f"ROBODYN_CACHE_MAX_MB={text!r}: expected a non-negative number of "
                          "megabytes")
     return int(mb * 2**20)
 

@@ -44,7 +44,7 @@ from robodyn.codegen.python import PythonPrinter
 from robodyn.numeric.checks import out_buffer, structural_singularity, without_infinities
 from robodyn.numeric.integrate_numpy import integrate_numpy as _integrate_numpy
 from robodyn.numeric.runtime_parameters import check_physics, parameter_array, runtime_names
-from robodyn.robot.errors import SimulationError, SingularMassMatrixError
+from robodyn.robot.errors import InputError, SimulationError, SingularMassMatrixError
 from robodyn.robot.model import Robot
 from robodyn.robot.overrides import checked_parameter_values
 
@@ -82,6 +82,10 @@ class Model:
         such as a calibration's), or None. Such a model still gives kinematics, inverse dynamics
         and the regressor; forward dynamics, simulation and their derivatives raise
         :class:`~robodyn.robot.errors.SingularMassMatrixError` with this reason.
+    sources : tuple of Path
+        The cache files the model was generated into (``rd_model_<key>.c`` and ``.cdef``, or
+        ``.py``; and ``.singular`` when it exists): what :mod:`robodyn.study.shipping` sends to
+        workers with the compiled library so that they need neither the derivation nor a compiler.
     """
 
     robot: Robot
@@ -90,6 +94,7 @@ class Model:
     _impl: CompiledLibrary | ModuleType = field(repr=False, compare=False)
     runtime_parameters: tuple[str, ...] = ()
     singular: str | None = None
+    sources: tuple[Path, ...] = field(default=(), repr=False, compare=False)
 
     @property
     def dof(self) -> int:
@@ -125,7 +130,8 @@ class Model:
         row = parameter_array(names, self.parameters, dict(values), (), "with_parameters")
         check_physics(self.robot, names, self.parameters, row, "with_parameters")
         merged = {**self.parameters, **dict(zip(names, row.tolist(), strict=True))}
-        return Model(self.robot, self.backend, tuple(sorted(merged.items())), self._impl, names)
+        return Model(self.robot, self.backend, tuple(sorted(merged.items())), self._impl, names,
+                     self.singular, self.sources)
 
     # --- public kernels ------------------------------------------------------------------------
     def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, *,
@@ -423,27 +429,27 @@ class Model:
         methods = {"rk4": 0, "semi_implicit": 1}
         modes = {"feedback": 0, "gravity": 1, "computed_torque": 2}
         if method not in methods:
-            raise ValueError(f"unknown fixed-step method {method!r}; choose {', '.join(methods)}")
+            raise InputError(f"unknown fixed-step method {method!r}; choose {', '.join(methods)}")
         if mode not in modes:
-            raise ValueError(f"unknown controller mode {mode!r}; choose {', '.join(modes)}")
+            raise InputError(f"unknown controller mode {mode!r}; choose {', '.join(modes)}")
         if control not in ("sampled", "continuous"):
-            raise ValueError(f"unknown control {control!r}; choose 'sampled' or 'continuous'")
+            raise InputError(f"unknown control {control!r}; choose 'sampled' or 'continuous'")
         continuous = control == "continuous"
         if continuous and method != "rk4":
-            raise ValueError(f"control='continuous' needs method='rk4' ({method} evaluates the law "
+            raise InputError(f"control='continuous' needs method='rk4' ({method} evaluates the law "
                              "once per step: use control='sampled')")
         steps = int(steps)
         if steps < 1:
-            raise ValueError(f"integrate: steps must be a positive integer, got {steps}")
+            raise InputError(f"integrate: steps must be a positive integer, got {steps}")
         threads = _thread_count(threads)
         ensemble = np.ndim(x0) == 2
         if ensemble and continuous:
-            raise ValueError("integrate: an ensemble (x0 of shape (N, 2 n)) runs control='sampled' "
+            raise InputError("integrate: an ensemble (x0 of shape (N, 2 n)) runs control='sampled' "
                              "only; integrate continuous-time control one trajectory at a time")
         count = np.shape(x0)[0] if ensemble else 1
         size = 8 * (steps + 1) * 3 * n * count
         if size > MAX_INTEGRATE_BYTES:
-            raise ValueError(f"integrate: {steps:,} steps of {n} joints need {size / 2**20:,.0f} MiB "
+            raise InputError(f"integrate: {steps:,} steps of {n} joints need {size / 2**20:,.0f} MiB "
                              f"of output, above {MAX_INTEGRATE_BYTES / 2**20:,.0f} MiB; split the "
                              "run into several calls from the last state (simulate() does so)")
         rows = 2 * steps + 1 if continuous else steps
@@ -459,7 +465,7 @@ class Model:
                 continue
             arr = np.ascontiguousarray(val, dtype=np.float64)
             if arr.shape != shape:
-                raise ValueError(f"integrate: {key} must have shape {shape}, got {arr.shape}")
+                raise InputError(f"integrate: {key} must have shape {shape}, got {arr.shape}")
             checked[key] = arr
         checked["params"] = None
         if self.runtime_parameters or parameters is not None:
@@ -547,7 +553,7 @@ class Model:
         (P,) or (N, P) array, columns in the order of :attr:`runtime_parameters`.
         """
         if not self.runtime_parameters:
-            raise ValueError(f"{where}: parameters=... needs a model compiled with runtime "
+            raise InputError(f"{where}: parameters=... needs a model compiled with runtime "
                              "parameters (compile_model(robot, runtime_parameters=True or names)); "
                              f"this {self.robot.name} model has its parameter values compiled in")
         return parameter_array(self.runtime_parameters, self.parameters, value, batch,
@@ -562,12 +568,12 @@ class Model:
         for (arg_name, width), value in zip(inputs, arrays, strict=True):
             arr = np.asarray(value, dtype=np.float64)
             if arr.ndim not in (1, 2) or arr.shape[-1] != width:
-                raise ValueError(f"{name}: {arg_name} must have shape ({width},) or (N, {width}), "
+                raise InputError(f"{name}: {arg_name} must have shape ({width},) or (N, {width}), "
                                  f"got {arr.shape}")
             if batch_shape is None:
                 batch_shape = arr.shape[:-1]
             elif arr.shape[:-1] != batch_shape:
-                raise ValueError(f"{name}: {arg_name} has shape {arr.shape}, but the first "
+                raise InputError(f"{name}: {arg_name} has shape {arr.shape}, but the first "
                                  f"argument's batch shape is {batch_shape}")
             args.append(arr)
         assert batch_shape is not None
@@ -641,7 +647,7 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
         inertia or rotor inertia, e.g. a massless final link): no forward dynamics exists.
     """
     if backend not in ("c", "numpy"):
-        raise ValueError(f"unknown backend {backend!r}; choose 'c' (compiled) or 'numpy'")
+        raise InputError(f"unknown backend {backend!r}; choose 'c' (compiled) or 'numpy'")
     # unknown names, non-finite values and impossible physics at the new values are refused
     values = checked_parameter_values(robot, parameters, where="compile_model(parameters=...)")
     runtime = runtime_names(robot, runtime_parameters)
@@ -663,6 +669,7 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
         impl: CompiledLibrary | ModuleType = _from_cache(
             (src, decl), write_c,
             lambda: compile_library(src.read_text(), decl.read_text(), flags=openmp_flags()))
+        sources: tuple[Path, ...] = (src, decl)
     else:
         path = directory / f"rd_model_{key}.py"
 
@@ -671,8 +678,11 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
             _write_atomic(path, PythonPrinter().module(kset))
 
         impl = _from_cache((path,), write_py, lambda: _import_file(path, f"robodyn_generated_{key}"))
+        sources = (path,)
     singular = marker.read_text(encoding="utf-8") if marker.exists() else None
-    return Model(robot, backend, tuple(sorted(values.items())), impl, runtime, singular)
+    if singular is not None:
+        sources += (marker,)
+    return Model(robot, backend, tuple(sorted(values.items())), impl, runtime, singular, sources)
 
 
 def _from_cache(paths: Sequence[Path], write: Callable[[], None], load: Callable[[], Any]) -> Any:
@@ -742,7 +752,7 @@ def _compile_derivatives(model: Model, names: tuple[str, ...] = DERIVATIVE_KERNE
 def _thread_count(threads: int) -> int:
     """``threads`` checked: a positive integer."""
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
-        raise ValueError(f"threads must be a positive integer, got {threads!r}")
+        raise InputError(f"threads must be a positive integer, got {threads!r}")
     return int(threads)
 
 

@@ -24,7 +24,7 @@ torque on the held-out run), ``heldout_rel`` (that over the RMS true torque) and
 from __future__ import annotations
 
 import warnings
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Any
@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from robodyn.robot.errors import StudyError
-from robodyn.study.models import RobotSource, model_of, robot_of
+from robodyn.study.models import ModelSpec, RobotSource, model_of, robot_of
 
 __all__ = ["IDENTIFICATION_PARAMETERS", "IdentificationMonteCarlo"]
 
@@ -103,6 +103,11 @@ class IdentificationMonteCarlo:
     def parameters(self) -> tuple[str, ...]:
         """Names a case may set."""
         return (*IDENTIFICATION_PARAMETERS, "seed")
+
+    def compiled_models(self, cases: Sequence[Mapping[str, Any]]) -> list[ModelSpec]:
+        """The one compiled model every case uses (the robot's, C backend), for a sweep to build
+        once and ship to its workers (:mod:`robodyn.study.shipping`)."""
+        return [ModelSpec(self.robot)] if cases else []
 
     def check_case(self, case: Mapping[str, Any], where: str) -> None:
         """Raise :class:`StudyError` naming ``where`` for a parameter this task does not know."""

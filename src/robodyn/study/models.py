@@ -5,7 +5,10 @@ a loaded robot or a cffi library: those do not pickle and would be rebuilt for e
 worker, :func:`robot_of` parses the text once per process and :func:`model_of` compiles (or loads
 from robodyn's content-hash cache, ``rd.compile_model``) once per process and
 ``(description, payload, parameter values, backend)``; every later case on that worker reuses it.
-On a cluster without a shared file system each worker fills its own cache once.
+On a cluster without a shared file system each worker fills its own cache once, unless the
+sweep ships the models: a task that lists the models its cases need (a method
+``compiled_models(cases) -> list of ModelSpec``) has them built here and sent to the workers with
+the tasks (:mod:`robodyn.study.shipping`).
 """
 
 from __future__ import annotations
@@ -17,13 +20,14 @@ from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
+from typing import NamedTuple
 
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import StudyError
 from robodyn.robot.load import builtin_names
 from robodyn.robot.model import Robot
 
-__all__ = ["RobotSource", "model_of", "robot_of"]
+__all__ = ["ModelSpec", "RobotSource", "model_of", "robot_of"]
 
 #: Compiled models kept per worker process (least recently used dropped beyond it).
 MODELS_PER_PROCESS = 64
@@ -122,3 +126,20 @@ def model_of(source: RobotSource, payload: float = 0.0,
     Model
     """
     return _model(source, float(payload), tuple(sorted(parameters)), backend)
+
+
+class ModelSpec(NamedTuple):
+    """The arguments of :func:`model_of`: one compiled model a study task uses.
+
+    Tasks list them in ``compiled_models(cases)`` so that a sweep can build the models once, here,
+    and ship them to its workers (:mod:`robodyn.study.shipping`).
+    """
+
+    source: RobotSource
+    payload: float = 0.0
+    parameters: tuple[tuple[str, float], ...] = ()
+    backend: str = "c"
+
+    def model(self) -> Model:
+        """The model, through :func:`model_of` (once per process)."""
+        return model_of(self.source, self.payload, self.parameters, self.backend)

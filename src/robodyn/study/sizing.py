@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from robodyn.robot.errors import StudyError
-from robodyn.study.models import RobotSource, model_of, robot_of
+from robodyn.study.models import ModelSpec, RobotSource, model_of, robot_of
 
 __all__ = ["SIZING_PARAMETERS", "ActuatorSizing"]
 
@@ -114,8 +114,7 @@ class ActuatorSizing:
 
         self.check_case(case, "case")
         robot = robot_of(self.robot)
-        p = {**SIZING_PARAMETERS, **self.defaults, **case}
-        overrides = tuple(sorted((k, float(v)) for k, v in p.items() if k in robot.parameters))
+        p, overrides = self._values(case)
         model = model_of(self.robot, float(p["payload"]), overrides, self.backend)
         plan = self._plan(overrides, float(p["speed_scale"]))
         q0 = plan.at(0.0)[0]
@@ -142,6 +141,29 @@ class ActuatorSizing:
             out[f"rms_power.{name}"] = float(np.sqrt(np.mean(power[:, j] ** 2)))
             out[f"tracking_error.{name}"] = float(np.max(np.abs(q_r[:, j] - sim.q[:, j])))
         return out
+
+    def compiled_models(self, cases: Sequence[Mapping[str, Any]]) -> list[ModelSpec]:
+        """The compiled models ``cases`` use (one per distinct payload and parameter values, and
+        the payload-free one the AA300 cycle is planned on), for a sweep to build once and ship
+        to its workers (:mod:`robodyn.study.shipping`). Cases this task would refuse are skipped.
+        """
+        specs: dict[ModelSpec, None] = {}
+        for case in cases:
+            try:
+                self.check_case(case, "case")
+                p, overrides = self._values(case)
+                specs[ModelSpec(self.robot, float(p["payload"]), overrides, self.backend)] = None
+            except (StudyError, TypeError, ValueError):
+                continue  # the case itself reports it
+            if self.trajectory == "aa300_cycle":
+                specs[ModelSpec(self.robot, 0.0, overrides, self.backend)] = None
+        return list(specs)
+
+    def _values(self, case: Mapping[str, Any]) -> tuple[dict[str, Any], tuple[tuple[str, float], ...]]:
+        """The case over the defaults, and its values of the robot's named parameters (sorted)."""
+        p = {**SIZING_PARAMETERS, **self.defaults, **case}
+        names = robot_of(self.robot).parameters
+        return p, tuple(sorted((k, float(v)) for k, v in p.items() if k in names))
 
     def _plan(self, overrides: tuple[tuple[str, float], ...], speed_scale: float) -> Any:
         return _plan(self.robot, overrides, self.backend, self.trajectory, self.dt, self.q_start,

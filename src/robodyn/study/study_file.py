@@ -2,9 +2,10 @@
 
 Layout (``examples/studies/aa300_sizing.yaml`` is a commented example)::
 
-    task: actuator_sizing          # or calibration_monte_carlo
+    task: actuator_sizing          # or calibration_monte_carlo, identification_monte_carlo,
+                                   # underwater_effects
     robot: aa300                   # built-in name, or a description path relative to this file
-    settings: {dt: 0.001}          # the task's fixed options (ActuatorSizing / CalibrationMonteCarlo)
+    settings: {dt: 0.001}          # the task class's fixed options (see TASKS)
     parameters:                    # what varies, by name (the task's case parameters)
       payload: [0, 25, 50]         # a list: grid values (crossed with everything else)
       bandwidth_hz: {min: 2, max: 8}              # a range: sampled (needs 'sampler')
@@ -22,7 +23,7 @@ the field and the reason.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -57,7 +58,7 @@ class Study:
     ----------
     path : Path
     task : callable
-        ``ActuatorSizing`` or ``CalibrationMonteCarlo`` (picklable).
+        An instance of a :data:`TASKS` class (picklable).
     cases : Grid, LatinHypercube or RandomSampler
     seed : int
     batch : int or None
@@ -231,4 +232,11 @@ class _Repeat:
 
     def __call__(self, case: Mapping[str, Any]) -> Any:
         return self.task({k: v for k, v in case.items() if k != "repeat"})
+
+    def compiled_models(self, cases: Sequence[Mapping[str, Any]]) -> list[Any]:
+        """The task's compiled models, if it lists them (:mod:`robodyn.study.shipping`)."""
+        listed = getattr(self.task, "compiled_models", None)
+        if listed is None:
+            return []
+        return list(listed([{k: v for k, v in c.items() if k != "repeat"} for c in cases]))
 

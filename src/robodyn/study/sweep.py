@@ -1,7 +1,10 @@
 """``sweep``: run a picklable task over the cases of a study on Dask, results as a pandas table.
 
 The cases are cut into batches (many cases per Dask task: a fast simulation costs less than one
-Dask task's scheduling) and mapped over the workers of a Dask cluster:
+Dask task's scheduling), at least :data:`MIN_BATCHES` of them whatever the workers at submission,
+all submitted at once: the scheduler hands them to the workers that exist and to those that join
+later (``cluster.scale``, ``cluster.adapt``, which sees the whole study queued). They run on the
+workers of a Dask cluster:
 
 * no ``client`` and no ``scheduler``: a :class:`distributed.LocalCluster` on 127.0.0.1 with one
   single-threaded worker process per CPU core (or ``workers``), closed when the sweep ends;
@@ -9,14 +12,19 @@ Dask task's scheduling) and mapped over the workers of a Dask cluster:
 * ``scheduler="tcp://host:8786"``: a client of that cluster, closed when the sweep ends; a
   scheduler that cannot be reached within ``timeout`` seconds is a :class:`StudyError`.
 
-Dask reruns the batches of a worker that dies; a case whose task raises is recorded with its
-message (``on_error="record"``) or stops the study (``"raise"``); an interrupted sweep raises
-:class:`SweepInterrupted` carrying the table of the cases that finished. Nothing here is a
-scheduler, a pool or a store of its own: Dask schedules, pandas/pyarrow store.
+Dask reruns the batches of a worker that dies; the cases of a batch whose worker died on every
+try are run again one at a time, each alone, so that only a case that kills its worker is
+recorded as failed; a case whose
+task raises is recorded with its message (``on_error="record"``) or stops the study
+(``"raise"``); an interrupted sweep raises :class:`SweepInterrupted` carrying the table of the
+cases that finished. Compiled models a task lists travel with the tasks
+(:mod:`robodyn.study.shipping`), so workers need no compiler. Nothing here is a scheduler, a pool
+or a store of its own: Dask schedules, pandas/pyarrow store.
 """
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import os
@@ -32,8 +40,8 @@ import pandas as pd
 from robodyn.robot.errors import StudyError
 from robodyn.study.cases import expand_cases
 
-__all__ = ["ERROR_COLUMN", "SweepInterrupted", "batches", "default_workers", "run_batch", "run_serial",
-           "sweep", "table", "write_table"]
+__all__ = ["ERROR_COLUMN", "MIN_BATCHES", "SweepInterrupted", "batches", "default_batch", "default_workers",
+           "run_batch", "run_serial", "sweep", "table", "write_table"]
 
 #: Column holding a failed case's error message (None where the case succeeded).
 ERROR_COLUMN = "error"
@@ -62,6 +70,34 @@ def default_workers() -> int:
         return max(1, len(os.sched_getaffinity(0)))
     except AttributeError:  # pragma: no cover - not Linux
         return max(1, os.cpu_count() or 1)
+
+
+#: Tasks a sweep is cut into at least (fewer only with fewer cases) when ``batch`` is not given,
+#: whatever the workers at submission: a cluster that has none yet or grows afterwards
+#: (``cluster.scale``, ``cluster.adapt``) finds work for this many worker threads queued on the
+#: scheduler, and ``adapt`` sees the whole study's work when it decides how many workers to ask for.
+MIN_BATCHES = 256
+
+
+def default_batch(n_cases: int, threads: int) -> int:
+    """Cases per Dask task when ``batch`` is not given.
+
+    ``n_cases`` cut into ``max(4 * threads, MIN_BATCHES)`` tasks: 4 per worker thread of a big
+    cluster, and at least :data:`MIN_BATCHES` however few threads exist at submission (zero for
+    an adaptive cluster that starts empty), all submitted at once. The scheduler hands them to
+    the workers as these join; each task costs about 2-5 ms of scheduling and transfer.
+
+    Parameters
+    ----------
+    n_cases : int
+    threads : int
+        Worker threads of the cluster at submission (``sum(client.nthreads().values())``).
+
+    Returns
+    -------
+    int
+    """
+    return max(1, math.ceil(n_cases / max(4 * threads, MIN_BATCHES)))
 
 
 def batches(n_cases: int, batch: int) -> list[range]:
@@ -241,7 +277,8 @@ def local_cluster(workers: int | None = None) -> Any:
 def sweep(task: Callable[[dict[str, Any]], Mapping[str, Any]], cases: Any, *, client: Any = None,
           scheduler: str | None = None, workers: int | None = None, batch: int | None = None,
           seed: int | None = 0, on_error: str = "record", progress: bool = False,
-          timeout: float = 10.0, on_batch: Callable[[list[Row]], None] | None = None) -> pd.DataFrame:
+          timeout: float = 10.0, on_batch: Callable[[list[Row]], None] | None = None,
+          ship: bool | None = None) -> pd.DataFrame:
     """Run ``task`` over ``cases`` on Dask; the table of cases and results, in case order.
 
     Parameters
@@ -261,7 +298,8 @@ def sweep(task: Callable[[dict[str, Any]], Mapping[str, Any]], cases: Any, *, cl
         Worker processes of the LocalCluster started when neither is given (default: the CPU
         cores available).
     batch : int, optional
-        Cases per Dask task (default: the cases split into about 4 tasks per worker thread).
+        Cases per Dask task (default :func:`default_batch`: at least :data:`MIN_BATCHES` tasks,
+        4 per worker thread on a bigger cluster, so that workers that join later get work).
     seed : int or None
         Study seed; case ``i`` gets the column ``seed = case_seed(seed, i)`` (None: no column).
     on_error : {"record", "raise"}
@@ -274,6 +312,11 @@ def sweep(task: Callable[[dict[str, Any]], Mapping[str, Any]], cases: Any, *, cl
     on_batch : callable, optional
         Called in this process with each finished batch's rows ``[(index, results, error)]``
         (e.g. to save partial results).
+    ship : bool or None
+        Compiled models sent to the workers with the tasks (:mod:`robodyn.study.shipping`), for a
+        task with ``compiled_models(cases)``: None ships up to
+        :data:`~robodyn.study.shipping.SHIP_LIMIT` models, True any number, False none (each
+        worker then builds its own, which needs a C compiler).
 
     Returns
     -------
@@ -292,78 +335,142 @@ def sweep(task: Callable[[dict[str, Any]], Mapping[str, Any]], cases: Any, *, cl
     expanded = expand_cases(cases, seed)
     if not expanded:
         return table(expanded, [])
-    from distributed import as_completed
-    from tqdm import tqdm
+    from robodyn.study.shipping import models_to_ship
 
-    rows: dict[int, Row] = {}
     with _connect(client, scheduler, workers, timeout) as dask:
-        threads = max(1, sum(dask.nthreads().values()))
-        size = batch or max(1, math.ceil(len(expanded) / (4 * threads)))
+        run = _Run(dask, task, on_error, models_to_ship(task, expanded, ship))
+        size = batch or default_batch(len(expanded), sum(dask.nthreads().values()))
         parts = [[(i, expanded[i]) for i in r] for r in batches(len(expanded), size)]
-        token = uuid.uuid4().hex[:12]
-        keys = [f"robodyn-sweep-{token}-{k}" for k in range(len(parts))]
-        futures = dask.map(_run_part, parts, task=task, on_error=on_error, pure=False, key=keys)
-        part_of = dict(zip(keys, parts, strict=True))
-        bar = tqdm(total=len(expanded), unit="case", disable=not progress, desc="sweep")
-        submitted = list(futures)
+        return table(expanded, run.collect(parts, on_batch, progress, expanded))
+
+
+class _Run:
+    """The Dask futures of one sweep: its batches, and the cases rerun alone after a worker died.
+
+    Parameters
+    ----------
+    dask : distributed.Client
+    task : callable
+    on_error : {"record", "raise"}
+    bundle : ModelBundle or None
+        Compiled models every worker writes into its cache before it runs a batch, as a worker
+        plugin (:mod:`robodyn.study.shipping`): workers that join or restart later get it too.
+    """
+
+    def __init__(self, dask: Any, task: Any, on_error: str, bundle: Any) -> None:
+        from distributed import as_completed
+
+        self.dask, self.task, self.on_error = dask, task, on_error
+        self.token = uuid.uuid4().hex[:12]
+        #: cases of each unfinished task by key
+        self.part_of: dict[str, list[tuple[int, dict[str, Any]]]] = {}
+        #: cases of tasks whose workers died, to run alone; the key of the one running alone
+        self.suspects: list[tuple[int, dict[str, Any]]] = []
+        self.alone: str | None = None
+        self.submitted: list[Any] = []
+        self.pending = as_completed(loop=dask.loop)
+        self.plugin: str | None = None
+        if bundle is not None:
+            from robodyn.study.shipping import ShipModels
+
+            # a plugin, not a task the batches depend on: batches without dependencies stay
+            # "root-ish", queued on the scheduler and handed out as workers free up or join
+            self.plugin = f"robodyn-models-{self.token}"
+            dask.register_plugin(ShipModels(bundle), name=self.plugin)
+
+    def collect(self, parts: list[list[tuple[int, dict[str, Any]]]],
+                on_batch: Callable[[list[Row]], None] | None, progress: bool,
+                cases: Sequence[dict[str, Any]]) -> dict[int, Row]:
+        """Submit ``parts`` and gather their rows by case; cancel everything on an error.
+
+        Raises
+        ------
+        SweepInterrupted
+            On a KeyboardInterrupt, with the table of ``cases`` that finished.
+        """
+        from tqdm import tqdm
+
+        rows: dict[int, Row] = {}
+        bar = tqdm(total=len(cases), unit="case", disable=not progress, desc="sweep")
         try:
-            pending = as_completed(futures, loop=dask.loop)
-            for fut in pending:
-                out = _finished(dask, fut, part_of, pending, submitted, task, on_error, token)
-                for row in out:
-                    rows[row[0]] = row
+            self.submit(parts)
+            for fut in self.pending:
+                out = self.finished(fut)
+                rows.update((row[0], row) for row in out)
                 bar.update(len(out))
                 if on_batch is not None and out:
                     on_batch(out)
         except KeyboardInterrupt:
-            dask.cancel(submitted)
-            raise SweepInterrupted(table(expanded, rows)) from None
+            self.cancel()
+            raise SweepInterrupted(table(cases, rows)) from None
         except BaseException:
-            dask.cancel(submitted)
+            self.cancel()
             raise
         finally:
             bar.close()
-    return table(expanded, rows)
+            self.close()
+        return rows
 
+    def submit(self, parts: list[list[tuple[int, dict[str, Any]]]]) -> None:
+        """Submit one task per batch of ``(index, case)``."""
+        keys = [f"robodyn-sweep-{self.token}-{k}" for k in range(len(parts))]
+        futures = self.dask.map(_run_part, parts, task=self.task, on_error=self.on_error,
+                                pure=False, key=keys)
+        self.part_of.update(zip(keys, parts, strict=True))
+        self.submitted.extend(futures)
+        self.pending.update(futures)
 
-def _finished(dask: Any, fut: Any, part_of: dict[str, list[tuple[int, dict[str, Any]]]],
-              pending: Any, submitted: list[Any], task: Any, on_error: str, token: str) -> list[Row]:
-    """The rows of a finished task. A task whose worker died on it (the scheduler's
-    ``distributed.scheduler.allowed-failures`` retries spent: a crash in compiled code, an
-    out-of-memory kill) is split into one task per case, added to ``pending``, so that only the
-    case that kills its worker is recorded as failed, with the reason, and the sweep goes on."""
-    from distributed import KilledWorker
+    def cancel(self) -> None:
+        """Cancel every task of this sweep."""
+        self.dask.cancel(self.submitted)
 
-    part = part_of.pop(fut.key)
-    rest = part_of.pop(f"{fut.key}-rest", [])
-    if rest:  # the next case of a split batch
-        _submit_single(dask, rest, part_of, pending, submitted, task, on_error, token)
-    if fut.status != "error":
-        return fut.result()
-    exc = fut.exception()
-    if not isinstance(exc, KilledWorker) or on_error != "record":
-        raise exc
-    if len(part) > 1:
-        # one case per task, one after the other (not beside each other on a worker, where the
-        # crashing case would take the others down with it)
-        _submit_single(dask, part, part_of, pending, submitted, task, on_error, token)
-        return []
-    tries = 1 + int(dask.run_on_scheduler(_allowed_failures))
-    return [(part[0][0], {}, f"the worker running this case died {tries} times (a crash in "
-                             f"compiled code or an out-of-memory kill?): {exc}")]
+    def close(self) -> None:
+        """Unregister the model plugin (the files stay in the workers' caches)."""
+        if self.plugin is not None:
+            with contextlib.suppress(Exception):  # a cluster already gone has nothing to remove
+                self.dask.unregister_worker_plugin(self.plugin)
+            self.plugin = None
 
+    def finished(self, fut: Any) -> list[Row]:
+        """The rows of a finished task.
 
-def _submit_single(dask: Any, cases: list[tuple[int, dict[str, Any]]], part_of: dict[str, Any],
-                   pending: Any, submitted: list[Any], task: Any, on_error: str, token: str) -> None:
-    """Submit the first of ``cases`` alone; the others wait in ``part_of[key + "-rest"]``."""
-    first = cases[0]
-    key = f"robodyn-sweep-{token}-case-{first[0]}"
-    fut = dask.submit(_run_part, [first], task=task, on_error=on_error, pure=False, key=key)
-    part_of[key] = [first]
-    if len(cases) > 1:
-        part_of[f"{key}-rest"] = cases[1:]
-    pending.add(fut)
-    submitted.append(fut)
+        A task whose worker died on it (the scheduler's ``distributed.scheduler.allowed-failures``
+        retries spent: a crash in compiled code, an out-of-memory kill, or a task that sat on
+        the same worker as such a case) gives no rows: its cases become suspects. Once nothing
+        else of the sweep is in flight, each suspect runs alone, one after the other, so that a
+        worker dies only of the case it runs: a suspect whose worker dies on every try is
+        recorded as failed, with the reason, the others give their rows.
+        """
+        from distributed import KilledWorker
+
+        part = self.part_of.pop(fut.key)
+        rows: list[Row] = []
+        if fut.status != "error":
+            rows = fut.result()
+        else:
+            exc = fut.exception()
+            if not isinstance(exc, KilledWorker) or self.on_error != "record":
+                raise exc
+            if fut.key == self.alone:
+                tries = 1 + int(self.dask.run_on_scheduler(_allowed_failures))
+                rows = [(part[0][0], {}, f"the worker running this case died {tries} times, the "
+                                         "case running alone (a crash in compiled code or an "
+                                         f"out-of-memory kill?): {exc}")]
+            else:
+                self.suspects.extend(part)
+        if not self.part_of and self.suspects:  # nothing else in flight: the next suspect alone
+            self._submit_alone(self.suspects.pop(0))
+        return rows
+
+    def _submit_alone(self, case: tuple[int, dict[str, Any]]) -> None:
+        """Submit one case as the sweep's only task in flight."""
+        key = f"robodyn-sweep-{self.token}-case-{case[0]}"
+        fut = self.dask.submit(_run_part, [case], task=self.task, on_error=self.on_error,
+                               pure=False, key=key)
+        self.alone = key
+        self.part_of[key] = [case]
+        self.pending.add(fut)
+        self.submitted.append(fut)
 
 
 def _allowed_failures(dask_scheduler: Any = None) -> int:
