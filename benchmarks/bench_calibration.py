@@ -3,7 +3,7 @@
 Prints, for a "true" PUMA 560 with millimetre-level manufacturing errors measured at 200 poses
 by a tracker with 0.05 mm noise (target: a whole calibration under 2 s):
 
-  1. ``robodyn.calibrate.calibrate`` end to end (placement, identifiability, Levenberg-Marquardt
+  1. ``robodyn.calibration.calibrate`` end to end (placement, identifiability, Levenberg-Marquardt
      with the analytic Jacobian, covariance, calibrated Robot), per error model;
   2. the same Levenberg-Marquardt problem (same model, parameters, start, weights and
      tolerances) solved by ``scipy.optimize.least_squares(method="lm")`` with the analytic
@@ -28,10 +28,10 @@ import numpy as np
 from timing import best_of_with_result as best_of
 
 import robodyn as rd
-from robodyn.calibrate import calibrate, random_configurations
-from robodyn.calibrate.kinematics import rot, trans
-from robodyn.calibrate.simulate_study import perturbed_robot, robot_positions
-from robodyn.calibrate.solve import fit
+from robodyn.calibration import calibrate, random_configurations
+from robodyn.calibration.kinematics import rot, trans
+from robodyn.calibration.simulate_study import perturbed_robot, robot_positions
+from robodyn.calibration.solve import fit
 
 SIGMA = 5e-5
 POSES = 200
@@ -86,8 +86,8 @@ def combined(robot, true, repeat: int) -> None:
     import tempfile
     from pathlib import Path
 
-    from robodyn.calibrate.io import write_calibration_csv  # noqa: F401 (format reference)
-    from robodyn.calibrate.simulate_study import robot_frames
+    from robodyn.calibration.io import write_calibration_csv  # noqa: F401 (format reference)
+    from robodyn.calibration.simulate_study import robot_frames
 
     n, targets = 1000, np.array([[0.031, -0.018, 0.076], [-0.045, 0.052, 0.060], [0.06, 0.04, 0.03]])
     rng = np.random.default_rng(3)
@@ -183,8 +183,8 @@ import sys
 import robodyn.cli
 args = robodyn.cli._parser().parse_args(["calibrate", "puma560", "--data", sys.argv[1], "-o", "o"])
 import robodyn as rd
-from robodyn.calibrate.io import read_calibration_csv
-from robodyn.calibrate.pipeline import convert_units
+from robodyn.calibration.io import read_calibration_csv
+from robodyn.calibration.pipeline import convert_units
 robot = rd.load(args.robot)
 data = read_calibration_csv(args.data, robot)
 import scipy.optimize  # the solver's import, made on the first solve: overhead, not solving

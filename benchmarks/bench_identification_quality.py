@@ -5,7 +5,7 @@ For every data set and split: the nominal description, the textbook baseline
 robodyn's default ``rd.identify(robot, fit, target=...)`` and its other methods, and the noise
 floor. Figures are ``||pred - y|| / ||y||`` pooled over the held-out samples and all joints
 (``raw``: against the measured target; ``filt``: against the reference-filtered target,
-:mod:`robodyn.validate.heldout`; ``floor``: ``||y - y_f|| / ||y||``).
+:mod:`robodyn.validation.heldout`; ``floor``: ``||y - y_f|| / ||y||``).
 
 Data sets:
 
@@ -48,15 +48,15 @@ import numpy as np  # noqa: E402
 
 import robodyn as rd  # noqa: E402
 from robodyn.robot.errors import IdentificationError  # noqa: E402
-from robodyn.validate.heldout import held_out_error  # noqa: E402
+from robodyn.validation.heldout import held_out_error  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent))
 import textbook  # noqa: E402
 
-from tests.identify.kinova import DATA as KINOVA  # noqa: E402
-from tests.identify.kinova import JOINTWISE_FILES, WHOLE_ARM, WHOLE_ARM_FILES, read, split  # noqa: E402
+from tests.identification.kinova import DATA as KINOVA  # noqa: E402
+from tests.identification.kinova import JOINTWISE_FILES, WHOLE_ARM, WHOLE_ARM_FILES, read, split  # noqa: E402
 
 KUKA = KINOVA.parent / "kuka-lwr4"
 
@@ -226,7 +226,7 @@ def run_case(case: Case, rows: list[list[str]]) -> None:
 
 def speed(samples: int = 100_000) -> None:
     """Time the default identification and the textbook script on ``samples`` Gen3 samples."""
-    from tests.identify.helpers import fourier
+    from tests.identification.helpers import fourier
 
     robot = rd.load("kinova_gen3")
     model = rd.compile_model(robot)

@@ -4,7 +4,7 @@ Prints, in one run:
 
   1. stacking the identification matrix (full regressor, 7 x 105 per sample) for 100,000
      Kinova Gen3 samples: robodyn's batched compiled regressor writing straight into one
-     matrix (``robodyn.identify.stacking.identification_matrix``), into a fresh matrix and
+     matrix (``robodyn.identification.stacking.identification_matrix``), into a fresh matrix and
      into a reused one (``out=``), on 1 and 2 threads; the memory floor of each case (NumPy
      writing a fresh matrix of the same shape, and filling the reused one); against a Python
      loop over Pinocchio's ``computeJointTorqueRegressor`` on the same arm (the manufacturer's
@@ -27,15 +27,15 @@ from pathlib import Path
 import numpy as np
 
 import robodyn as rd
-from robodyn.identify import identify
-from robodyn.identify.stacking import identification_matrix
+from robodyn.identification import identify
+from robodyn.identification.stacking import identification_matrix
 from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 from timing import best_of_with_result as best_of  # noqa: E402
 
-from tests.identify.kinova import DATA, WHOLE_ARM_FILES, read  # noqa: E402
+from tests.identification.kinova import DATA, WHOLE_ARM_FILES, read  # noqa: E402
 from tests.urdf_chains import pin_q  # noqa: E402
 
 PIN_ORDER = [INERTIAL_NAMES.index(k) for k in ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")]

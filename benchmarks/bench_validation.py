@@ -6,7 +6,7 @@ Prints, in one run (real recordings in ../shared/data/kinova-gen3, motor current
      for OLS, WLS and the physically consistent SDP: seconds each and their ratio to OLS;
   2. per method, the held-out relative current error on the last 30 % of each whole-arm run
      (all joints) and of the three pooled, and on every jointwise run (its moving joint),
-     raw and against the reference-filtered current (``robodyn.validate.heldout``: zero-phase
+     raw and against the reference-filtered current (``robodyn.validation.heldout``: zero-phase
      Butterworth, order 4, 2.5 Hz), with the noise floor beside each, and the data README's
      baseline (0.32 raw, 0.22 filtered, on the pooled last 30 %);
   3. cross-run validation: identify on one (or two) whole runs, predict a different whole run.
@@ -25,11 +25,11 @@ from pathlib import Path
 import numpy as np
 
 import robodyn as rd
-from robodyn.validate.heldout import HeldOutError, format_held_out, held_out_error, moving_joints
+from robodyn.validation.heldout import HeldOutError, format_held_out, held_out_error, moving_joints
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-from tests.identify.kinova import JOINTWISE_FILES, WHOLE_ARM, WHOLE_ARM_FILES, read, split  # noqa: E402
+from tests.identification.kinova import JOINTWISE_FILES, WHOLE_ARM, WHOLE_ARM_FILES, read, split  # noqa: E402
 
 BASELINE = (0.32, 0.22)
 

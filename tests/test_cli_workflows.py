@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from robodyn.calibrate.io import write_calibration_csv
-from robodyn.calibrate.simulate_study import perturbed_robot, robot_positions
+from robodyn.calibration.io import write_calibration_csv
+from robodyn.calibration.simulate_study import perturbed_robot, robot_positions
 from robodyn.cli import main
-from tests.calibrate.helpers import TARGET, TRACKER, poses, robot
+from tests.calibration.helpers import TARGET, TRACKER, poses, robot
 
 # --- simulate ----------------------------------------------------------------------------------
 

@@ -16,13 +16,29 @@ def test_every_public_name_resolves():
 
 def test_functions_named_like_their_subpackage_stay_functions():
     # importing the subpackages binds them on robodyn; the public functions must keep the names
-    import robodyn.calibrate.models  # noqa: F401
-    import robodyn.identify  # noqa: F401
-    import robodyn.simulate.controllers  # noqa: F401
-    import robodyn.validate  # noqa: F401
+    import robodyn.calibration.models  # noqa: F401
+    import robodyn.identification  # noqa: F401
+    import robodyn.simulation.controllers  # noqa: F401
+    import robodyn.validation  # noqa: F401
 
     for name in ("simulate", "calibrate", "identify", "validate"):
         assert callable(getattr(rd, name)) and getattr(rd, name).__name__ == name
+
+
+def test_import_robodyn_x_always_gives_a_module():
+    # no package shares a public function's name, so `import robodyn.X as m` binds a module
+    import pkgutil
+    import types
+
+    import robodyn.calibration as calibration
+    import robodyn.identification as identification
+    import robodyn.simulation as simulation
+    import robodyn.validation as validation
+
+    for m in (calibration, identification, simulation, validation):
+        assert isinstance(m, types.ModuleType)
+    packages = {info.name for info in pkgutil.iter_modules(rd.__path__)}
+    assert not packages & set(rd.__all__), packages & set(rd.__all__)
 
 
 def test_import_is_light():

@@ -12,19 +12,20 @@ Public API::
 from __future__ import annotations
 
 import importlib
-import sys
-import types
 from typing import TYPE_CHECKING, Any
 
 # Public names and the module each comes from. They are imported on first use (PEP 562), so
 # ``import robodyn`` and the command line do not pay for SciPy's signal processing, cvxpy or
-# Dask unless a command needs them.
+# Dask unless a command needs them. The packages beside the public functions ``simulate``,
+# ``calibrate``, ``identify`` and ``validate`` are named for what they hold (``simulation``,
+# ``calibration``, ``identification``, ``validation``), so ``import robodyn.X`` always gives a
+# module and ``rd.simulate`` is always the function.
 _EXPORTS = {
-    "Calibration": "robodyn.calibrate",
-    "calibrate": "robodyn.calibrate",
-    "Identification": "robodyn.identify",
-    "identify": "robodyn.identify",
-    "Payload": "robodyn.identify",
+    "Calibration": "robodyn.calibration",
+    "calibrate": "robodyn.calibration",
+    "Identification": "robodyn.identification",
+    "identify": "robodyn.identification",
+    "Payload": "robodyn.identification",
     "Recording": "robodyn.measure",
     "excitation": "robodyn.measure",
     "read_recording": "robodyn.measure",
@@ -37,43 +38,26 @@ _EXPORTS = {
     "Joint": "robodyn.robot.model",
     "Link": "robodyn.robot.model",
     "Robot": "robodyn.robot.model",
-    "Trajectory": "robodyn.simulate",
-    "simulate": "robodyn.simulate",
+    "Trajectory": "robodyn.simulation",
+    "simulate": "robodyn.simulation",
     "sweep": "robodyn.study.sweep",
     "EquationsOfMotion": "robodyn.symbolic.eom",
     "derive": "robodyn.symbolic.eom",
-    "Validation": "robodyn.validate",
-    "validate": "robodyn.validate",
+    "Validation": "robodyn.validation",
+    "validate": "robodyn.validation",
 }
 
 if TYPE_CHECKING:  # static analysers see ordinary imports
-    from robodyn.calibrate import Calibration, calibrate
-    from robodyn.identify import Identification, Payload, identify
+    from robodyn.calibration import Calibration, calibrate
+    from robodyn.identification import Identification, Payload, identify
     from robodyn.measure import Recording, excitation, read_recording
     from robodyn.numeric.model import Model, compile_model
     from robodyn.robot.load import builtin_names, load
     from robodyn.robot.model import Drive, Friction, Joint, Link, Robot
-    from robodyn.simulate import Trajectory, simulate
+    from robodyn.simulation import Trajectory, simulate
     from robodyn.study.sweep import sweep
     from robodyn.symbolic.eom import EquationsOfMotion, derive
-    from robodyn.validate import Validation, validate
-
-
-class _Package(types.ModuleType):
-    """``robodyn`` itself: keeps public functions that share a subpackage's name bound.
-
-    After importing a subpackage the import system binds it on its parent (``robodyn.simulate``
-    = the package); for ``simulate``, ``calibrate``, ``identify`` and ``validate`` the public name
-    is the function of that name, so the package's own function is bound instead.
-    """
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        if isinstance(value, types.ModuleType) and _EXPORTS.get(name) == value.__name__:
-            value = getattr(value, name)
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package
+    from robodyn.validation import Validation, validate
 
 
 def __getattr__(name: str) -> Any:

@@ -41,7 +41,7 @@ if TYPE_CHECKING:
 
 # SymPy, the symbolic layer and the agreement report are imported inside the commands that use
 # them, so that ``robodyn --help`` and the numeric commands (calibrate, identify, ...) start
-# without them. The parser only needs these names; tests/calibrate/test_startup.py checks them
+# without them. The parser only needs these names; tests/calibration/test_startup.py checks them
 # against robodyn.symbolic.eom.METHODS and robodyn.report.agreement.TOLERANCE.
 METHODS: tuple[str, ...] = ("newton_euler", "lagrange", "kane")
 TOLERANCE = 1e-9

@@ -11,7 +11,7 @@ import argparse
 __all__ = ["add_cache_parser"]
 
 # robodyn.codegen.build (and cffi) is imported by the command itself, not to build the parser;
-# tests/calibrate/test_startup.py checks this against codegen.build.DEFAULT_CACHE_MAX_MB.
+# tests/calibration/test_startup.py checks this against codegen.build.DEFAULT_CACHE_MAX_MB.
 DEFAULT_CACHE_MAX_MB = 1024
 
 

@@ -25,8 +25,8 @@ from robodyn.robot.errors import InputError
 __all__ = ["add_parsers"]
 
 # The --friction choices, kept here so that building the parser does not import the
-# identification package; tests/calibrate/test_startup.py checks them against
-# robodyn.identify.friction.FRICTION_MODELS.
+# identification package; tests/calibration/test_startup.py checks them against
+# robodyn.identification.friction.FRICTION_MODELS.
 FRICTION_MODELS: tuple[str, ...] = ("none", "linear", "stribeck", "load", "polynomial")
 
 
@@ -201,7 +201,7 @@ def _held_out_table(vals: Sequence[tuple[str, rd.Validation]]) -> str:
     """Relative error of each validation, raw and against the reference-filtered target, beside
     its noise floor (a jointwise run: its moving joint only), and the held-out recordings
     pooled over every joint (the figure a user compares models by)."""
-    from robodyn.validate.heldout import format_held_out, held_out_error, held_out_from_validation
+    from robodyn.validation.heldout import format_held_out, held_out_error, held_out_from_validation
 
     rows = [held_out_from_validation(v, label) for label, v in vals]
     held = [v for label, v in vals if label.startswith("held-out")]
@@ -456,7 +456,7 @@ def _validate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
                         "description's gear ratio x torque constant)")
     p.add_argument("--noise-cutoff", type=float, metavar="HZ",
                    help="low-pass cut-off separating the target from its noise, Hz (default: the "
-                        "reference filter of robodyn.validate.heldout, zero-phase Butterworth "
+                        "reference filter of robodyn.validation.heldout, zero-phase Butterworth "
                         "order 4 at 2.5 Hz, which reproduces the Kinova data README's noise floor)")
     p.add_argument("--cutoff", type=float, metavar="HZ",
                    help="process the states as an identification did: positions low-passed at HZ "

@@ -23,7 +23,7 @@ __all__ = ["add_parsers"]
 
 # The parsers' choices and defaults, kept here so that building the parser (every command, and
 # --help) imports neither the simulation nor the calibration package; test_startup.py in
-# tests/calibrate checks them against robodyn.simulate.simulation and robodyn.calibrate.models.
+# tests/calibration checks them against robodyn.simulation.simulation and robodyn.calibration.models.
 FIXED_STEP: tuple[str, ...] = ("rk4", "semi_implicit")
 ADAPTIVE: tuple[str, ...] = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 MAX_SAMPLES = 1_000_000
@@ -57,8 +57,8 @@ def _vector(value: np.ndarray | None, n: int, option: str, default: float = 0.0)
 
 def _controller(args: argparse.Namespace, model: rd.Model, q0: np.ndarray):
     """The controller and the planned reference (None for a passive run)."""
-    from robodyn.simulate.controllers import PD, PID, ComputedTorque, GravityCompensation
-    from robodyn.simulate.trajectory import quintic
+    from robodyn.simulation.controllers import PD, PID, ComputedTorque, GravityCompensation
+    from robodyn.simulation.trajectory import quintic
 
     n = model.dof
     if args.controller == "none":
@@ -108,7 +108,7 @@ def _check_size(args: argparse.Namespace, n: int) -> None:
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from robodyn.codegen.build import CompilerNotFoundError
-    from robodyn.simulate.plots import trajectory_figure
+    from robodyn.simulation.plots import trajectory_figure
 
     robot = rd.load(args.robot, tool=args.tool)
     n = robot.dof
@@ -176,8 +176,8 @@ def _payload(values: np.ndarray | None) -> tuple[float, np.ndarray] | None:
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
-    from robodyn.calibrate.io import read_calibration_csv, read_joint_map, write_calibration
-    from robodyn.calibrate.pipeline import (
+    from robodyn.calibration.io import read_calibration_csv, read_joint_map, write_calibration
+    from robodyn.calibration.pipeline import (
         ANGLE_UNITS,
         LENGTH_UNITS,
         convert_units,
@@ -215,8 +215,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
                            deflection=args.deflection, **units)
     validation = None
     if args.validate:
-        from robodyn.calibrate.result import ErrorStats
-        from robodyn.calibrate.simulate_study import robot_positions
+        from robodyn.calibration.result import ErrorStats
+        from robodyn.calibration.simulate_study import robot_positions
 
         held = read_calibration_csv(args.validate, robot, targets=args.targets, joint_map=jmap)
         held_q, held_pts = si(held)
@@ -269,7 +269,7 @@ def _terms_check(args: argparse.Namespace, robot: rd.Robot, cal: Any, data: Any,
                  stem: str) -> tuple[Any, tuple[str, float, float]]:
     """The non-geometric terms cross-validated over the poses, and the written description's own
     figure on ``poses`` (name, q rad, points m), stated in its files and the JSON report."""
-    from robodyn.calibrate.term_check import description_alone, terms_cross_validation
+    from robodyn.calibration.term_check import description_alone, terms_cross_validation
 
     with progress(f"cross-validating the non-geometric terms over {len(data.q)} poses"):
         check = terms_cross_validation(
@@ -297,7 +297,7 @@ def _add_to_report(path: Path, entries: dict[str, Any]) -> None:
 
 def _print_terms(check: Any, alone: tuple[str, float, float], yaml_name: str, stem: str) -> None:
     """The terms' cross-validation, a warning per family that overfits, and the description's
-    own figure (:mod:`robodyn.calibrate.term_check`)."""
+    own figure (:mod:`robodyn.calibration.term_check`)."""
     print(f"\n{check.text()}")
     for family in check.overfitting:
         err(f"robodyn: warning: adding '{family}' made the held-out error worse "
@@ -332,7 +332,7 @@ def _state_alone(paths: dict[str, Any], alone: tuple[str, float, float], stem: s
 
 
 def _cmd_iso9283(args: argparse.Namespace) -> int:
-    from robodyn.calibrate.iso9283 import overshoot_from_csv, pose_characteristics_from_csv
+    from robodyn.calibration.iso9283 import overshoot_from_csv, pose_characteristics_from_csv
 
     if args.data is None and args.approach is None:
         raise InputError("give a CSV of repeated poses (DATA) and/or --approach FILE.csv")

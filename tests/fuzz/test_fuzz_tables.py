@@ -13,8 +13,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import robodyn as rd
-from robodyn.calibrate.io import read_calibration_csv
-from robodyn.calibrate.iso9283 import overshoot_from_csv, pose_characteristics_from_csv
+from robodyn.calibration.io import read_calibration_csv
+from robodyn.calibration.iso9283 import overshoot_from_csv, pose_characteristics_from_csv
 from robodyn.robot.errors import DataFileError, DescriptionWarning
 from tests.fuzz.strategies import TOKENS, fuzz_settings, mutated
 

@@ -12,7 +12,7 @@ from robodyn.hydro.sensitivity import sensitivity, with_drag_coefficient
 from robodyn.hydro.study import effect_variant
 from robodyn.robot.errors import StudyError
 from robodyn.robot.yaml_loader import load_yaml_text
-from robodyn.simulate.trajectory import quintic
+from robodyn.simulation.trajectory import quintic
 from tests.hydro.test_closed_form import PENDULUM
 
 

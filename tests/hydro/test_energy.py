@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 import robodyn as rd
-from robodyn.simulate.energy import potential_energy
+from robodyn.simulation.energy import potential_energy
 from tests.hydro.test_dynamics import _energy_function
 
 Q0, QD0 = np.array([0.4, -0.8]), np.array([1.0, -0.5])

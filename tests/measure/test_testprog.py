@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from robodyn.measure.testprog import iso_cube, jointwise
-from robodyn.simulate import UnreachableError
+from robodyn.simulation import UnreachableError
 
 
 @pytest.fixture(scope="module")

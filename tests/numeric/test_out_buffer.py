@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from robodyn.identify.stacking import identification_matrix
+from robodyn.identification.stacking import identification_matrix
 
 pytestmark = pytest.mark.tool("gcc|cc")
 

@@ -5,14 +5,14 @@ from __future__ import annotations
 import pytest
 
 from robodyn.robot.errors import StudyError
-from robodyn.simulate.aa300_study import run_study
+from robodyn.simulation.aa300_study import run_study
 from robodyn.study.calibration_mc import CalibrationMonteCarlo
 from robodyn.study.models import RobotSource
 from robodyn.study.sizing import ActuatorSizing
 
 
 def test_aa300_sizing_case_reproduces_the_design_study():
-    # one sweep case = the AA300 design study of robodyn.simulate.aa300_study, number for number
+    # one sweep case = the AA300 design study of robodyn.simulation.aa300_study, number for number
     task = ActuatorSizing(RobotSource.of("aa300"))
     for gravity in (True, False):
         result = task({"payload": 50.0, "gravity_compensation": gravity})

@@ -32,9 +32,9 @@ from robodyn.hydro.study import effect_variant
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import StudyError
 from robodyn.robot.model import Robot
-from robodyn.simulate.controllers import ComputedTorque
-from robodyn.simulate.simulation import Trajectory, simulate
-from robodyn.simulate.trajectory import JointTrajectory
+from robodyn.simulation.controllers import ComputedTorque
+from robodyn.simulation.simulation import Trajectory, simulate
+from robodyn.simulation.trajectory import JointTrajectory
 
 __all__ = ["OMITTED", "ModelErrorStudy", "model_error_study", "model_without"]
 

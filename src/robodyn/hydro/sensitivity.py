@@ -35,8 +35,8 @@ from robodyn.hydro.study import effect_variant
 from robodyn.numeric.model import compile_model
 from robodyn.robot.errors import StudyError
 from robodyn.robot.model import Robot
-from robodyn.simulate.simulation import Trajectory, simulate
-from robodyn.simulate.trajectory import JointTrajectory
+from robodyn.simulation.simulation import Trajectory, simulate
+from robodyn.simulation.trajectory import JointTrajectory
 
 __all__ = ["DEFAULT_CD_VALUES", "DEFAULT_CURRENT_SPEEDS", "Sensitivity", "sensitivity",
            "with_drag_coefficient"]

@@ -57,9 +57,9 @@ from robodyn.robot.errors import StudyError
 from robodyn.robot.model import Robot
 from robodyn.robot.overrides import checked_parameter_values
 from robodyn.robot.sizes import time_grid_steps
-from robodyn.simulate.controllers import PD
-from robodyn.simulate.simulation import Trajectory, simulate
-from robodyn.simulate.trajectory import JointTrajectory, quintic
+from robodyn.simulation.controllers import PD
+from robodyn.simulation.simulation import Trajectory, simulate
+from robodyn.simulation.trajectory import JointTrajectory, quintic
 
 __all__ = [
     "DEFAULT_CURRENT",

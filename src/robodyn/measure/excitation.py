@@ -61,7 +61,7 @@ from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 from robodyn.robot.sizes import time_grid_steps
-from robodyn.simulate.trajectory import JointTrajectory
+from robodyn.simulation.trajectory import JointTrajectory
 from robodyn.symbolic.regressor import JOINT_NAMES, PER_JOINT, parameter_names
 
 Criterion = Literal["cond", "logdet"]
@@ -170,7 +170,7 @@ def base_columns(model: Model, rng: np.random.Generator | int | None = 0, *, sam
     limits or ``+-pi``, velocities and accelerations standard normal) and stacked; QR with column
     pivoting picks the columns, and the rank is the number of ``|R_kk| > rtol |R_00|`` after the
     columns are scaled to unit norm (so the units of the parameters do not decide the rank): the
-    rule of :func:`robodyn.identify.base.base_relations`, which also gives the combinations the
+    rule of :func:`robodyn.identification.base.base_relations`, which also gives the combinations the
     dependent columns make (not needed here, and importing it would tie ``measure`` to ``identify``).
 
     Parameters
@@ -433,8 +433,8 @@ class Excitation:
         return q, qd, qdd
 
     def trajectory(self, knot_step: float = 0.01) -> JointTrajectory:
-        """The motion as a :class:`~robodyn.simulate.trajectory.JointTrajectory` (a reference
-        for :func:`robodyn.simulate` controllers): quintic Hermite pieces matching q, qd, qdd of
+        """The motion as a :class:`~robodyn.simulation.trajectory.JointTrajectory` (a reference
+        for :func:`robodyn.simulation` controllers): quintic Hermite pieces matching q, qd, qdd of
         the series exactly at knots every ``knot_step`` s."""
         steps = max(1, int(np.ceil(self.duration / knot_step - 1e-9)))
         tk = np.linspace(0.0, self.duration, steps + 1)

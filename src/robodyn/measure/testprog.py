@@ -8,13 +8,13 @@
     and makes each drive's gain observable on its own.
 ``iso_cube``
     The five ISO 9283 test points P1..P5 on the diagonal plane of a cube placed in the workspace
-    (:func:`robodyn.calibrate.iso9283.cube_points`), reached by damped-least-squares inverse
-    kinematics (:func:`robodyn.simulate.inverse_kinematics`, each solution warm-started from the
+    (:func:`robodyn.calibration.iso9283.cube_points`), reached by damped-least-squares inverse
+    kinematics (:func:`robodyn.simulation.inverse_kinematics`, each solution warm-started from the
     previous one), visited in the order P1 P2 P3 P4 P5 (back to P1) for a number of cycles with
     synchronised joint-space trapezoidal moves and a dwell at each pose.
 
-Both return a :class:`TestProgram`: a :class:`~robodyn.simulate.trajectory.JointTrajectory`
-(``t, q, qd, qdd``; a reference for :func:`robodyn.simulate` controllers and for
+Both return a :class:`TestProgram`: a :class:`~robodyn.simulation.trajectory.JointTrajectory`
+(``t, q, qd, qdd``; a reference for :func:`robodyn.simulation` controllers and for
 :func:`robodyn.measure.virtual_lab.virtual_lab`) and the list of its segments, writable as CSV.
 """
 
@@ -27,13 +27,13 @@ from pathlib import Path
 
 import numpy as np
 
-from robodyn.calibrate.iso9283 import cube_points
+from robodyn.calibration.iso9283 import cube_points
 from robodyn.measure.excitation import excitation_limits, write_trajectory_csv
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
-from robodyn.simulate.ik import UnreachableError, inverse_kinematics
-from robodyn.simulate.trajectory import JointTrajectory, concatenate, trapezoidal
+from robodyn.simulation.ik import UnreachableError, inverse_kinematics
+from robodyn.simulation.trajectory import JointTrajectory, concatenate, trapezoidal
 
 __all__ = ["Segment", "TestProgram", "default_cube_center", "iso_cube", "jointwise"]
 

@@ -35,9 +35,9 @@ from robodyn.measure.testprog import TestProgram
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
-from robodyn.simulate.controllers import ComputedTorque, Controller
-from robodyn.simulate.simulation import simulate
-from robodyn.simulate.trajectory import JointTrajectory
+from robodyn.simulation.controllers import ComputedTorque, Controller
+from robodyn.simulation.simulation import simulate
+from robodyn.simulation.trajectory import JointTrajectory
 
 __all__ = ["LabRun", "Sensors", "Truth", "virtual_lab"]
 
@@ -174,7 +174,7 @@ def virtual_lab(robot: Robot | Model, trajectory: JointTrajectory | TestProgram 
         The plant (its compiled model is simulated).
     trajectory : JointTrajectory, TestProgram or Excitation
         The program to run (from :mod:`robodyn.measure.testprog`, :func:`robodyn.excitation` or
-        :mod:`robodyn.simulate.trajectory`); the arm starts at rest at its first position.
+        :mod:`robodyn.simulation.trajectory`); the arm starts at rest at its first position.
     sensors : Sensors, optional
         Default ``Sensors()``.
     seed : int

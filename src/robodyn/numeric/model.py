@@ -55,7 +55,7 @@ ParameterValues = Mapping[str, float] | Sequence[Mapping[str, float]] | np.ndarr
 _PREFIX = "rd_"
 
 #: Largest output of one :meth:`Model.integrate` call (states and torques), bytes: longer runs
-#: are split into several calls (as :func:`robodyn.simulate.simulate` does).
+#: are split into several calls (as :func:`robodyn.simulation.simulate` does).
 MAX_INTEGRATE_BYTES = 1 << 30
 
 
@@ -628,7 +628,7 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
         Named parameters (``robot.parameters``) that stay inputs of the generated kernels
         instead of being folded in as constants: True for all of them, or their names. Every
         method of the model then takes ``parameters=`` (one set, or one per state), and
-        :meth:`Model.integrate` / :func:`robodyn.simulate` one set per trajectory of an
+        :meth:`Model.integrate` / :func:`robodyn.simulation` one set per trajectory of an
         ensemble, all in one C call. ``parameters`` gives their default values. The code is
         slower than with folded constants (no constant folding), and a state's bits may
         differ from a model compiled with the same values in the last places (other rounding

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from robodyn.calibrate.result import Calibration, ErrorStats
-from robodyn.calibrate.simulate_study import StudyResult
+from robodyn.calibration.result import Calibration, ErrorStats
+from robodyn.calibration.simulate_study import StudyResult
 from robodyn.report.html import figure, html_table, page
 
 __all__ = ["calibration_figure", "calibration_html", "study_section"]

@@ -90,7 +90,7 @@ def _simulation(ctx: DemoContext) -> tuple[str, bool]:
 
 def _calibration(ctx: DemoContext) -> tuple[str, bool]:
     """Run the PUMA 560 calibration study into ``out/calibration``; (HTML section, all ok)."""
-    from robodyn.calibrate.simulate_study import puma_study
+    from robodyn.calibration.simulate_study import puma_study
     from robodyn.report.calibration_report import study_section
 
     with progress("PUMA 560 calibration study (DH, Hayati, S-model, POE; 2 tracker noises)"):

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from robodyn.report.html import figure, html_table, page
-from robodyn.validate.validation import Validation
+from robodyn.validation.validation import Validation
 
 __all__ = ["KINOVA_CONTROLLER_GAINS", "combined_relative", "identification_html",
            "kinova_section", "parameter_table", "validation_html", "validation_section"]
@@ -69,7 +69,7 @@ def validation_section(val: Validation, out: Path, folder: str, stem: str, headi
     level : int
         HTML heading level.
     """
-    from robodyn.validate import figures
+    from robodyn.validation import figures
 
     draw = {"prediction": figures.prediction_figure, "friction": figures.friction_figure,
             "errors": figures.error_histogram_figure, "spectra": figures.spectra_figure}
@@ -237,7 +237,7 @@ def kinova_section(out: Path, data_dir: Path | None = None, method: str = "wls",
             ident = rd.identify(robot, train, target="current", method=method)
         friction_html = ""
         if friction_models:
-            from robodyn.identify.friction import friction_table
+            from robodyn.identification.friction import friction_table
 
             with progress(f"Kinova Gen3: held-out error of {len(friction_models)} friction models"):
                 ft = friction_table(robot, train, test, models=friction_models, target="current",
@@ -276,7 +276,7 @@ the controller's current-to-torque constants (9.13 N m/A joints 1&ndash;4, 5.852
 5&ndash;7), no friction and no rotor inertia.</p>
 <h3>Held-out current error (last 30 % of the whole-arm runs, all joints together)</h3>
 <p>"Against filtered" and the noise floor use validation's {held_id[0].noise.cutoff:g} Hz
-zero-phase low-pass, the reference filter of <code>robodyn.validate.heldout</code> (the data
+zero-phase low-pass, the reference filter of <code>robodyn.validation.heldout</code> (the data
 README does not state its cut-off; this one reproduces the noise floor of about 0.26 that it
 quotes). The friction table below uses the same filter.</p>
 {html_table(("model", "relative error (raw)", "against filtered", "noise floor",
@@ -396,7 +396,7 @@ def _joint_row(j: int, robot: Any, ident: Any, held_id: Sequence[Validation],
 
 
 def _friction_html(ft: Any, names: Sequence[str]) -> str:
-    """The friction-model table (``robodyn.identify.friction.friction_table``) as HTML."""
+    """The friction-model table (``robodyn.identification.friction.friction_table``) as HTML."""
     rows = [[r["model"], f"{r['relative_error']:.3f}", f"{r['relative_error_filtered']:.3f}",
              f"{r['noise_floor']:.3f}", *(f"{r[f'relative_error_{n}']:.3f}" for n in names)]
             for _, r in ft.iterrows()]
@@ -404,7 +404,7 @@ def _friction_html(ft: Any, names: Sequence[str]) -> str:
                *names)
     return f"""<h3>What friction adds (held-out current error by friction model)</h3>
 <p>Each friction model identified anew on the same 70 % and evaluated on the same held-out 30 %
-(<code>robodyn.identify.friction.friction_table</code>; "against filtered" and the noise floor
+(<code>robodyn.identification.friction.friction_table</code>; "against filtered" and the noise floor
 use the identification's own low-pass cut-off). "none" is the rigid-body and drive model
 alone: the difference to the other rows is what friction is worth here.</p>
 {html_table(headers, rows)}"""

@@ -11,11 +11,11 @@ import robodyn as rd
 from robodyn.codegen.emit import generate
 from robodyn.report.html import figure
 from robodyn.report.text import progress
-from robodyn.simulate.aa300_study import run_study
-from robodyn.simulate.balance import balance_double_pendulum
-from robodyn.simulate.controllers import ComputedTorque
-from robodyn.simulate.plots import balance_figure
-from robodyn.simulate.trajectory import quintic
+from robodyn.simulation.aa300_study import run_study
+from robodyn.simulation.balance import balance_double_pendulum
+from robodyn.simulation.controllers import ComputedTorque
+from robodyn.simulation.plots import balance_figure
+from robodyn.simulation.trajectory import quintic
 
 
 def simulation_sections(robot: rd.Robot, out: Path, backend: str = "c") -> tuple[str, bool]:
@@ -43,7 +43,7 @@ def simulation_sections(robot: rd.Robot, out: Path, backend: str = "c") -> tuple
         err = float(np.max(np.abs(sim.q - plan.q[: len(sim.t)])))
         err_held = float(np.max(np.abs(held.q - plan.q[: len(held.t)])))
     # continuous law, exact model (rotor inertia and friction included): RK4's own error only
-    # (tests/simulate checks its fourth-order convergence)
+    # (tests/simulation checks its fourth-order convergence)
     ok_track = err < 1e-8
     parts.append(
         "<h2>Computed torque, PUMA 560</h2><p>Quintic move from zero to "

@@ -51,7 +51,7 @@ class DescriptionWarning(UserWarning):
 class ValidationError(RobodynError, ValueError):
     """Measured data cannot be compared with a robot's model.
 
-    Raised by :func:`robodyn.validate`: the message names the recording (its source file), the
+    Raised by :func:`robodyn.validation`: the message names the recording (its source file), the
     field or joint, the row where one matters, and the reason (joints that do not match the
     robot, a missing target signal, too few samples, values that are not finite).
     """
@@ -87,7 +87,7 @@ class SingularMassMatrixError(SimulationError):
 class IdentificationError(RobodynError, ValueError):
     """Measured data cannot be used to identify a robot's parameters, or an estimator failed.
 
-    Raised by :func:`robodyn.identify`: the message names the recording (its source file), the
+    Raised by :func:`robodyn.identification`: the message names the recording (its source file), the
     field or joint, the row where one matters, and the reason (joints that do not match the
     robot, too few samples for the parameters, values that are not finite, an infeasible or
     failed semidefinite program).
@@ -107,7 +107,7 @@ class StudyError(RobodynError, ValueError):
 class DataFileError(RobodynError, ValueError):
     """A data table (calibration poses, ISO 9283 cycles, approach records) cannot be read.
 
-    Raised by :func:`robodyn.calibrate.io.read_table` and the readers built on it: the message
+    Raised by :func:`robodyn.calibration.io.read_table` and the readers built on it: the message
     names the file, the line (1-based, as an editor counts) and the column where known, and the
     reason (not a UTF-8 text file, a row with more or fewer values than the header, a missing or
     repeated column, a value that is not a finite number).

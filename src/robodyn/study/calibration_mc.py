@@ -1,7 +1,7 @@
 """Calibration Monte Carlo as a study task: random manufacturing errors, noisy tracker, held-out error.
 
 Each case draws, from its own seed, a "true" robot (the nominal one with random joint placement
-errors and zero offsets, :func:`robodyn.calibrate.simulate_study.perturbed_robot`), ``n_poses``
+errors and zero offsets, :func:`robodyn.calibration.simulate_study.perturbed_robot`), ``n_poses``
 random calibration poses and ``n_test`` held-out poses; measures the true tool positions with
 Gaussian noise ``sigma`` per coordinate; calibrates ``model`` (``rd.calibrate``) and reports the
 held-out errors. Over many seeds, the table is the distribution of the calibrated accuracy for
@@ -75,8 +75,8 @@ class CalibrationMonteCarlo:
                                  f"(known: {', '.join(known)})")
 
     def __call__(self, case: Mapping[str, Any]) -> dict[str, float]:
-        from robodyn.calibrate.pipeline import calibrate, random_configurations
-        from robodyn.calibrate.simulate_study import perturbed_robot, robot_positions
+        from robodyn.calibration.pipeline import calibrate, random_configurations
+        from robodyn.calibration.simulate_study import perturbed_robot, robot_positions
 
         self.check_case(case, "case")
         if "seed" not in case:

@@ -5,7 +5,7 @@ Each case runs the excitation program on the robot in the virtual laboratory
 sensor noise, identifies the base parameters from the joint torques (``rd.identify``, decimated to
 100 Hz) and compares them with the truth. The plant is the description itself, so the true base
 parameters are ``relations.to_base(nominal_standard(robot))`` -- the same base relations and
-standard vector ``rd.identify`` uses (:mod:`robodyn.identify.base`).
+standard vector ``rd.identify`` uses (:mod:`robodyn.identification.base`).
 
 Excitations: ``"optimal"`` (``rd.excitation``: a Fourier trajectory of ``harmonics`` harmonics,
 design seed 0, one period of ``1 / base_frequency`` s) or ``"jointwise"`` (the thesis's one joint
@@ -119,7 +119,7 @@ class IdentificationMonteCarlo:
 
     def __call__(self, case: Mapping[str, Any]) -> dict[str, float]:
         import robodyn as rd
-        from robodyn.identify.pipeline import nominal_standard
+        from robodyn.identification.pipeline import nominal_standard
         from robodyn.measure.virtual_lab import Sensors, virtual_lab
         from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
 

@@ -102,7 +102,7 @@ def robot_of(source: RobotSource) -> Robot:
 @lru_cache(maxsize=MODELS_PER_PROCESS)
 def _model(source: RobotSource, payload: float, parameters: tuple[tuple[str, float], ...],
            backend: str) -> Model:
-    from robodyn.simulate.aa300_study import with_payload
+    from robodyn.simulation.aa300_study import with_payload
 
     robot = with_payload(robot_of(source), payload)
     return compile_model(robot, backend, parameters=dict(parameters) or None)  # type: ignore[arg-type]

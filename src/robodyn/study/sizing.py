@@ -1,6 +1,6 @@
 """Actuator sizing as a study task: one simulated manoeuvre per case, peak/RMS torque and power.
 
-:class:`ActuatorSizing` is the AA300 design study (:mod:`robodyn.simulate.aa300_study`) cut down
+:class:`ActuatorSizing` is the AA300 design study (:mod:`robodyn.simulation.aa300_study`) cut down
 to one case of a sweep: a robot (description text), a planned joint motion, a PD controller
 (with or without gravity compensation) tuned from a closed-loop bandwidth, and per case
 parameters (payload, bandwidth, damping, controller, the description's named parameters). The
@@ -56,7 +56,7 @@ class ActuatorSizing:
     robot : RobotSource
         ``RobotSource.of("aa300")`` or a description file.
     trajectory : {"aa300_cycle", "trapezoid"}
-        The AA300 pick-lift-rotate-place cycle (:func:`robodyn.simulate.aa300_study.plan_cycle`,
+        The AA300 pick-lift-rotate-place cycle (:func:`robodyn.simulation.aa300_study.plan_cycle`,
         AA300 only), or a synchronised trapezoidal joint move from ``q_start`` to ``q_goal``.
     q_start, q_goal : (n,) tuple of float
         Trapezoid end points, rad or m.
@@ -109,8 +109,8 @@ class ActuatorSizing:
                                  f"{self.robot.name} (known: {', '.join(known)})")
 
     def __call__(self, case: Mapping[str, Any]) -> dict[str, float]:
-        from robodyn.simulate.controllers import PD, GravityCompensation
-        from robodyn.simulate.simulation import simulate
+        from robodyn.simulation.controllers import PD, GravityCompensation
+        from robodyn.simulation.simulation import simulate
 
         self.check_case(case, "case")
         robot = robot_of(self.robot)
@@ -175,8 +175,8 @@ def _plan(source: RobotSource, overrides: tuple[tuple[str, float], ...], backend
           dt: float, q_start: Sequence[float], q_goal: Sequence[float], vmax: Sequence[float],
           amax: Sequence[float], speed_scale: float) -> Any:
     """The planned motion, once per process and kinematics (planned on the payload-free model)."""
-    from robodyn.simulate.aa300_study import plan_cycle
-    from robodyn.simulate.trajectory import trapezoidal
+    from robodyn.simulation.aa300_study import plan_cycle
+    from robodyn.simulation.trajectory import trapezoidal
 
     if not speed_scale > 0:
         raise StudyError(f"speed_scale must be > 0, got {speed_scale!r}")

@@ -1,0 +1,784 @@
+"""``calibrate``: kinematic calibration from measured target positions, end to end.
+
+Steps (each a function of its own module):
+
+1. the nominal geometry of the robot (:mod:`~robodyn.calibration.nominal`);
+2. the instrument placement and target offset for the nominal kinematics: rigid registration of
+   the nominal predictions onto the measurements (Kabsch, alternated with a linear solve for the
+   target offset), refined by least squares on those 6 + 3 parameters only. Its residuals are
+   the "before" errors;
+3. the initial estimate: the nominal model so placed, or circle-point analysis
+   (:mod:`~robodyn.calibration.circle_point`);
+4. identifiability (:mod:`~robodyn.calibration.identifiability`): the parameters no pose set can
+   identify (found on random poses at the initial estimate), then those this pose set cannot;
+5. weighted Levenberg-Marquardt on all poses (:mod:`~robodyn.calibration.solve`);
+6. the calibrated robot (:mod:`~robodyn.calibration.to_robot`) and the result.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from robodyn.calibration.circle_point import CirclePointResult, circle_point
+from robodyn.calibration.identifiability import (
+    Unidentifiable,
+    compress_rows,
+    describe,
+    independent_columns,
+    observability,
+)
+from robodyn.calibration.kinematics import hom, inv
+from robodyn.calibration.models import MODELS, ErrorModel, build_model, extend_model, model_frames
+from robodyn.calibration.nominal import RobotGeometry, default_frame0, robot_geometry
+from robodyn.calibration.result import Calibration, ErrorStats, Parameter
+from robodyn.calibration.solve import LOSSES, Fit, fit, rotation_vector
+from robodyn.calibration.to_robot import calibrated_robot
+from robodyn.robot.errors import InputError
+from robodyn.robot.model import Robot
+
+__all__ = ["calibrate", "check_data", "compensate", "identifiable_parameters", "inverse_kinematics",
+           "nominal_placement", "random_configurations", "validate",
+           "validate_orientation"]
+
+#: Threshold of :func:`~robodyn.calibration.identifiability.independent_columns`.
+RANK_TOL = 1e-7
+
+
+def _array(name: str, value, shape_text: str) -> np.ndarray:
+    try:
+        a = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be a numeric array of shape {shape_text}: {exc}") from None
+    bad = np.argwhere(~np.isfinite(a))
+    if bad.size:
+        row = int(bad[0][0])
+        col = f", column {int(bad[0][1])}" if bad.shape[1] > 1 else ""
+        raise InputError(f"{name} has NaN or infinite values ({len(bad)} entries; first at row {row}{col})")
+    return a
+
+
+def check_data(robot: Robot, q, points, orientations=None, sigma=5e-5,
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray]:
+    """Validate calibration data; returns q (N, n), points, orientations and sigma (shape of points).
+
+    ``points`` is (N, 3), or (N, K, 3) for K targets measured at each pose.
+
+    Raises
+    ------
+    ValueError
+        On wrong shapes, mismatched lengths, NaN or infinite values, non-rotations, bad sigma.
+    """
+    n = robot.dof
+    q = _array("q", q, f"(N, {n})")
+    points = _array("points", points, "(N, 3) or (N, K, 3)")
+    if q.ndim != 2 or q.shape[1] != n:
+        raise InputError(f"q must have shape (N, {n}) for {robot.name}'s {n} joints "
+                         f"({', '.join(robot.joint_names)}); got {q.shape}")
+    if points.ndim not in (2, 3) or points.shape[-1] != 3 or (points.ndim == 3 and points.shape[1] < 1):
+        raise InputError(f"points must have shape (N, 3) or (N, K, 3) for K targets per pose; "
+                         f"got {points.shape}")
+    if len(q) != len(points):
+        raise InputError(f"mismatched lengths: q has {len(q)} poses but points has {len(points)}")
+    if orientations is not None:  # one per pose: the frame of the body that carries the targets
+        orientations = _array("orientations", orientations, "(N, 3, 3)")
+        if orientations.shape != (len(q), 3, 3):
+            raise InputError(f"orientations must have shape ({len(q)}, 3, 3); got {orientations.shape}")
+        err = np.abs(orientations @ np.swapaxes(orientations, 1, 2) - np.eye(3)).max(axis=(1, 2))
+        det = np.linalg.det(orientations)
+        bad = np.flatnonzero((err > 1e-6) | (det < 0))
+        if bad.size:
+            raise InputError(f"orientations[{bad[0]}] is not a rotation matrix ({bad.size} such rows)")
+    s = _array("sigma", sigma, "scalar, (N,), (N, 3) or the shape of points")
+    if s.ndim == 1:
+        s = s.reshape((-1,) + (1,) * (points.ndim - 1))
+    elif s.ndim == 2 and points.ndim == 3:
+        s = s[:, None, :]
+    try:
+        s = np.broadcast_to(s, points.shape).copy()
+    except ValueError:
+        raise InputError(f"sigma must be a scalar, (N,), (N, 3) or {points.shape} for N = {len(points)}; "
+                         f"got shape {np.shape(sigma)}") from None
+    if not np.all(s > 0):
+        raise InputError("sigma must be positive")
+    return q, points, orientations, s
+
+
+#: Length and angle units accepted by :func:`calibrate`, with their factor to SI.
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3}
+ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180}
+
+
+def convert_units(robot: Robot, q, points, sigma, sigma_rot, length_unit: str, angle_unit: str):
+    """Copies of q, points, sigma and sigma_rot in m and rad (revolute joints' readings only).
+
+    Raises
+    ------
+    ValueError
+        An unknown unit.
+    """
+    if length_unit not in LENGTH_UNITS:
+        raise InputError(f"length_unit must be one of {', '.join(LENGTH_UNITS)}, got {length_unit!r}")
+    if angle_unit not in ANGLE_UNITS:
+        raise InputError(f"angle_unit must be one of {', '.join(ANGLE_UNITS)}, got {angle_unit!r}")
+    if length_unit == "m" and angle_unit == "rad":
+        return q, points, sigma, sigma_rot
+    lf, af = LENGTH_UNITS[length_unit], ANGLE_UNITS[angle_unit]
+    q = _array("q", q, f"(N, {robot.dof})")
+    if q.ndim == 2 and q.shape[1] == robot.dof:
+        scale = np.array([af if j.type == "revolute" else 1.0 for j in robot.joints])
+        q = q * scale  # a new array: the caller's is not modified
+    return q, _array("points", points, "(N, 3)") * lf, _array("sigma", sigma, "") * lf, sigma_rot * af
+
+
+def check_magnitude(geometry: RobotGeometry, q: np.ndarray, points: np.ndarray, length_unit: str) -> None:
+    """Reject data whose spread contradicts the declared length unit.
+
+    The spread (RMS distance from the mean) of the measured points is compared with that of the
+    nominal model's target over the same readings; they differ by a rigid placement and small
+    errors only, so a ratio beyond 30 (or below 1/30) means the unit is wrong (millimetres given
+    as metres gives 1000).
+
+    Raises
+    ------
+    ValueError
+        Naming the declared unit, the two spreads and the likely unit.
+    """
+    if len(q) < 3:
+        return
+    nominal = build_model("dh", geometry)
+    p = nominal.evaluate(nominal.initial, q, derivatives=False).position
+    y = points.reshape(len(q), -1, 3)[:, 0]
+    spread_n = float(np.sqrt(((p - p.mean(axis=0)) ** 2).sum(axis=1).mean()))
+    spread_y = float(np.sqrt(((y - y.mean(axis=0)) ** 2).sum(axis=1).mean()))
+    if spread_n <= 0 or spread_y <= 0:
+        return
+    ratio = spread_y / spread_n
+    if ratio > 30 or ratio < 1 / 30:
+        hint = ("the data look like millimetres: give length_unit='mm' (CLI --length-unit mm)"
+                if 300 < ratio < 3000 else
+                "the data look like metres: give length_unit='m'" if 3e-4 < ratio < 3e-3 else
+                "check the units of the points and of the joint readings (deg vs rad)")
+        raise InputError(f"points contradict length_unit {length_unit!r}: the measured points spread "
+                         f"{spread_y:.4g} {'units' if length_unit != 'm' else 'm'} (as given, converted: "
+                         f"{spread_y:.4g} m) where the nominal model's target spreads {spread_n:.4g} m over "
+                         f"the same readings (ratio {ratio:.3g}); {hint}")
+
+
+def target_offsets(model: ErrorModel, params: np.ndarray, q: np.ndarray, points: np.ndarray,
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Positions in the last link frame of further targets, by linear least squares.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        A geometric model with one target (its tool parameters are set to zero here).
+    params : numpy.ndarray, shape (P,)
+    q : numpy.ndarray, shape (N, n)
+    points : numpy.ndarray, shape (N, K', 3)
+        Measured positions of the further targets, m.
+
+    Returns
+    -------
+    offsets : numpy.ndarray, shape (K', 3)
+    residuals : numpy.ndarray, shape (N, K', 3)
+    """
+    p = np.array(params, dtype=float)
+    p[[model.index(f"tool.{a}") for a in "xyz"]] = 0.0
+    ev = model.evaluate(p, q, derivatives=False)
+    r_last = ev.rotation @ model.target_rotation(p).T  # offsets are in the last link frame
+    offsets = np.zeros((points.shape[1], 3))
+    res = np.zeros(points.shape)
+    for k in range(points.shape[1]):
+        # R_i t = y_ik - o_i, stacked over poses
+        offsets[k], *_ = np.linalg.lstsq(r_last.reshape(-1, 3), (points[:, k] - ev.position).ravel(),
+                                         rcond=None)
+        res[:, k] = points[:, k] - ev.position - r_last @ offsets[k]
+    return offsets, res
+
+
+def random_configurations(robot: Robot, count: int, rng: np.random.Generator | int = 0) -> np.ndarray:
+    """Uniformly random joint readings within the joint limits, shape (count, n).
+
+    Joints without limits range over ``[-pi, pi]`` (revolute) or ``[-0.5, 0.5]`` m (prismatic).
+    """
+    rng = np.random.default_rng(rng)
+    subs = robot.defaults()
+    lo, hi = [], []
+    for j in robot.joints:
+        default = (-math.pi, math.pi) if j.type == "revolute" else (-0.5, 0.5)
+        lower = float(j.lower.xreplace(subs)) if j.lower is not None else default[0]
+        upper = float(j.upper.xreplace(subs)) if j.upper is not None else default[1]
+        lo.append(lower)
+        hi.append(upper)
+    return rng.uniform(lo, hi, size=(count, robot.dof))
+
+
+def _rows(model: ErrorModel, params: np.ndarray, q: np.ndarray, weights: np.ndarray,
+          rot_weight: float) -> np.ndarray:
+    """Weighted identification Jacobian, shape (N * r, P)."""
+    jac = model.evaluate(params, q).jac_param
+    j = jac[:, :3] * weights[:, :, None]
+    if model.orientation and model.targets > 1:
+        # one orientation per pose (the rows of every target carry the same rotation)
+        rot = jac[:: model.targets, 3:] * rot_weight
+        return np.concatenate((j.reshape(-1, model.n_params), rot.reshape(-1, model.n_params)))
+    if model.orientation:
+        j = np.concatenate((j, jac[:, 3:] * rot_weight), axis=1)
+    return j.reshape(-1, model.n_params)
+
+
+def nominal_placement(geometry: RobotGeometry, q: np.ndarray, points: np.ndarray,
+              orientations: np.ndarray | None, sigma: np.ndarray, sigma_rot: float,
+              ) -> tuple[np.ndarray, np.ndarray, ErrorModel, np.ndarray]:
+    """Instrument placement and target for the nominal kinematics ("before" calibration).
+
+    Returns the robot world frame in the instrument frame (4, 4), the before residuals (N, 3),
+    and the placed nominal DH model with its fitted parameters.
+    """
+    nominal = build_model("dh", geometry)
+    p = nominal.initial.copy()
+    tool = [nominal.index(f"tool.{a}") for a in "xyz"]
+    offset = p[tool].copy()
+    p[tool] = 0.0
+    ev = nominal.evaluate(p, q, derivatives=False)  # last model frame, world
+    rn, on = ev.rotation, ev.position
+    x = np.eye(4)
+    for _ in range(50):
+        y = rn @ offset + on
+        x = _kabsch(y, points)
+        # linear target offset: (R R_n) p = points - t - R o_n
+        a = (x[:3, :3] @ rn).reshape(-1, 3)
+        b = (points - x[:3, 3] - on @ x[:3, :3].T).ravel()
+        new, *_ = np.linalg.lstsq(a, b, rcond=None)
+        if np.linalg.norm(new - offset) < 1e-12:
+            offset = new
+            break
+        offset = new
+    r_tool = np.eye(3)
+    if orientations is not None:
+        # tool rotation in the last frame: the rotation nearest mean_k (R_x R_n,k)^T R_measured,k
+        u, _, vt = np.linalg.svd(np.einsum("kji,kjl->il", x[:3, :3] @ rn, orientations))
+        r_tool = u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
+    zero = nominal.evaluate(p, np.zeros((1, geometry.dof)), derivatives=False)
+    target = x @ hom(zero.rotation[0] @ r_tool, zero.rotation[0] @ offset + zero.position[0])
+    placed = build_model("dh", geometry, base=x, target=target, orientation=orientations is not None)
+    p0 = placed.initial.copy()
+    names = [f"base.{a}" for a in ("x", "y", "z", "rx", "ry", "rz")] + [f"tool.{a}" for a in "xyz"]
+    if orientations is not None:
+        names += [f"tool.r{a}" for a in "xyz"]
+    cand = [placed.index(name) for name in names]
+    rot_weight = 1.0 / sigma_rot if orientations is not None else 0.0
+    jac = _rows(placed, p0, q, 1.0 / sigma, rot_weight)[:, cand]
+    free = [cand[k] for k in independent_columns(jac, range(len(cand)), RANK_TOL)]
+    res = fit(placed, p0, free, q, points, sigma=sigma, orientations=orientations, sigma_rot=sigma_rot)
+    frame0, _, _ = model_frames(placed, res.params)
+    world = frame0 @ inv(default_frame0(geometry))
+    return world, res.residuals, placed, res.params
+
+
+def _kabsch(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Rigid transform (4, 4) minimising ``sum |R a_k + t - b_k|^2`` for point sets (N, 3)."""
+    ca, cb = a.mean(axis=0), b.mean(axis=0)
+    h = (a - ca).T @ (b - cb)
+    u, _, vt = np.linalg.svd(h)
+    d = np.diag([1.0, 1.0, np.sign(np.linalg.det(vt.T @ u.T))])
+    r = vt.T @ d @ u.T
+    return hom(r, cb - r @ ca)
+
+
+def identifiable_parameters(robot: Robot, model: ErrorModel, params: np.ndarray, q: np.ndarray,
+                            weights: np.ndarray | float = 1.0, rot_weight: float = 1.0,
+                            ) -> tuple[list[int], list[Unidentifiable]]:
+    """Identifiable parameters of ``model`` for the poses ``q``, and the reasons for the others.
+
+    Structure first: random poses within the joint limits, unit weights, at ``params``; then the
+    given poses with ``weights`` (1 / sigma, scalar or (N, 3)) and ``rot_weight`` (1 / sigma_rot).
+
+    Returns
+    -------
+    free : list of int
+        Indices of the identifiable parameters, in the model's priority order.
+    unidentifiable : list of Unidentifiable
+    """
+    weights = np.broadcast_to(np.asarray(weights, dtype=float).reshape(-1, 3) if np.ndim(weights) else
+                              weights, (len(q) * model.targets, 3))
+    qr = random_configurations(robot, max(3 * model.n_params, 60), rng=12345)
+    ones = np.ones((len(qr) * model.targets, 3))
+    js = compress_rows(_rows(model, params, qr, ones, 1.0))  # same column geometry, L rows
+    kept_s = independent_columns(js, model.priority, RANK_TOL)
+    drop_s = [k for k in model.priority if k not in kept_s]
+    out = [Unidentifiable(model.names[k], float(params[k]), "structural", combo,
+                          f"{text}, whatever the poses")
+           for k, (combo, text) in zip(drop_s, describe(js, model.names, kept_s, drop_s), strict=True)]
+    jd = compress_rows(_rows(model, params, q, weights, rot_weight))
+    order = [k for k in model.priority if k in kept_s]
+    kept_d = independent_columns(jd, order, RANK_TOL)
+    drop_d = [k for k in order if k not in kept_d]
+    still = [robot.joint_names[j] for j in range(robot.dof) if np.ptp(q[:, j]) <= 1e-9]
+    note = f"; joint(s) {', '.join(still)} take a single value in every pose" if still else ""
+    for k, (combo, text) in zip(drop_d, describe(jd, model.names, kept_d, drop_d), strict=True):
+        out.append(Unidentifiable(model.names[k], float(params[k]), "pose set", combo,
+                                  f"{text} on this pose set (a richer pose set would identify it){note}"))
+    return sorted(kept_d, key=model.priority.index), out
+
+
+def calibrate(
+    robot: Robot,
+    q,
+    points,
+    model: str = "s-model",
+    *,
+    sigma: float | np.ndarray = 5e-5,
+    loss: str = "linear",
+    initial: str = "nominal",
+    circle_data: Sequence[tuple[np.ndarray, np.ndarray]] | None = None,
+    orientations=None,
+    sigma_rot: float = 1e-4,
+    loss_scale: float = 3.0,
+    parallel_tol: float = math.radians(1.0),
+    max_nfev: int | None = None,
+    nongeometric: Sequence[str] = (),
+    payload: tuple[float, Sequence[float]] | None = None,
+    identify_payload: bool = False,
+    length_unit: str = "m",
+    angle_unit: str = "rad",
+    deflection: str = "linear",
+) -> Calibration:
+    """Identify a robot's kinematics from measured target positions.
+
+    Parameters
+    ----------
+    robot : Robot
+        The nominal robot.
+    q : array_like, shape (N, n)
+        Joint readings at the measured poses, rad (m for prismatic joints).
+    points : array_like, shape (N, 3) or (N, K, 3)
+        Measured target positions in the instrument's frame, m; (N, K, 3) for K targets
+        (reflectors) measured at each pose, each with its own offset on the last link, all fitted
+        together. The instrument-to-base transform and the target offsets are unknown and
+        estimated.
+    model : {"s-model", "hayati", "dh", "poe"}
+        The error model (:mod:`robodyn.calibration.models`).
+    sigma : float or array_like, shape (N,) or (N, 3)
+        Standard uncertainty of each measured coordinate, m (0.05 mm by default).
+    loss : {"linear", "huber", "soft_l1", "cauchy", "arctan"}
+        Robust loss (on weighted residuals, in units of sigma, scaled by ``loss_scale``).
+    initial : {"nominal", "circle-point"}
+        Start from the nominal geometry, or from circle-point analysis of ``circle_data``.
+    circle_data : sequence of (q, points), optional
+        One data set per joint that moves only that joint (see
+        :func:`robodyn.calibration.circle_point.circle_point`); used for the initial estimate only.
+    orientations : array_like, shape (N, 3, 3), optional
+        Measured target orientations in the instrument frame (then the target's orientation is
+        estimated too).
+    sigma_rot : float
+        Standard uncertainty of a measured orientation, rad.
+    loss_scale : float
+    parallel_tol : float
+        Nominal consecutive axes closer than this to parallel (rad) get Hayati's link.
+    max_nfev : int, optional
+        Most residual evaluations of the final fit.
+    nongeometric : sequence of {"compliance", "harmonics"}
+        Non-geometric joint errors identified with the geometry
+        (:mod:`robodyn.calibration.nongeometric`): joint compliance under the gravity model's
+        holding torques, first harmonics of the joint (and motor) angles.
+    payload : (float, sequence of float), optional
+        Known payload for the compliance torques: mass (kg) and centre of mass in the tool frame (m).
+    identify_payload : bool
+        Estimate the payload (``payload.mass``, kg, and its first moments ``payload.mx``, ``.my``,
+        ``.mz``, kg m, in the tool frame; ``payload`` is then the starting value, else zero) with
+        the compliances. The payload acts only through the compliances, so the fit runs in
+        stages: compliances and geometry first, then again from that solution with the
+        identifiability checked there, while the identifiable set grows (at most three more
+        times). Needs ``"compliance"`` in ``nongeometric``.
+    length_unit : {"m", "mm"}
+        Unit of ``points`` and ``sigma`` (converted to m; the result is in m).
+    angle_unit : {"rad", "deg"}
+        Unit of the revolute joints' readings in ``q`` and of ``sigma_rot`` (converted to rad).
+    deflection : {"linear", "exact"}
+        Compliance model: the holding torque at the readings (``"linear"``, first order, compiles
+        nothing), or the static equilibrium at the deflected pose, ``x = u - C tau(x)``, solved by
+        Newton with the compiled model's analytic gravity derivatives and an exact Jacobian
+        (``"exact"``, :mod:`robodyn.calibration.deflection`; compiles the model on first use). Needs
+        ``"compliance"`` and link masses; not with ``identify_payload``.
+
+    Returns
+    -------
+    Calibration
+
+    Raises
+    ------
+    ValueError
+        On bad input: shapes, lengths, NaN, unknown options, too few poses for the identifiable
+        parameters, a circle-point set in which its joint never moved.
+    """
+    _check_options(model, loss, initial, nongeometric, payload, identify_payload, deflection,
+                   circle_data)
+    q, points, orientations, sig, sigma_rot, geometry = _prepared_data(
+        robot, q, points, orientations, sigma, sigma_rot, length_unit, angle_unit)
+    oriented = orientations is not None
+    pts3 = points if points.ndim == 3 else points[:, None]
+    sig3 = sig.reshape(pts3.shape)
+    world, target, placed, placed_params, before_res = _before_calibration(
+        geometry, q, pts3, orientations, sig3, sigma_rot, points.shape)
+    em, cp = _error_model(robot, geometry, model, initial, circle_data, target, world, oriented,
+                          parallel_tol, q, pts3, nongeometric, payload, identify_payload, deflection)
+    points = pts3.reshape(-1, 3)
+    sig = sig3.reshape(-1, 3)
+    res, unid = _identify(robot, em, model, q, points, sig, orientations, sigma_rot, pts3.shape[1],
+                          loss, loss_scale, max_nfev, identify_payload)
+    if not res.success:
+        warnings.warn(f"calibration of {robot.name} did not converge: {res.message}", RuntimeWarning,
+                      stacklevel=2)
+    _warn_variance_factor(robot.name, res.variance_factor)
+    return _calibration(robot, geometry, em, res, unid, q, sig, before_res, placed, placed_params, loss,
+                        initial, cp)
+
+
+def _prepared_data(robot: Robot, q, points, orientations, sigma, sigma_rot: float, length_unit: str,
+                   angle_unit: str,
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray, float, RobotGeometry]:
+    """The data of :func:`calibrate` in m and rad, checked, with the robot's nominal geometry.
+
+    Returns
+    -------
+    q : numpy.ndarray, shape (N, n)
+        Joint readings, rad (m for prismatic joints).
+    points : numpy.ndarray, shape (N, 3) or (N, K, 3)
+        Measured target positions, m.
+    orientations : numpy.ndarray or None, shape (N, 3, 3)
+    sigma : numpy.ndarray, shape of ``points``
+        Standard uncertainty of each coordinate, m.
+    sigma_rot : float
+        Standard uncertainty of an orientation, rad.
+    geometry : RobotGeometry
+    """
+    q, points, sigma, sigma_rot = convert_units(robot, q, points, sigma, sigma_rot, length_unit,
+                                                angle_unit)
+    q, points, orientations, sig = check_data(robot, q, points, orientations, sigma)
+    geometry = robot_geometry(robot)
+    check_magnitude(geometry, q, points, length_unit)
+    return q, points, orientations, sig, sigma_rot, geometry
+
+
+def _before_calibration(geometry: RobotGeometry, q: np.ndarray, pts3: np.ndarray,
+                        orientations: np.ndarray | None, sig3: np.ndarray, sigma_rot: float,
+                        shape: tuple[int, ...],
+                        ) -> tuple[np.ndarray, np.ndarray, ErrorModel, np.ndarray, np.ndarray]:
+    """The nominal model placed on the measurements, and its ("before") residuals.
+
+    ``q`` is (N, n); ``pts3`` (N, K, 3) the measured positions and ``sig3`` (N, K, 3) their
+    uncertainties, m; ``orientations`` (N, 3, 3) or None, ``sigma_rot`` in rad; ``shape`` that of
+    the points as given, (N, 3) or (N, K, 3).
+
+    Returns
+    -------
+    world : numpy.ndarray, shape (4, 4)
+        The robot world frame in the instrument frame.
+    target : numpy.ndarray, shape (4, 4)
+        The first target's frame at ``q = 0``, instrument frame.
+    placed : ErrorModel
+        The placed nominal DH model.
+    placed_params : numpy.ndarray, shape (P,)
+    before_res : numpy.ndarray, shape ``shape``
+        Residuals of the placed nominal model (with every target's offset fitted), m.
+    """
+    world, before1, placed, placed_params = nominal_placement(geometry, q, pts3[:, 0], orientations,
+                                                              sig3[:, 0], sigma_rot)
+    _, before_k = target_offsets(placed, placed_params, q, pts3[:, 1:])
+    before_res = np.concatenate((before1[:, None], before_k), axis=1).reshape(shape)
+    target = model_frames(placed, placed_params)[2]
+    return world, target, placed, placed_params, before_res
+
+
+def _identify(robot: Robot, em: ErrorModel, model: str, q: np.ndarray, points: np.ndarray,
+              sig: np.ndarray, orientations: np.ndarray | None, sigma_rot: float, k_count: int,
+              loss: str, loss_scale: float, max_nfev: int | None, identify_payload: bool,
+              ) -> tuple[Fit, list[Unidentifiable]]:
+    """The identifiable parameters of ``em`` and their fit from its initial values.
+
+    With ``identify_payload``, identifiability is checked again at the solution and the fit
+    repeated from it while the identifiable set grows (at most three more times).
+
+    ``q`` is (N, n); ``points`` (N * K, 3) the measured positions (the K = ``k_count`` targets of
+    each pose together) and ``sig`` (N * K, 3) their uncertainties, m; ``orientations``
+    (N, 3, 3) or None, ``sigma_rot`` in rad.
+
+    Returns
+    -------
+    fit : Fit
+    unidentifiable : list of Unidentifiable
+        Those of the last identifiability check.
+
+    Raises
+    ------
+    ValueError
+        Too few poses for the identifiable parameters.
+    """
+    oriented = orientations is not None
+    weights = 1.0 / sig
+    rot_weight = 1.0 / sigma_rot if oriented else 0.0
+    free, unid = identifiable_parameters(robot, em, em.initial, q, weights, rot_weight)
+    _check_pose_count(robot, em, model, unid, q, k_count, oriented)
+    res = fit(em, em.initial, free, q, points, sigma=sig, orientations=orientations,
+              sigma_rot=sigma_rot, loss=loss, loss_scale=loss_scale, max_nfev=max_nfev)
+    for _ in range(3 if identify_payload else 0):
+        # at c = 0 the payload has no effect, and a joint the arm alone does not load (a wrist)
+        # shows its compliance only under the payload: identifiability again at the solution,
+        # refit from it while the identifiable set grows
+        again, unid_again = identifiable_parameters(robot, em, res.params, q, weights, rot_weight)
+        if set(again) <= set(free):
+            break
+        free, unid = again, unid_again
+        res = fit(em, res.params, free, q, points, sigma=sig, orientations=orientations,
+                  sigma_rot=sigma_rot, loss=loss, loss_scale=loss_scale, max_nfev=max_nfev)
+    return res, unid
+
+
+def _check_pose_count(robot: Robot, em: ErrorModel, model: str, unid: Sequence[Unidentifiable],
+                      q: np.ndarray, k_count: int, oriented: bool) -> None:
+    """Refuse fewer equations than structurally identifiable parameters (ValueError).
+
+    ``q`` is (N, n); each pose gives 3 equations per target (``k_count`` of them) and 3 more
+    with a measured orientation.
+    """
+    per = 3 * k_count + (3 if oriented else 0)
+    rows = q.shape[0] * per
+    n_struct = em.n_params - sum(u.kind == "structural" for u in unid)
+    if rows <= n_struct:
+        raise InputError(
+            f"too few poses: {len(q)} poses give {rows} equations for {n_struct} identifiable "
+            f"parameters of the {model} model of {robot.name}; at least {n_struct // per + 1} poses "
+            "are needed (several times more for a useful calibration)"
+        )
+
+
+def _calibration(robot: Robot, geometry: RobotGeometry, em: ErrorModel, res: Fit,
+                 unid: Sequence[Unidentifiable], q: np.ndarray, sig: np.ndarray,
+                 before_res: np.ndarray, placed: ErrorModel, placed_params: np.ndarray, loss: str,
+                 initial: str, cp: CirclePointResult | None) -> Calibration:
+    """The :class:`Calibration` of a fit: parameters with uncertainties, statistics, robots.
+
+    Parameters
+    ----------
+    q : numpy.ndarray, shape (N, n)
+    sig : numpy.ndarray, shape (N * K, 3)
+        Standard uncertainties of the measured coordinates, m.
+    before_res : numpy.ndarray, shape (N, 3) or (N, K, 3)
+        Residuals of the placed nominal model, m (the shape of the measured points).
+    placed : ErrorModel
+        The placed nominal model, with its parameters ``placed_params`` (P',).
+    """
+    std = np.sqrt(np.diag(res.covariance))
+    parameters = tuple(
+        Parameter(em.names[k], float(res.params[k]), float(s), float(em.initial[k]), em.units[k])
+        for k, s in zip(res.free, std, strict=True)
+    )
+    obs = observability(_rows(em, res.params, q, np.ones((len(sig), 3)), 1.0)[:, res.free], len(q))
+    return Calibration(
+        robot=calibrated_robot(robot, geometry, em, res.params),
+        model=em,
+        params=res.params,
+        parameters=parameters,
+        covariance=res.covariance,
+        unidentifiable=tuple(unid),
+        residuals=res.residuals.reshape(before_res.shape),
+        rotation_residuals=res.rotation_residuals,
+        before_residuals=before_res,
+        before=ErrorStats.from_residuals(before_res),
+        after=ErrorStats.from_residuals(res.residuals),
+        observability=obs,
+        variance_factor=res.variance_factor,
+        pose_count=len(q),
+        sigma=float(np.mean(sig)),
+        loss=loss,
+        initial=initial,
+        nfev=res.nfev,
+        converged=res.success,
+        message=res.message,
+        circle_point=cp,
+        before_robot=calibrated_robot(robot, geometry, placed, placed_params, name=f"{robot.name}_placed"),
+        targets_axis=before_res.ndim == 3,
+    )
+
+
+def _check_options(model: str, loss: str, initial: str, nongeometric: Sequence[str],
+                   payload: Any, identify_payload: bool, deflection: str, circle_data: Any) -> None:
+    """Refuse option values and combinations :func:`calibrate` cannot honour (ValueError)."""
+    if model not in MODELS:
+        raise InputError(f"unknown error model {model!r}; choose one of {', '.join(MODELS)}")
+    if loss not in LOSSES:
+        raise InputError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
+    if initial not in ("nominal", "circle-point"):
+        raise InputError(f"initial must be 'nominal' or 'circle-point', got {initial!r}")
+    if (identify_payload or payload is not None) and "compliance" not in tuple(nongeometric):
+        raise InputError(f"{'identify_payload' if identify_payload else 'payload'} needs the "
+                         "'compliance' term (nongeometric=('compliance', ...)): the payload is seen "
+                         "only through the joints' deflection under its weight")
+    if deflection not in ("linear", "exact"):
+        raise InputError(f"deflection must be 'linear' or 'exact', got {deflection!r}")
+    if deflection == "exact" and "compliance" not in tuple(nongeometric):
+        raise InputError("deflection='exact' needs the 'compliance' term (nongeometric=('compliance', "
+                         "...)): it changes how the joints deflect under their load")
+    if initial == "circle-point" and circle_data is None:
+        raise InputError("initial='circle-point' needs circle_data: one (q, points) set per joint")
+
+
+def _error_model(robot: Robot, geometry: RobotGeometry, model: str, initial: str, circle_data: Any,
+                 target: np.ndarray, world: np.ndarray, oriented: bool, parallel_tol: float,
+                 q: np.ndarray, pts3: np.ndarray, nongeometric: Sequence[str], payload: Any,
+                 identify_payload: bool, deflection: str) -> tuple[ErrorModel, CirclePointResult | None]:
+    """The error model at its starting point (nominal or circle-point), with the other targets'
+    offsets and the non-geometric terms added; and the circle-point result when used."""
+    cp: CirclePointResult | None = None
+    if initial == "circle-point":
+        cp = circle_point(geometry, circle_data, parallel_tol=parallel_tol)
+        t0 = target.copy()
+        t0[:3, 3] = cp.target
+        em = build_model(model, geometry, base=cp.registration, lines=(cp.points, cp.directions),
+                         target=t0, orientation=oriented, parallel_tol=parallel_tol)
+    else:
+        em = build_model(model, geometry, base=world, target=target, orientation=oriented,
+                         parallel_tol=parallel_tol)
+    if pts3.shape[1] > 1 or nongeometric:
+        ng = None
+        if nongeometric:
+            from robodyn.calibration.nongeometric import build_nongeometric, nominal_frames
+
+            ng = build_nongeometric(robot, nongeometric, nominal_frames(geometry), payload=payload,
+                                    identify_payload=identify_payload, deflection=deflection)
+        offsets, _ = target_offsets(em, em.initial, q, pts3[:, 1:])
+        em = extend_model(em, offsets, ng)
+    return em, cp
+
+
+def _warn_variance_factor(name: str, variance_factor: float) -> None:
+    """Warn when the variance factor says the given sigma is off by more than 3x either way."""
+    ratio = math.sqrt(variance_factor)
+    if ratio > 3.0 or ratio < 1.0 / 3.0:
+        warnings.warn(f"calibration of {name}: the variance factor {variance_factor:.4g} says the "
+                      f"given sigma is wrong by a factor of about {ratio:.3g} (residuals "
+                      f"{'larger' if ratio > 1 else 'smaller'} than sigma); the standard uncertainties "
+                      "are scaled by it, but check sigma (or the data's units, or unmodelled errors)",
+                      RuntimeWarning, stacklevel=3)
+
+
+def validate(calibration: Calibration, q, points) -> ErrorStats:
+    """Error statistics of the calibrated model on other (held-out) poses.
+
+    Parameters
+    ----------
+    calibration : Calibration
+    q : array_like, shape (N, n)
+    points : array_like, shape (N, 3)
+        Measured target positions, instrument frame, m.
+    """
+    q, points, _, _ = check_data(calibration.robot, q, points)
+    return ErrorStats.from_residuals(points - calibration.predict(q))
+
+
+def validate_orientation(calibration: Calibration, q, orientations) -> ErrorStats:
+    """Orientation error statistics of the calibrated model on other (held-out) poses.
+
+    Parameters
+    ----------
+    calibration : Calibration
+        Fitted with measured orientations.
+    q : array_like, shape (N, n)
+    orientations : array_like, shape (N, 3, 3)
+        Measured orientations (one per pose, the targets' common frame), instrument frame.
+
+    Returns
+    -------
+    ErrorStats
+        Of the rotation vectors ``log(R_measured R_predicted^T)``: angles in rad.
+    """
+    if not calibration.model.orientation:
+        raise InputError("validate_orientation: the calibration was fitted without orientations")
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    dummy = np.zeros((len(q), 3))
+    q, _, orientations, _ = check_data(calibration.robot, q, dummy, orientations)
+    k = calibration.model.targets
+    predicted = calibration.predict_frames(q)[::k, :3, :3]
+    return ErrorStats.from_residuals(rotation_vector(orientations @ np.swapaxes(predicted, 1, 2)))
+
+
+def compensate(
+    calibration: Calibration,
+    points,
+    q_seed,
+    *,
+    frame: str = "instrument",
+    tol: float = 1e-10,
+    max_iter: int = 100,
+) -> np.ndarray:
+    """Corrected joint targets that put the target on desired points (calibrated inverse kinematics).
+
+    From ``q_seed`` (typically the nominal controller's joint solution), Newton steps with the
+    minimum-norm (pseudo-inverse) joint correction, so redundant degrees of freedom change as
+    little as possible.
+
+    Parameters
+    ----------
+    calibration : Calibration
+    points : array_like, shape (M, 3)
+        Desired target positions, m.
+    q_seed : array_like, shape (M, n)
+    frame : {"instrument", "base"}
+        Frame of ``points``: the instrument's, or the robot's chain base frame.
+    tol : float
+        Position tolerance, m.
+    max_iter : int
+
+    Returns
+    -------
+    numpy.ndarray, shape (M, n)
+
+    Raises
+    ------
+    ValueError
+        If a point is out of reach (no convergence from its seed).
+    """
+    q, pts, _, _ = check_data(calibration.robot, q_seed, points)
+    if pts.ndim != 2:
+        raise InputError(f"compensate: points must have shape (M, 3) (positions of the first target); "
+                         f"got {pts.shape}")
+    if frame == "base":
+        b = calibration.base()
+        pts = pts @ b[:3, :3].T + b[:3, 3]
+    elif frame != "instrument":
+        raise InputError(f"frame must be 'instrument' or 'base', got {frame!r}")
+    return inverse_kinematics(calibration.model, calibration.params, pts, q, tol=tol, max_iter=max_iter)
+
+
+def inverse_kinematics(model: ErrorModel, params: np.ndarray, points: np.ndarray, q_seed: np.ndarray,
+                       *, tol: float = 1e-10, max_iter: int = 100) -> np.ndarray:
+    """Readings (M, n) that put the model's target on ``points`` (M, 3), from ``q_seed`` (M, n).
+
+    Newton steps with the minimum-norm (pseudo-inverse) joint correction.
+
+    Raises
+    ------
+    ValueError
+        If a point is not reached within ``tol`` (m).
+    """
+    q = np.array(q_seed, dtype=float)
+    step = model.targets  # the first target of each pose
+    for _ in range(max_iter):
+        ev = model.evaluate(params, q)
+        err = points - ev.position[::step]
+        if np.all(np.linalg.norm(err, axis=1) < tol):
+            return q
+        # dq = J^+ e (minimum-norm step)
+        q += np.einsum("mij,mj->mi", np.linalg.pinv(ev.jac_joint[::step, :3], rcond=1e-10), err)
+    err = np.linalg.norm(points - model.evaluate(params, q, derivatives=False).position[::step], axis=1)
+    bad = np.flatnonzero(err >= tol)
+    if bad.size:
+        raise InputError(f"compensate: {bad.size} point(s) not reached (first: index {bad[0]}, "
+                         f"{err[bad[0]] * 1e3:.3g} mm away); out of reach or a poor seed")
+    return q

@@ -1,0 +1,232 @@
+"""Preprocessing choices of ``rd.identify`` made from the identification data by cross-validation.
+
+A setting left at ``"auto"`` (the velocity source, the Coulomb dead band, the cut-off, thermal
+friction) is chosen among a few candidates by time-block cross-validation on the identification
+data themselves: each recording is cut into ``FOLDS`` contiguous blocks, each block is predicted
+by a fit on the others (for every Tikhonov weight of
+:data:`robodyn.identification.estimate.LAMBDA_GRID`), and the candidate whose best held-out error is
+lowest is kept. The fit uses the filtered regressor rows and the per-joint row weights of
+weighted least squares, as the identification does; the held-out block is predicted as
+:meth:`Identification.predict` predicts (the unfiltered rows with the candidate's dead band,
+:func:`robodyn.identification.preprocess.prediction_rows`), so that what a candidate does to a
+prediction (a Coulomb sign flipping with the noise of a joint at rest) is what is scored, and
+compared with one target for all candidates (low-passed at the plain candidate's cut-off, not
+each candidate's own filtered one, which differs between cut-offs), in torque units, rows
+unweighted. The score is the relative held-out error
+``sqrt(sum e^2 / sum y^2)`` over all blocks: a ratio over the same blocks of time, so that
+candidates with other decimations (other cut-offs) compare like for like.
+Held-out blocks, not the fit residual: a richer processing always fits its own data better, but
+only a real gain survives a block it has not seen.
+
+The first candidate (position differences, no dead band, the cut-off rule's value, no thermal
+friction: the plain processing) is kept unless
+another beats it by more than one standard error of the paired block differences (the
+"one-standard-error rule" of cross-validation, Hastie, Tibshirani and Friedman, *The Elements
+of Statistical Learning*, 7.10): differences within the blocks' own scatter are not evidence,
+and a choice made on them would follow the noise of the particular recording.
+
+:class:`Choices` records every candidate's score and why the winner was kept; it is
+``Identification.choices``, printed by ``robodyn identify`` and shown in its HTML report.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from robodyn.identification.estimate import LAMBDA_GRID, candidate_cv_errors
+
+__all__ = ["Candidate", "Choices", "Problem", "candidates", "choose"]
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One preprocessing candidate and its cross-validated score.
+
+    Attributes
+    ----------
+    velocity : {"position", "measured"}
+    dead_band : float
+        Coulomb dead band, rad/s.
+    score : float
+        Relative held-out error over the time blocks (best Tikhonov weight); NaN: not scored.
+    lam : float
+        The Tikhonov weight of that best held-out error.
+    thermal : bool
+        With temperature-dependent friction (:mod:`robodyn.identification.thermal`).
+    cutoff : float, None or "auto"
+        Low-pass cut-off, Hz, as passed to the preprocessing ("auto": its own rule).
+    """
+
+    velocity: str
+    dead_band: float
+    score: float = float("nan")
+    lam: float = float("nan")
+    thermal: bool = False
+    cutoff: float | str | None = "auto"
+
+    @property
+    def key(self) -> tuple[str, float, bool, float | str | None]:
+        """What identifies the candidate: (velocity, dead_band, thermal, cutoff)."""
+        return (self.velocity, self.dead_band, self.thermal, self.cutoff)
+
+    @property
+    def label(self) -> str:
+        """``velocity=..., dead_band=..., cutoff=..., thermal`` as printed."""
+        cut = self.cutoff if isinstance(self.cutoff, str) or self.cutoff is None else f"{self.cutoff:.3g} Hz"
+        return (f"velocity={self.velocity}, dead_band={self.dead_band:g} rad/s, cutoff={cut}"
+                + (", thermal friction" if self.thermal else ""))
+
+
+@dataclass(frozen=True)
+class Choices:
+    """What ``rd.identify`` chose from the data, and why.
+
+    Attributes
+    ----------
+    velocity : {"position", "measured"}
+        Velocity source used.
+    dead_band : float
+        Coulomb dead band used, rad/s.
+    cutoff : float or None
+        Low-pass cut-off used, Hz (its own rule: :mod:`robodyn.identification.preprocess`).
+    regularization : float
+        Tikhonov weight of the final fit (chosen by the same time-block cross-validation when
+        ``regularization="auto"``).
+    candidates : tuple of Candidate
+        Every candidate tried with its score (one when nothing was left to choose).
+    reason : str
+        One sentence: how the winner was chosen.
+    thermal : bool
+        Whether temperature-dependent friction was used.
+    chosen : Candidate or None
+        The winning candidate (its entry of ``candidates``).
+    friction : str or None
+        The friction law chosen by ``friction="auto"`` (:mod:`robodyn.identification.friction_choice`),
+        else None.
+    friction_scores : tuple of (str, float)
+        Each law's relative held-out error of the friction residual (``friction="auto"``).
+    """
+
+    velocity: str
+    dead_band: float
+    cutoff: float | None
+    regularization: float
+    candidates: tuple[Candidate, ...]
+    reason: str
+    thermal: bool = False
+    chosen: Candidate | None = None
+    friction: str | None = None
+    friction_scores: tuple[tuple[str, float], ...] = ()
+
+    def summary(self) -> str:
+        """A few lines for the terminal and the report."""
+        cut = "none" if self.cutoff is None else f"{self.cutoff:g} Hz"
+        lines = [f"velocity {self.velocity}, Coulomb dead band {self.dead_band:g} rad/s, cut-off "
+                 f"{cut}, regularization {self.regularization:g}"
+                 + (", thermal friction" if self.thermal else "") + f": {self.reason}"]
+        if self.friction is not None:
+            scores = ", ".join(f"{law} {score:.4f}" for law, score in self.friction_scores)
+            lines.append(f"  friction law {self.friction} (held-out blocks of the friction "
+                         f"residual: {scores})")
+        if len(self.candidates) > 1:
+            for c in self.candidates:
+                mark = "*" if self.chosen is not None and c.key == self.chosen.key else " "
+                lines.append(f"  {mark} {c.label}: held-out blocks {c.score:.4f} (lambda {c.lam:g})")
+        return "\n".join(lines)
+
+
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """One candidate's identification problem, as :func:`choose` scores it (m rows).
+
+    Attributes
+    ----------
+    phi : numpy.ndarray, shape (m, p)
+        Filtered identification matrix (base columns, then any extra ones).
+    y : numpy.ndarray, shape (m,)
+        Filtered target in torque units.
+    theta0 : numpy.ndarray, shape (p,)
+        The prior.
+    joint, blocks : numpy.ndarray of int, shape (m,)
+        Joint and cross-validation block of each row.
+    phi_test : numpy.ndarray, shape (m, p)
+        Prediction rows of the same samples (unfiltered, :meth:`Identification.predict`'s).
+    y_test : numpy.ndarray, shape (m,)
+        The held-out target at the same samples, torque units (the same signal for every
+        candidate).
+    payload : Any
+        Whatever the caller needs back for the winner.
+    """
+
+    phi: np.ndarray
+    y: np.ndarray
+    theta0: np.ndarray
+    joint: np.ndarray
+    blocks: np.ndarray
+    phi_test: np.ndarray
+    y_test: np.ndarray
+    payload: Any
+
+
+def candidates(velocity: str, dead_band: float | str, thermal: bool | str, measured_available: bool,
+               temperatures_available: bool, default_band: float,
+               cutoffs: tuple[float | str | None, ...] = ("auto",)) -> list[Candidate]:
+    """The candidates of the ``"auto"`` settings (a fixed setting is its only candidate).
+
+    ``velocity="auto"``: position differences, and the measured velocity when every recording
+    has one (not estimated); ``dead_band="auto"``: none and ``default_band``;
+    ``thermal="auto"``: without, and with when every recording has temperatures; ``cutoffs``:
+    the cut-offs to try (the first is the plain one).
+    """
+    vels = (["position", "measured"] if measured_available else ["position"]) \
+        if velocity == "auto" else [velocity]
+    bands = [0.0, float(default_band)] if dead_band == "auto" else [float(dead_band)]
+    therms = ([False, True] if temperatures_available else [False]) if thermal == "auto" \
+        else [bool(thermal)]
+    return [Candidate(v, b, thermal=th, cutoff=c) for c in cutoffs for th in therms for v in vels
+            for b in bands]
+
+
+def choose(cands: Sequence[Candidate], stacked: Callable[[Candidate], Problem]
+           ) -> tuple[Candidate, Problem, list[Candidate]]:
+    """Score each candidate and return the best, its problem and every scored candidate.
+
+    Parameters
+    ----------
+    cands : sequence of Candidate
+    stacked : callable
+        ``stacked(candidate) -> Problem``; the winner's is returned so that the caller need not
+        build it again.
+
+    Returns
+    -------
+    (Candidate, Problem, list of Candidate)
+    """
+    if len(cands) == 1:
+        return cands[0], stacked(cands[0]), list(cands)
+    scored, problems, blocks_err = [], [], []
+    for cand in cands:
+        pr = stacked(cand)
+        # the estimator's own row weights (per joint, from a first fit), the raw target held out;
+        # squared error of each held-out block (K, L) relative to the whole target: candidates
+        # with another decimation (another cut-off) have other rows, the same blocks of time
+        per_block = candidate_cv_errors(pr.phi, pr.y, pr.theta0, pr.joint, pr.blocks, pr.phi_test,
+                                        pr.y_test)
+        per_block = per_block / max(float(pr.y_test @ pr.y_test), 1e-300)
+        k = int(np.argmin(per_block.sum(axis=0)))
+        scored.append(replace(cand, score=float(np.sqrt(per_block[:, k].sum())),
+                              lam=float(LAMBDA_GRID[k])))
+        blocks_err.append(per_block[:, k])
+        problems.append(pr)
+    best = 0
+    for i in range(1, len(scored)):
+        # paired difference of the block errors against the plain candidate, and its SE
+        d = blocks_err[i] - blocks_err[0]
+        se = float(np.std(d, ddof=1) * np.sqrt(d.size)) if d.size > 1 else 0.0
+        if d.sum() < -se and scored[i].score < scored[best].score:
+            best = i
+    return scored[best], problems[best], scored

@@ -1,0 +1,180 @@
+"""Physically consistent estimation: least squares over the pseudo-inertia cone (Wensing et al. 2017).
+
+A link's ten inertial parameters are physically realisable (a non-negative mass density exists)
+if and only if its 4 x 4 pseudo-inertia matrix is positive semi-definite (Wensing, Kim and
+Slotine, "Linear matrix inequalities for physically consistent inertial parameter
+identification", IEEE RA-L 2017)::
+
+    J = [[Sigma, h], [h^T, m]],   Sigma = tr(I_O) / 2 * 1 - I_O
+
+with ``I_O`` the inertia about the link frame origin and ``h = m c``. The estimate minimises the
+weighted squared error of the linear step (its row weights and its Tikhonov weight toward the
+description's base parameters) over the full standard vector ``p`` (15 n)::
+
+    min |A (K p) - b|^2 + lam |D (K p - theta0)|^2 + mu |S (p - p_nom)|^2
+    s.t. J_j(p) >= eps 1 (every link),  Ia_j, Fv_j, Fcp_j, Fcn_j >= 0,  optional bounds
+
+where ``K`` maps standard to base parameters, and the small ``mu`` term (1e-8 of the data term's
+scale, ``S`` the nominal magnitudes) picks, among the standard sets with the same base
+parameters, the one closest to the description. ``eps = EPS`` keeps a small margin inside the
+cone so that the result passes robodyn's strict inertia validation after rounding. The problem
+is a semidefinite program solved by cvxpy with Clarabel; an infeasible problem (e.g.
+contradictory ``bounds``) or a solver failure raises :class:`IdentificationError`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from robodyn.identification.base import BaseRelations
+from robodyn.identification.estimate import LinearFit, thin_svd
+from robodyn.robot.errors import IdentificationError
+from robodyn.robot.model import Robot
+from robodyn.robot.validation import inertia_problems
+from robodyn.symbolic.regressor import PER_JOINT
+
+__all__ = ["EPS", "consistent_standard", "pseudo_inertia"]
+
+#: Margin inside the pseudo-inertia cone, kg m^2 (Sigma block) and kg (mass).
+EPS = 1e-7
+
+
+def pseudo_inertia(standard: np.ndarray, j: int) -> np.ndarray:
+    """Pseudo-inertia matrix (4, 4) of link ``j`` from a standard vector (15 n,)."""
+    xx, xy, xz, yy, yz, zz, mx, my, mz, m = standard[PER_JOINT * j:PER_JOINT * j + 10]
+    i_o = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    sigma = 0.5 * np.trace(i_o) * np.eye(3) - i_o  # Sigma = tr(I)/2 1 - I
+    out = np.zeros((4, 4))
+    out[:3, :3] = sigma
+    out[:3, 3] = out[3, :3] = (mx, my, mz)
+    out[3, 3] = m
+    return out
+
+
+def _pseudo_expr(cp, p, j: int):
+    b = PER_JOINT * j
+    xx, xy, xz, yy, yz, zz, mx, my, mz, m = (p[b + k] for k in range(10))
+    tr = 0.5 * (xx + yy + zz)
+    return cp.bmat([[tr - xx, -xy, -xz, mx],
+                    [-xy, tr - yy, -yz, my],
+                    [-xz, -yz, tr - zz, mz],
+                    [mx, my, mz, m]])
+
+
+def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray, y: np.ndarray,
+                        joint: np.ndarray, fit: LinearFit, nominal: np.ndarray,
+                        bounds: Mapping[str, tuple[float, float]] | None = None) -> np.ndarray:
+    """Physically consistent standard parameters (15 n,) (module docstring).
+
+    Parameters
+    ----------
+    robot : Robot
+    relations : BaseRelations
+    phi : numpy.ndarray, shape (m, b)
+        Identification matrix (base columns); ``y`` (m,) the target in torque units.
+    joint : numpy.ndarray of int, shape (m,)
+    fit : LinearFit
+        The linear step (its row weights and regularisation weight are reused).
+    nominal : numpy.ndarray, shape (15 n,)
+    bounds : Mapping[str, (float, float)], optional
+        Extra box constraints on named standard parameters (e.g. ``{"M3": (0.5, 2.0)}``).
+
+    Returns
+    -------
+    numpy.ndarray, shape (15 n,)
+
+    Raises
+    ------
+    IdentificationError
+        Infeasible problem, solver failure, or a result that fails the inertia checks.
+    """
+    import cvxpy as cp
+
+    n = robot.dof
+    names = relations.standard_names
+    w = fit.weights[joint]
+    a = phi * w[:, None]
+    b = y * w
+    norms = np.linalg.norm(a, axis=0)
+    scale = np.where(norms > 0, norms, 1.0)
+    # |A theta - b|^2 = |S V^T theta - U^T b|^2 + const (thin SVD keeps the program small)
+    u, s, vt = thin_svd(a)
+    r_mat = s[:, None] * vt
+    r_rhs = u.T @ b
+    k = relations.matrix
+    theta0 = relations.to_base(nominal)
+    p = cp.Variable(k.shape[1])
+    theta = k @ p
+    data = float(np.sum(s**2)) / max(s.size, 1)
+    mag = np.maximum(np.abs(nominal), 1e-3)
+    objective = cp.sum_squares(r_mat @ theta - r_rhs)
+    if fit.lam > 0:
+        objective += fit.lam * cp.sum_squares(cp.multiply(scale, theta - theta0))
+    objective += 1e-8 * data * cp.sum_squares(cp.multiply(1.0 / mag, p - nominal))
+    constraints = []
+    for j in range(n):
+        constraints.append(_pseudo_expr(cp, p, j) >> EPS * np.eye(4))
+        base = PER_JOINT * j + 10
+        constraints += [p[base + i] >= 0 for i in range(4)]  # Ia, Fv, Fcp, Fcn >= 0
+    for name, (lo, hi) in (bounds or {}).items():
+        if name not in names:
+            raise IdentificationError(f"bounds: unknown standard parameter {name!r} "
+                                      f"(names like {names[0]!r}, {names[9]!r})")
+        i = names.index(name)
+        constraints += [p[i] >= lo, p[i] <= hi]
+    problem = cp.Problem(cp.Minimize(objective), constraints)
+    try:
+        problem.solve(solver=cp.CLARABEL)
+    except cp.error.SolverError as exc:
+        raise IdentificationError(f"method='consistent': the semidefinite program failed in "
+                                  f"Clarabel: {exc}") from exc
+    if problem.status in ("infeasible", "infeasible_inaccurate"):
+        raise IdentificationError(
+            "method='consistent': the semidefinite program is infeasible: no physically "
+            "consistent parameters (pseudo-inertia >= 0, rotor inertia and friction >= 0)"
+            + (f" satisfy the bounds {dict(bounds)}" if bounds else ""))
+    if problem.status not in ("optimal", "optimal_inaccurate") or p.value is None:
+        raise IdentificationError(f"method='consistent': the semidefinite program ended with "
+                                  f"status {problem.status!r}")
+    out = np.asarray(p.value, dtype=float)
+    for j in range(n):
+        _project_link(out, j)
+        _check_link(out, j, robot)
+    return out
+
+
+def _project_link(p: np.ndarray, j: int) -> None:
+    """Put link ``j``'s pseudo-inertia of ``p`` (15 n,) back into ``J >= EPS I`` in place.
+
+    The interior-point solver meets the LMI only to its own tolerance: a link whose optimum
+    lies on the boundary (a point mass: inertia about the centre of mass near zero) can come
+    back with principal moments of -1e-7 kg m^2. Clipping the eigenvalues of
+    ``J = [[Sigma, h], [h^T, m]]`` (``Sigma = tr(I)/2 1 - I``) at ``EPS`` moves the parameters by
+    at most the solver's tolerance and makes the link exactly consistent.
+    """
+    b = PER_JOINT * j
+    lam, vec = np.linalg.eigh(pseudo_inertia(p, j))
+    if lam[0] >= EPS:
+        return
+    pseudo = (vec * np.maximum(lam, EPS)) @ vec.T
+    sigma = 0.5 * (pseudo[:3, :3] + pseudo[:3, :3].T)
+    # I = tr(Sigma) 1 - Sigma
+    i_new = np.trace(sigma) * np.eye(3) - sigma
+    p[b:b + 10] = (i_new[0, 0], i_new[0, 1], i_new[0, 2], i_new[1, 1], i_new[1, 2], i_new[2, 2],
+                   *pseudo[:3, 3], pseudo[3, 3])
+
+
+def _check_link(p: np.ndarray, j: int, robot: Robot) -> None:
+    b = PER_JOINT * j
+    m = p[b + 9]
+    c = p[b + 6:b + 9] / m
+    xx, xy, xz, yy, yz, zz = p[b:b + 6]
+    i_o = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    i_c = i_o - m * (float(c @ c) * np.eye(3) - np.outer(c, c))
+    problems = inertia_problems(i_c)
+    if m <= 0 or problems:
+        raise IdentificationError(
+            f"method='consistent': link {robot.links[j].name!r} came out physically inconsistent "
+            f"(mass {m:g}; {'; '.join(problems)}): solver inaccuracy")

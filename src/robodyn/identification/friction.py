@@ -1,0 +1,207 @@
+"""Friction beyond the linear model, fitted after the linear step (two-step least squares).
+
+Step 1 is :func:`robodyn.identification` with the linear friction of the regressor (viscous, Coulomb
++/-, offset). Step 2 keeps its rigid-body and rotor-inertia parameters and fits, joint by joint, a
+nonlinear friction law ``f_j(qd_j)`` to what they leave of the target,
+``r_j = y_j - [Y(q, qd, qdd) p_nf]_j`` (``p_nf``: the identified parameters with friction set to
+zero; the filtered regressor and target of the linear step), by nonlinear least squares
+(``scipy.optimize.least_squares``, trust-region reflective, started from the linear step's
+values). Models, ``v = qd_j``, ``s(v) = tanh(v / V_EPS)`` a sign
+smoothed over ``V_EPS = 0.01`` rad/s (so that a joint at rest, whose filtered velocity wanders
+around zero, is not given full Coulomb friction of random sign):
+
+``"linear"``      ``Fv v + Fcp H(v) - Fcn H(-v) + Fo`` (step 1 itself; ``H`` the step);
+``"stribeck"``    ``s(v) (Fc + (Fs - Fc) exp(-(v / vs)^2)) + Fv v + Fo`` (static Fs, Coulomb Fc,
+                  Stribeck velocity vs, viscous Fv, offset Fo);
+``"load"``        ``s(v) (Fc + mu |tau_j|) + Fv v + Fo``: Coulomb friction growing with the load
+                  torque ``tau_j = [Y p_nf]_j`` the transmission carries;
+``"polynomial"``  ``s(v) Fc + a1 v + a2 v |v| + a3 v^3 + Fo``.
+
+``"none"`` (no friction at all, rigid body and rotor inertia only) is a separate linear fit,
+``rd.identify(..., friction="none")``. :func:`friction_table` compares them on held-out data.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from robodyn.identification.preprocess import Samples, preprocess, regressor_rows
+from robodyn.robot.errors import IdentificationError
+from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
+
+__all__ = ["FRICTION_MODELS", "NONLINEAR", "V_EPS", "FrictionFit", "fit_friction", "friction_table"]
+
+V_EPS = 0.01
+NONLINEAR = ("stribeck", "load", "polynomial")
+FRICTION_MODELS = ("none", "linear", *NONLINEAR)
+_NAMES = {
+    "stribeck": ("Fc", "Fs", "vs", "Fv", "Fo"),
+    "load": ("Fc", "mu", "Fv", "Fo"),
+    "polynomial": ("Fc", "a1", "a2", "a3", "Fo"),
+}
+
+
+def _law(model: str, x: np.ndarray, v: np.ndarray, load: np.ndarray) -> np.ndarray:
+    s = np.tanh(v / V_EPS)
+    if model == "stribeck":
+        fc, fs, vs, fv, fo = x
+        # f = s(v) (Fc + (Fs - Fc) exp(-(v/vs)^2)) + Fv v + Fo
+        return s * (fc + (fs - fc) * np.exp(-((v / vs) ** 2))) + fv * v + fo
+    if model == "load":
+        fc, mu, fv, fo = x
+        # f = s(v) (Fc + mu |tau|) + Fv v + Fo
+        return s * (fc + mu * np.abs(load)) + fv * v + fo
+    fc, a1, a2, a3, fo = x
+    # f = s(v) Fc + a1 v + a2 v|v| + a3 v^3 + Fo
+    return s * fc + a1 * v + a2 * v * np.abs(v) + a3 * v**3 + fo
+
+
+@dataclass(frozen=True, eq=False)
+class FrictionFit:
+    """A nonlinear friction law per joint (module docstring), in target-torque units (N m).
+
+    Attributes
+    ----------
+    model : {"stribeck", "load", "polynomial"}
+    names : tuple of str
+        Parameter names of the law.
+    params : numpy.ndarray, shape (n, len(names))
+    """
+
+    model: str
+    names: tuple[str, ...]
+    params: np.ndarray
+
+    def torque(self, qd: np.ndarray, load: np.ndarray) -> np.ndarray:
+        """Friction torque (N, n) at velocities ``qd`` (N, n), rad/s, and load torques (N, n)."""
+        return np.column_stack([_law(self.model, self.params[j], qd[:, j], load[:, j])
+                                for j in range(self.params.shape[0])])
+
+
+def without_friction(standard: np.ndarray) -> np.ndarray:
+    """The standard vector (15 n,) with the friction entries (Fv, Fcp, Fcn, Fo) set to zero."""
+    p = standard.copy()
+    for j in range(p.size // PER_JOINT):
+        p[PER_JOINT * j + len(INERTIAL_NAMES) + 1:PER_JOINT * (j + 1)] = 0.0
+    return p
+
+
+def _start(model: str, linear: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
+    fv, fcp, fcn, fo = linear
+    fc = max(0.5 * (fcp + fcn), 1e-6)
+    inf = np.inf
+    if model == "stribeck":
+        return (np.array([fc, 1.2 * fc, 0.05, max(fv, 0.0), fo + 0.5 * (fcp - fcn)]),
+                (np.array([0, 0, 1e-3, 0, -inf]), np.array([inf, inf, 10.0, inf, inf])))
+    if model == "load":
+        return (np.array([fc, 0.0, max(fv, 0.0), fo + 0.5 * (fcp - fcn)]),
+                (np.array([0, 0, 0, -inf]), np.array([inf, inf, inf, inf])))
+    return (np.array([fc, fv, 0.0, 0.0, fo + 0.5 * (fcp - fcn)]),
+            (np.array([0, -inf, -inf, -inf, -inf]), np.full(5, inf)))
+
+
+def fit_friction_samples(ident: Any, samples: Sequence[Samples], y_full: Sequence[np.ndarray],
+                         model: str) -> FrictionFit:
+    """Step 2 on already processed, decimated samples and their (filtered) full regressors
+    (:func:`robodyn.identification.preprocess.regressor_rows`); see :func:`fit_friction`."""
+    if model not in NONLINEAR:
+        raise IdentificationError(f"friction: expected one of {FRICTION_MODELS}, got {model!r}")
+    p_nf = without_friction(ident.standard)
+    n = ident.robot.dof
+    qd = np.vstack([s.qd for s in samples])
+    load = np.vstack([y @ p_nf for y in y_full])
+    r = np.vstack([s.y for s in samples]) * ident.gains[None, :] - load  # r = K H y - H Y p_nf
+    params = []
+    for j in range(n):
+        b = PER_JOINT * j + len(INERTIAL_NAMES) + 1
+        x0, bounds = _start(model, ident.standard[b:b + 4])
+        x0 = np.clip(x0, bounds[0] + 1e-12, bounds[1] - 1e-12)
+        if np.ptp(qd[:, j]) == 0.0:  # a joint held still: only the offset is seen
+            x = np.zeros_like(x0)
+            x[-1] = float(np.mean(r[:, j]))
+            params.append(x)
+            continue
+        sol = least_squares(lambda x, j=j: _law(model, x, qd[:, j], load[:, j]) - r[:, j], x0,
+                            bounds=bounds, method="trf", x_scale="jac")
+        params.append(sol.x)
+    return FrictionFit(model=model, names=_NAMES[model], params=np.array(params))
+
+
+def fit_friction(ident: Any, recordings: Any, model: str = "stribeck") -> Any:
+    """Fit a nonlinear friction law after the linear identification (module docstring).
+
+    Parameters
+    ----------
+    ident : Identification
+        The linear step (``rd.identify``).
+    recordings : Recording or sequence of Recording
+        Identification data (normally the same as the linear step's), processed with
+        ``ident.preprocess``.
+    model : {"stribeck", "load", "polynomial"}
+
+    Returns
+    -------
+    Identification
+        ``ident`` with :attr:`~Identification.friction_fit` set; its :meth:`predict` then uses
+        the nonlinear law in place of the linear friction.
+    """
+    recs = [recordings] if hasattr(recordings, "q") else list(recordings)
+    d = ident.preprocess.decimate
+    samples, y_full = [], []
+    for r in recs:
+        s = preprocess(r, ident.preprocess, ident.target)
+        y_full.append(regressor_rows(ident._model, s, ident.preprocess))
+        samples.append(Samples(s.t[::d], s.q[::d], s.qd[::d], s.qdd[::d], s.y[::d], s.source))
+    return replace(ident, friction_fit=fit_friction_samples(ident, samples, y_full, model))
+
+
+def friction_table(robot: Any, train: Any, test: Sequence[Any], models: Sequence[str] = FRICTION_MODELS,
+                   **options: Any) -> Any:
+    """Held-out error of each friction model.
+
+    Each model is identified on ``train`` (``rd.identify(robot, train, friction=model,
+    **options)``) and predicts every recording of ``test``.
+
+    Parameters
+    ----------
+    robot : Robot
+    train : Recording or sequence of Recording
+    test : sequence of Recording
+    models : sequence of str
+        Among ``FRICTION_MODELS``.
+    **options
+        Passed to :func:`robodyn.identification` (target, method, cutoff, ...).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per model: ``relative_error`` (``||e|| / ||y||`` against the raw target over all
+        test samples and joints), ``relative_error_filtered`` (against the target low-passed with
+        the reference filter of :mod:`robodyn.validation.heldout`), ``noise_floor``
+        (``||y - y_f|| / ||y||``) and
+        ``relative_error_<joint>`` per joint (raw).
+    """
+    import pandas as pd
+
+    from robodyn.identification.pipeline import identify
+    from robodyn.validation.heldout import held_out_error
+
+    rows = []
+    for model in models:
+        ident = identify(robot, train, friction=model, **options)
+        preds = [ident.predict(r) for r in test]
+        ys = [np.asarray(getattr(r, ident.target), float) for r in test]
+        fig = held_out_error([np.asarray(r.t, float) for r in test], ys, preds, robot.joint_names)
+        pred, y = np.vstack(preds), np.vstack(ys)
+        row = {"model": model, "relative_error": fig.raw, "relative_error_filtered": fig.filtered,
+               "noise_floor": fig.noise_floor}
+        for j, name in enumerate(robot.joint_names):
+            row[f"relative_error_{name}"] = float(np.linalg.norm(pred[:, j] - y[:, j])
+                                                  / np.linalg.norm(y[:, j]))
+        rows.append(row)
+    return pd.DataFrame(rows)

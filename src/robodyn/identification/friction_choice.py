@@ -1,0 +1,79 @@
+"""The friction law of ``rd.identify(..., friction="auto")``, chosen by time-block cross-validation.
+
+With the identified rigid-body and rotor parameters fixed, what they leave of the (filtered)
+target is friction: ``r = K H(y) - H(Y) p_nf``. Each law is fitted joint by joint on the time
+blocks of all recordings but one (:data:`robodyn.identification.estimate.FOLDS` per recording) and
+predicts the block left out: the linear law on its filtered columns (viscous, Coulomb +/-,
+offset, as the linear fit has them), the Stribeck law as :func:`fit_friction_samples` fits it.
+The linear law is kept unless Stribeck's held-out error is lower by more than one standard
+error of the paired block differences (the rule of :mod:`robodyn.identification.choices`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from robodyn.identification.estimate import FOLDS
+from robodyn.identification.friction import _law, _start, without_friction
+from robodyn.identification.preprocess import Samples
+from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
+
+__all__ = ["LAWS", "choose_friction_law"]
+
+#: The laws compared, the first the plain one.
+LAWS = ("linear", "stribeck")
+
+
+def choose_friction_law(ident: Any, samples: Sequence[Samples], y_full: Sequence[np.ndarray]
+                        ) -> tuple[str, dict[str, float]]:
+    """The chosen law and each law's relative held-out error over the blocks.
+
+    Parameters
+    ----------
+    ident : Identification
+        The linear identification (its rigid-body and rotor parameters are kept).
+    samples : sequence of Samples
+        Processed, decimated samples with the filtered target ``y`` (N_k, n).
+    y_full : sequence of numpy.ndarray, shape (N_k, n, 15 n)
+        The fit's (filtered) regressor rows of the same samples.
+
+    Returns
+    -------
+    (str, dict of str to float)
+    """
+    p_nf = without_friction(ident.standard)
+    qd = np.vstack([s.qd for s in samples])
+    load = np.vstack([y @ p_nf for y in y_full])
+    r = np.vstack([s.y for s in samples]) * ident.gains[None, :] - load  # r = K H y - H Y p_nf
+    block = np.concatenate([np.arange(s.q.shape[0]) * FOLDS // s.q.shape[0] for s in samples])
+    n = qd.shape[1]
+    per_block = {law: np.zeros(FOLDS) for law in LAWS}
+    for j in range(n):
+        first = PER_JOINT * j + len(INERTIAL_NAMES) + 1
+        cols = np.vstack([y[:, j, first:first + 4] for y in y_full])  # Fv, Fcp, Fcn, Fo columns
+        x0, bounds = _start("stribeck", ident.standard[first:first + 4])
+        x0 = np.clip(x0, bounds[0] + 1e-12, bounds[1] - 1e-12)
+        for k in range(FOLDS):
+            train, test = block != k, block == k
+            if not test.any() or not train.any():
+                continue
+            # linear law: least squares on the filtered columns
+            c = np.linalg.lstsq(cols[train], r[train, j], rcond=None)[0]
+            per_block["linear"][k] += float(np.sum((r[test, j] - cols[test] @ c) ** 2))
+            if np.ptp(qd[train, j]) == 0.0:
+                pred = np.full(int(test.sum()), float(np.mean(r[train, j])))
+            else:
+                sol = least_squares(lambda x, j=j, t=train: _law("stribeck", x, qd[t, j], load[t, j])
+                                    - r[t, j], x0, bounds=bounds, method="trf", x_scale="jac")
+                pred = _law("stribeck", sol.x, qd[test, j], load[test, j])
+            per_block["stribeck"][k] += float(np.sum((r[test, j] - pred) ** 2))
+    total = max(float(np.sum(r**2)), 1e-300)
+    scores = {law: float(np.sqrt(e.sum() / total)) for law, e in per_block.items()}
+    d = per_block["stribeck"] - per_block["linear"]
+    se = float(np.std(d, ddof=1) * np.sqrt(d.size))
+    chosen = "stribeck" if d.sum() < -se else "linear"
+    return chosen, scores

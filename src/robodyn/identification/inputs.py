@@ -1,0 +1,134 @@
+"""Input checks of ``rd.identify``: the recordings, the options and the payloads (step 1).
+
+Every problem is an :class:`~robodyn.robot.errors.IdentificationError` naming the recording (its
+``source``, or ``recordings[i]``), the field and the reason.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from robodyn.identification.friction import FRICTION_MODELS
+from robodyn.identification.payload import Payload
+from robodyn.robot.errors import IdentificationError
+from robodyn.robot.model import Robot
+
+__all__ = ["METHODS", "TARGETS", "WEIGHTS", "check_payloads", "check_recording", "checked_inputs"]
+
+TARGETS = ("tau", "current")
+METHODS = ("ols", "wls", "consistent")
+WEIGHTS = ("residual", "state-noise")
+
+
+def _src(rec: Any, index: int) -> str:
+    return str(getattr(rec, "source", "") or f"recordings[{index}]")
+
+
+def _first_bad(a: np.ndarray) -> tuple[int, int]:
+    rows, cols = np.nonzero(~np.isfinite(a))
+    return int(rows[0]), int(cols[0])
+
+
+def check_recording(robot: Robot, rec: Any, index: int, target: str | None) -> None:
+    """Raise :class:`IdentificationError` when ``rec`` cannot be used with ``robot``.
+
+    Checks: joint names equal the robot's (same order), ``q`` (N, n), finite ``t``/``q``/target
+    (the first bad row and column named), and the target signal present.
+    """
+    src = _src(rec, index)
+    names = getattr(rec, "joint_names", None)
+    n = robot.dof
+    q = np.asarray(rec.q, dtype=float)
+    if q.ndim != 2 or q.shape[1] != n:
+        raise IdentificationError(f"{src}: q: expected shape (N, {n}) for robot {robot.name!r} "
+                                  f"({n} joints), got {q.shape}")
+    if names is not None and tuple(names) != tuple(f"q{j + 1}" for j in range(n)) \
+            and tuple(names) != robot.joint_names:
+        missing = [j for j in robot.joint_names if j not in names]
+        extra = [j for j in names if j not in robot.joint_names]
+        why = (f"missing {missing}, unknown {extra}" if missing or extra
+               else f"order {list(names)} is not the chain order {list(robot.joint_names)}")
+        raise IdentificationError(f"{src}: joint_names do not match robot {robot.name!r}: {why} "
+                                  f"(use rec.select(robot.joint_names))")
+    fields = [("t", np.asarray(rec.t, dtype=float).reshape(-1, 1)), ("q", q)]
+    if target is not None:
+        y = getattr(rec, target, None)
+        if y is None:
+            raise IdentificationError(f"{src}: {target}: the recording has no {target!r} signal to "
+                                      f"fit (target={target!r})")
+        y = np.asarray(y, dtype=float)
+        if y.shape != q.shape:
+            raise IdentificationError(f"{src}: {target}: shape {y.shape} differs from q {q.shape}")
+        fields.append((target, y))
+    for name, a in fields:
+        if not np.all(np.isfinite(a)):
+            row, col = _first_bad(a)
+            column = "" if name == "t" else f", column {col} ({robot.joint_names[col]})"
+            raise IdentificationError(f"{src}: {name}: value {a[row, col]} is not finite at row "
+                                      f"{row}{column}")
+
+
+def checked_inputs(robot: Robot, recordings: Any, target: str | None, method: str, friction: str,
+                    weights: str, state_noise: Any, gains: str, velocity: str, dead_band: Any,
+                    thermal: Any, sensor: str,
+                    payloads: Sequence[Payload | None] | None
+                    ) -> tuple[list[Any], str, list[Payload | None]]:
+    """The recordings as a list, the resolved target and one payload per recording (step 1).
+
+    Raises :class:`IdentificationError` on no recordings, an unknown option, missing state
+    noise for ``weights="state-noise"``, a recording that does not fit ``robot``
+    (:func:`check_recording`) or malformed payloads.
+    """
+    recs = [recordings] if hasattr(recordings, "q") else list(recordings)
+    if not recs:
+        raise IdentificationError("recordings: none given")
+    if target is None:
+        target = "tau" if all(getattr(r, "tau", None) is not None for r in recs) else "current"
+    if target not in TARGETS:
+        raise IdentificationError(f"target: expected one of {TARGETS}, got {target!r}")
+    if method not in METHODS:
+        raise IdentificationError(f"method: expected one of {METHODS}, got {method!r}")
+    if friction not in (*FRICTION_MODELS, "auto"):
+        raise IdentificationError(f"friction: expected one of {(*FRICTION_MODELS, 'auto')}, got "
+                                  f"{friction!r}")
+    if weights not in WEIGHTS:
+        raise IdentificationError(f"weights: expected one of {WEIGHTS}, got {weights!r}")
+    if weights == "state-noise" and state_noise is None:
+        raise IdentificationError("state_noise: weights='state-noise' needs the state noise "
+                                  "(s_q, s_qd, s_qdd) in rad, rad/s, rad/s^2")
+    if velocity not in ("auto", "position", "measured"):
+        raise IdentificationError(f"velocity: expected 'auto', 'position' or 'measured', got {velocity!r}")
+    if sensor not in ("motor", "link"):
+        raise IdentificationError(f"sensor: expected 'motor' or 'link', got {sensor!r}")
+    if sensor == "link" and target != "tau":
+        raise IdentificationError("sensor: 'link' (a joint torque sensor after the gear) needs "
+                                  f"target='tau', got target={target!r}")
+    if thermal not in (False, True, "auto"):
+        raise IdentificationError(f"thermal: expected False, True or 'auto', got {thermal!r}")
+    if isinstance(dead_band, str) and dead_band != "auto":
+        raise IdentificationError(f"dead_band: expected a velocity in rad/s or 'auto', got {dead_band!r}")
+    if gains not in ("auto", "description", "absorbed"):
+        raise IdentificationError(f"gains: expected 'auto', 'description' or 'absorbed', got {gains!r}")
+    for i, rec in enumerate(recs):
+        check_recording(robot, rec, i, target)
+    return recs, target, check_payloads(payloads, len(recs))
+
+
+def check_payloads(payloads: Any, count: int) -> list[Payload | None]:
+    """One ``Payload`` or None per recording (an error naming the entry otherwise)."""
+    if payloads is None:
+        return [None] * count
+    if isinstance(payloads, Payload):
+        raise IdentificationError("payloads: expected a sequence with one Payload or None per "
+                                  "recording, got a single Payload")
+    pays = list(payloads)
+    if len(pays) != count:
+        raise IdentificationError(f"payloads: expected one per recording ({count}), got {len(pays)}")
+    for i, p in enumerate(pays):
+        if p is not None and not isinstance(p, Payload):
+            raise IdentificationError(f"payloads[{i}]: expected a Payload or None, got "
+                                      f"{type(p).__name__}")
+    return pays

@@ -1,0 +1,587 @@
+"""``rd.identify``: inertial, drive and friction parameters from measured motion and effort.
+
+Steps (each a function of its own module):
+
+1. check the recordings (joints, shapes, finite values, a target signal);
+2. preprocess each recording (:mod:`robodyn.identification.preprocess`: zero-phase filter, derivatives,
+   the same filter on the target; :func:`filtered_regressor`: the same filter on every column
+   of the regressor, then decimation);
+3. base parameters of the robot (:mod:`robodyn.identification.base`, Gautier's QR on random states);
+4. identification matrix: the compiled, batched regressor ``Y(q, qd, qdd)`` (N, n, 15 n) of every
+   sample, restricted to the base columns and stacked, one row per joint per sample;
+5. the prior (:mod:`robodyn.identification.prior`): the description's inertial parameters with each
+   joint's rotor inertia and friction (and, for ``target="current"``, its drive gain ``K_j``,
+   N m / A) fitted joint by joint; rows of a current target are scaled by ``K_j`` so that the fit
+   is in torque units, ``K_j i_j = Y_j p``;
+6. estimate (:mod:`robodyn.identification.estimate`, :mod:`robodyn.identification.consistent`);
+7. the full standard parameter set and a :class:`Robot` carrying it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from robodyn.identification.base import BaseRelations, base_relations
+from robodyn.identification.choices import Candidate, Choices, Problem, candidates, choose
+from robodyn.identification.drive_gains import estimate_drive_gains
+from robodyn.identification.estimate import FOLDS, LinearFit, fit_linear
+from robodyn.identification.friction import NONLINEAR, fit_friction_samples, without_friction
+from robodyn.identification.friction_choice import choose_friction_law
+from robodyn.identification.inputs import check_recording, checked_inputs
+from robodyn.identification.payload import Payload, payload_standard, payload_torque
+from robodyn.identification.preprocess import (
+    DEAD_BAND,
+    Preprocess,
+    Samples,
+    prediction_rows,
+    preprocess,
+    regressor_rows,
+    resolve_preprocess,
+)
+from robodyn.identification.prior import joint_prior
+from robodyn.identification.result import BaseParameters, Identification
+from robodyn.identification.state_noise import state_noise_std, torque_variance
+from robodyn.identification.thermal import ThermalData, ThermalFit, thermal_data
+from robodyn.identification.to_robot import robot_with_parameters
+from robodyn.measure.filtering import lowpass
+from robodyn.numeric.model import Model, compile_model
+from robodyn.robot.errors import IdentificationError
+from robodyn.robot.model import Robot
+from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT, parameter_values
+
+__all__ = ["check_recording", "identify", "nominal_standard"]
+
+#: Floor of the measurement variance, as a fraction of the first fit's residual variance.
+MEAS_FLOOR = 0.01
+#: The wider cut-off tried by cross-validation, as a multiple of the rule's (cutoff="auto").
+CUTOFF_WIDER = 2.5
+#: Fraction of a joint's samples at rest from which its friction offset is its own base parameter.
+REST_FRACTION = 0.01
+#: Unit directions whose singular value is below this fraction of the largest are reported.
+UNEXCITED_RTOL = 1e-6
+
+
+def nominal_standard(robot: Robot) -> np.ndarray:
+    """The description's standard parameter vector (15 n,) at its parameters' defaults."""
+    subs = robot.defaults()
+    return np.array([float(sp.sympify(v).xreplace(subs)) for v in parameter_values(robot)])
+
+
+def _description_gains(robot: Robot) -> np.ndarray:
+    subs = robot.defaults()
+    return np.array([abs(float(sp.sympify(j.drive.gear_ratio * j.drive.torque_constant).xreplace(subs)))
+                     for j in robot.joints])
+
+
+def _stack(samples: Sequence[Samples], y_full: Sequence[np.ndarray], columns: np.ndarray,
+           gains: np.ndarray, loads: Sequence[np.ndarray],
+           extra: Sequence[np.ndarray] | None = None
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``Phi`` (m, b + e), ``y`` (m,), joint of each row, CV block of each row (m = sum N_k n);
+    ``loads`` (N_k, n): the known payload torque of each recording, taken off the target;
+    ``extra`` (N_k, n, e): further columns appended after the base columns (thermal friction)."""
+    phis, ys, joints, blocks = [], [], [], []
+    for i, (s, y, load) in enumerate(zip(samples, y_full, loads, strict=True)):
+        count, n = s.q.shape
+        rows = y[:, :, columns].reshape(count * n, -1)
+        if extra is not None:
+            rows = np.hstack([rows, extra[i].reshape(count * n, -1)])
+        phis.append(rows)
+        ys.append((s.y * gains[None, :] - load).reshape(-1))  # K_j i_j - P_j (or tau_j - P_j)
+        joints.append(np.tile(np.arange(n), count))
+        blocks.append(np.repeat(np.arange(count) * FOLDS // count, n))
+    return np.vstack(phis), np.concatenate(ys), np.concatenate(joints), np.concatenate(blocks)
+
+
+def identify(robot: Robot, recordings: Any, target: str | None = None, method: str = "wls", *,
+             friction: str = "auto", regularization: float | str | None = "auto",
+             cutoff: float | str | None = "auto", decimate: int | str = "auto",
+             velocity: str = "auto", dead_band: float | str = 0.0, gains: str = "auto",
+             bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None,
+             payloads: Sequence[Payload | None] | None = None, weights: str = "residual",
+             state_noise: Any = None, thermal: bool | str = False, sensor: str = "motor"
+             ) -> Identification:
+    """Identify the base inertial, drive and friction parameters of a robot from recordings.
+
+    Parameters
+    ----------
+    robot : Robot
+        The nominal description (with per-joint drive and friction fits, the prior of the
+        regularisation: :mod:`robodyn.identification.prior`).
+    recordings : Recording or sequence of Recording
+        Measured runs, joints in the robot's order: ``t`` (N,) s, ``q`` (N, n) and the target
+        ``tau`` or ``current`` (N, n).
+    target : {"tau", "current"}, optional
+        Default: ``"tau"`` when every recording has torques, else ``"current"``.
+    method : {"ols", "wls", "consistent"}
+        Ordinary or weighted least squares, or physically consistent (pseudo-inertia LMIs).
+    friction : {"linear", "none", "stribeck", "load", "polynomial", "auto"}
+        "linear": viscous, Coulomb (+/-) and offset per joint in the linear fit; "none": no
+        friction; the others: a nonlinear law fitted after the linear step
+        (:mod:`robodyn.identification.friction`); "auto": linear or Stribeck, chosen by time-block
+        cross-validation (:mod:`robodyn.identification.friction_choice`).
+    regularization : "auto", float or None
+        Tikhonov weight toward the description's values (dimensionless, see
+        :mod:`robodyn.identification.estimate`); "auto": chosen by time-block cross-validation on these
+        data; None: plain least squares (not-excited directions stay at the prior).
+    cutoff : "auto", float or None
+        Zero-phase low-pass cut-off, Hz (:mod:`robodyn.identification.preprocess`); None: none.
+    decimate : "auto" or int
+    velocity : {"auto", "position", "measured"}
+        Joint velocities from the filtered positions or the filtered measured ones; "auto":
+        chosen by time-block cross-validation (:mod:`robodyn.identification.choices`) between the two
+        when every recording has a measured velocity, else "position".
+    dead_band : "auto" or float
+        Coulomb dead band, rad/s (m/s): where a joint's processed velocity is below it, its
+        Coulomb columns are zero and only the friction offset acts, in the fit and in
+        :meth:`Identification.predict` alike (:mod:`robodyn.identification.preprocess`); 0: none;
+        "auto": 0 or ``DEAD_BAND`` (1e-3), chosen by time-block cross-validation.
+    gains : {"auto", "description", "absorbed"}
+        Drive gains for ``target="current"`` (:func:`robodyn.identification.prior.joint_prior`).
+    bounds : dict of str to (float, float), optional
+        Box constraints on named standard parameters for ``method="consistent"``
+        (e.g. ``{"M7": (0.3, 2.0)}`` for a known payload range).
+    model : Model, optional
+        A compiled model of ``robot`` to reuse (default ``rd.compile_model(robot)``).
+    payloads : sequence of Payload or None, optional
+        One per recording: the known payload attached to the last link during that run (None:
+        none). Its torque is taken off the target; with ``target="current"``, a payload run
+        together with a run without it (or with another payload) identifies the drive gains
+        (:mod:`robodyn.identification.drive_gains`; ``gains_source="payload"``, ``gains_std``).
+        ``ident.robot`` is the robot without payloads.
+    weights : {"residual", "state-noise"}
+        Row weights of ``method="wls"``/``"consistent"``: per joint from the residuals of a first
+        fit, or per sample and joint ``1 / sigma_tau`` with ``sigma_tau^2`` the measurement
+        variance plus the state noise propagated through the analytic derivatives of the first
+        fit's model (errors in variables, :mod:`robodyn.identification.state_noise`).
+    state_noise : (s_q, s_qd, s_qdd), optional
+        Standard deviations of the processed states' noise (rad, rad/s, rad/s^2; scalars or
+        (n,)), required by ``weights="state-noise"``.
+    sensor : {"motor", "link"}
+        Where the effort is measured: "motor" (motor current, or a torque that includes the
+        drive: the reflected rotor inertia ``Ia`` is identified), or "link" (a joint torque
+        sensor after the gear, which does not see the rotor: the ``Ia`` columns are dropped and
+        ``Ia = 0`` in the prior and the result; ``target="tau"`` only).
+    thermal : bool or "auto"
+        Temperature-dependent viscous and Coulomb friction (:mod:`robodyn.identification.thermal`;
+        needs the recordings' ``temperature``); "auto": with and without, chosen by time-block
+        cross-validation when every recording has temperatures.
+
+    Returns
+    -------
+    Identification
+
+    Raises
+    ------
+    IdentificationError
+        Joints not matching the robot, NaN, a missing target, too few samples for the
+        parameters, an unknown option, an infeasible or failed semidefinite program.
+    """
+    recs, target, pays = checked_inputs(robot, recordings, target, method, friction, weights,
+                                         state_noise, gains, velocity, dead_band, thermal,
+                                         sensor, payloads)
+    model = model if model is not None else compile_model(robot)
+    measured = all(r.qd is not None and "qd" not in getattr(r, "estimated", frozenset()) for r in recs)
+    temps = all(getattr(r, "temperature", None) is not None for r in recs)
+
+    def stacked(c: Candidate) -> Problem:
+        data = _prepared(robot, recs, target, friction, c.cutoff, decimate, c.velocity, c.dead_band,
+                         model, c.thermal, sensor)
+        drive, prior, loads = _gains_and_prior(robot, data, pays, target, gains, friction, sensor)
+        cols = data.relations.independent
+        th = data.thermal
+        phi, y, joint, blocks = _stack(data.samples, data.y_full, cols, drive.k, loads,
+                                       None if th is None else th.fit_rows)
+        test = [prediction_rows(model, s, data.settings)[:, :, cols] for s in data.samples]
+        if th is not None:
+            test = [np.concatenate([a, b], axis=2) for a, b in zip(test, th.test_rows, strict=True)]
+        theta0 = np.concatenate([data.relations.to_base(prior), np.zeros(phi.shape[1] - cols.size)])
+        d = data.settings.decimate
+        # the common held-out target at the same samples, torque units, payload torque taken off
+        held = np.concatenate([(ref[::d] * drive.k - load).reshape(-1)
+                               for ref, load in zip(reference, loads, strict=True)])
+        return Problem(phi, y, theta0, joint, blocks,
+                       np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), held,
+                       (data, drive, prior, loads))
+
+    cutoffs = _cutoff_candidates(recs, cutoff)
+    reference = _reference_targets(recs, target, cutoffs[0])
+    cands = candidates(velocity, dead_band, thermal, measured, temps, DEAD_BAND, cutoffs)
+    best, problem, scored = choose(cands, stacked)
+    data, drive, prior, loads = problem.payload
+    step, thermal_fit = _linear_step(robot, data, drive.k, loads, prior, method, regularization,
+                                     weights, state_noise)
+    theta, standard = _estimate_standard(robot, data.relations, step, prior, method, bounds)
+    result = _identification(robot, data, step, theta, standard, drive, target, method)
+    reason = (f"held-out time blocks ({FOLDS} per recording), {len(scored)} candidates: the plain "
+              "processing unless another is better by more than one standard error"
+              if len(scored) > 1 else "as given")
+    result = replace(result, choices=Choices(best.velocity, best.dead_band, data.settings.cutoff,
+                                             step.fit.lam, tuple(scored), reason, best.thermal, best),
+                     thermal_fit=thermal_fit)
+    law = friction
+    if friction == "auto":
+        law, scores = choose_friction_law(result, data.samples, data.y_full)
+        result = replace(result, choices=replace(result.choices, friction=law,
+                                                 friction_scores=tuple(scores.items())))
+    if law in NONLINEAR:
+        result = replace(result, friction_fit=fit_friction_samples(result, data.samples, data.y_full,
+                                                                    law))
+    return result
+
+
+@dataclass(frozen=True, eq=False)
+class _Prepared:
+    """The processed data of :func:`identify` (steps 2 and 3).
+
+    Attributes
+    ----------
+    settings : Preprocess
+        The resolved preprocessing settings.
+    model : Model
+        The compiled model of the robot.
+    relations : BaseRelations
+        The base relations (without the friction columns for ``friction="none"``).
+    samples : list of Samples
+        Processed and decimated samples of each recording, (N_k, n).
+    y_full : list of ndarray
+        Filtered and decimated full regressor of each recording, (N_k, n, 15 n).
+    count : int
+        Total number of samples ``sum N_k`` after decimation.
+    thermal : ThermalData or None
+        The thermal friction columns (``thermal=True``).
+    """
+
+    settings: Preprocess
+    model: Model
+    relations: BaseRelations
+    samples: list[Samples]
+    y_full: list[np.ndarray]
+    count: int
+    thermal: ThermalData | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class _Drive:
+    """The drive gains of :func:`identify` and where they come from.
+
+    Attributes
+    ----------
+    k : ndarray, shape (n,)
+        Drive gain of each joint, N m / A (ones when absorbed or for ``target="tau"``).
+    source : str
+        Where ``k`` comes from (``Identification.gains_source``).
+    std : ndarray, shape (n,)
+        Standard deviation of ``k``, N m / A (inf when absorbed, NaN when unknown).
+    """
+
+    k: np.ndarray
+    source: str
+    std: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class _LinearStep:
+    """The stacked identification problem of :func:`identify` and its linear fit (m = sum N_k n).
+
+    Attributes
+    ----------
+    phi : ndarray, shape (m, b)
+        Identification matrix restricted to the base columns.
+    y : ndarray, shape (m,)
+        Target in torque units with the payload torque taken off, N m.
+    joint : ndarray, shape (m,)
+        Joint of each row.
+    blocks : ndarray, shape (m,)
+        Cross-validation block of each row.
+    theta0 : ndarray, shape (b,)
+        Base parameters of the prior.
+    fit : LinearFit
+        The (weighted) least-squares fit.
+    """
+
+    phi: np.ndarray
+    y: np.ndarray
+    joint: np.ndarray
+    blocks: np.ndarray
+    theta0: np.ndarray
+    fit: LinearFit
+
+
+def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff: float | str | None,
+              decimate: int | str, velocity: str, dead_band: float, model: Model,
+              thermal: bool = False, sensor: str = "motor") -> _Prepared:
+    """Preprocessed samples, filtered regressors and base relations of ``recs`` (steps 2 and 3).
+
+    Raises :class:`IdentificationError` when the
+    ``sum N_k n`` equations left after decimation are fewer than twice the ``b`` base parameters.
+    """
+    settings = resolve_preprocess(recs, cutoff, decimate, velocity, dead_band=dead_band)
+    full = [preprocess(r, settings, target) for r in recs]
+    y_full = [filtered_regressor(model, s, settings) for s in full]
+    samples = [_decimated(s, settings) for s in full]
+    rotor = np.arange(robot.dof) * PER_JOINT + len(INERTIAL_NAMES)
+    relations = base_relations(model, at_rest=_at_rest(samples, settings.dead_band),
+                               unseen=rotor if sensor == "link" else None)
+    if friction == "none":
+        relations = _without_friction_columns(relations)
+    count = sum(s.q.shape[0] for s in samples)
+    b = relations.independent.size
+    if count * robot.dof < 2 * b:
+        raise IdentificationError(
+            f"recordings: too few samples for the parameters: {count} samples x {robot.dof} joints "
+            f"= {count * robot.dof} equations after decimation by {settings.decimate} for {b} base "
+            f"parameters (at least {2 * b} needed; record longer or pass decimate=1)")
+    return _Prepared(settings, model, relations, samples, y_full, count,
+                     thermal_data(recs, full, settings) if thermal else None)
+
+
+def _cutoff_candidates(recs: list[Any], cutoff: float | str | None) -> tuple[float | str | None, ...]:
+    """The cut-offs to try: a given one alone; for "auto" its rule's value and ``CUTOFF_WIDER``
+    times it (below 0.2 x the slowest sampling rate), for a record whose torque holds more above
+    the motion's own bandwidth (a stiff controller, a fast excitation) than its noise."""
+    if cutoff != "auto":
+        return (cutoff,)
+    rule = resolve_preprocess(recs, "auto", "auto").cutoff
+    fs = min(1.0 / float(np.median(np.diff(np.asarray(r.t, float)))) for r in recs)
+    wide = min(CUTOFF_WIDER * rule, 0.2 * fs)
+    return ("auto", wide) if wide > 1.01 * rule else ("auto",)
+
+
+def _reference_targets(recs: list[Any], target: str, cutoff: float | str | None) -> list[np.ndarray]:
+    """The held-out target of the cross-validated choices, (N_k, n) per recording: each
+    recording's target low-passed at the first (plain) candidate's cut-off, the same for every
+    candidate, so that a wider cut-off wins only by better parameters, not by following the
+    target's noise (the raw target when the plain candidate has no filter)."""
+    cut = resolve_preprocess(recs, cutoff, 1).cutoff
+    out = []
+    for r in recs:
+        y = np.asarray(getattr(r, target), float)
+        out.append(y if cut is None else lowpass(np.asarray(r.t, float), y, cut, order=4))
+    return out
+
+
+def _at_rest(samples: Sequence[Samples], band: float) -> np.ndarray:
+    """Joints (n,) bool with at least ``REST_FRACTION`` of their fitted samples at rest
+    (``|qd| < band``, or exactly 0: a joint held still): their offset ``Fo`` is then seen alone."""
+    qd = np.abs(np.vstack([s.qd for s in samples]))
+    rest = (qd < band) | (qd == 0.0)
+    return np.mean(rest, axis=0) >= REST_FRACTION
+
+
+def _gains_and_prior(robot: Robot, data: _Prepared, pays: list[Payload | None], target: str,
+                     gains: str, friction: str, sensor: str = "motor"
+                     ) -> tuple[_Drive, np.ndarray, list[np.ndarray]]:
+    """Drive gains, the prior (15 n,) and the payload torque (N_k, n), N m, of each recording (step 5).
+
+    With ``target="current"`` and a payload in some recording, the gains are estimated from the
+    payload runs (:func:`_payload_gains`); for ``friction="none"`` the prior has no friction.
+    """
+    nominal = nominal_standard(robot)
+    loads = [np.zeros_like(s.q) if p is None else payload_torque(y, payload_standard(robot, p))
+             for s, y, p in zip(data.samples, data.y_full, pays, strict=True)]
+    has_payload = any(p is not None for p in pays)
+    k, k_source, prior = joint_prior(robot, data.samples, data.y_full, nominal, target, gains)
+    drive = _Drive(k, k_source, np.full(robot.dof, np.inf if k_source.startswith("absorbed") else np.nan))
+    if target == "current" and has_payload:
+        drive, prior = _payload_gains(robot, data, loads, drive, prior)
+    if friction == "none":
+        prior = without_friction(prior)
+    if sensor == "link":
+        prior = prior.copy()
+        prior[len(INERTIAL_NAMES)::PER_JOINT] = 0.0  # Ia: the sensor does not see the rotor
+    return drive, prior, loads
+
+
+def _payload_gains(robot: Robot, data: _Prepared, loads: list[np.ndarray], drive: _Drive,
+                   prior: np.ndarray) -> tuple[_Drive, np.ndarray]:
+    """Drive gains (n,), N m / A, estimated from runs with and without a payload.
+
+    ``loads`` (N_k, n) is the payload torque of each recording, N m. Returns the gains and a
+    copy of ``prior`` (15 n,) whose drive and friction terms, fitted in the units of
+    ``drive.k``, are rescaled to the estimated gains.
+    """
+    k = drive.k
+    phi, y, joint, _ = _stack(data.samples, data.y_full, data.relations.independent, np.ones(robot.dof),
+                              [np.zeros_like(x) for x in loads])
+    est = estimate_drive_gains(phi, y, np.concatenate([x.reshape(-1) for x in loads]), joint,
+                               robot.joint_names)
+    # the prior's drive and friction terms were fitted in the units of the absorbed gains
+    prior = prior.copy()
+    for j in range(robot.dof):
+        prior[PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)] *= est.gains[j] / k[j]
+    return _Drive(est.gains, "payload", est.std), prior
+
+
+def _linear_step(robot: Robot, data: _Prepared, k: np.ndarray, loads: list[np.ndarray],
+                 prior: np.ndarray, method: str, regularization: float | str | None, weights: str,
+                 state_noise: Any) -> tuple[_LinearStep, ThermalFit | None]:
+    """The stacked problem and its (weighted) least-squares fit toward ``prior`` (steps 4 and 6),
+    and the thermal friction fit (None without ``data.thermal``).
+
+    ``k`` (n,) are the drive gains, N m / A, ``loads`` (N_k, n) the payload torques, N m, and
+    ``prior`` (15 n,) the standard parameters of the prior. With thermal columns the thermal
+    coefficients are estimated together with the base parameters (toward 0), their torque is
+    then taken off the target and the base parameters fitted again alone, so that every later
+    step (weights, the consistent program) sees the base columns only.
+    """
+    phi, y, joint, blocks = _stack(data.samples, data.y_full, data.relations.independent, k, loads)
+    theta0 = data.relations.to_base(prior)
+    lin_method = "ols" if method == "ols" else "wls"
+    thermal_fit = None
+    if data.thermal is not None:
+        extra = np.vstack([r.reshape(-1, r.shape[2]) for r in data.thermal.fit_rows])
+        coef = _thermal_coefficients(phi, y, theta0, joint, blocks, extra, lin_method, regularization)
+        y = y - extra @ coef  # tau - (T - T_ref)(cv qd + cc sign qd)
+        thermal_fit = ThermalFit(data.thermal.t_ref, coef[0::2], coef[1::2])
+    fit = fit_linear(phi, y, theta0, joint, blocks, method=lin_method, regularization=regularization)
+    step = _LinearStep(phi, y, joint, blocks, theta0, fit)
+    if weights == "state-noise":
+        step = replace(step, fit=_state_noise_fit(robot, data, step, prior, regularization, state_noise))
+    return step, thermal_fit
+
+
+def _thermal_coefficients(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, joint: np.ndarray,
+                          blocks: np.ndarray, extra: np.ndarray, method: str,
+                          regularization: float | str | None) -> np.ndarray:
+    """Thermal coefficients (e,) of the columns ``extra`` (m, e), not regularised.
+
+    ``min |y - Phi theta - E c|^2 + lam |theta - theta0|^2`` (Tikhonov on the base parameters
+    only: a weight chosen for them would pull the small thermal columns to zero): for any
+    ``theta`` the best ``c`` is ``E^+ (y - Phi theta)``, so ``theta`` is the usual fit of the
+    rows projected off the thermal columns, ``P = 1 - Q Q^T`` with ``E = Q R``.
+    """
+    q, _ = np.linalg.qr(extra)
+    # P Phi, P y: the base problem with the thermal columns projected out
+    fit = fit_linear(phi - q @ (q.T @ phi), y - q @ (q.T @ y), theta0, joint, blocks, method=method,
+                     regularization=regularization)
+    # c = E^+ (y - Phi theta)
+    return np.linalg.lstsq(extra, y - phi @ fit.theta, rcond=None)[0]
+
+
+def _state_noise_fit(robot: Robot, data: _Prepared, step: _LinearStep, prior: np.ndarray,
+                     regularization: float | str | None, state_noise: Any) -> LinearFit:
+    """The fit again with row weights ``1 / sigma_tau`` (m,) from the first fit ``step.fit``.
+
+    ``sigma_tau^2`` (N m^2) is the state noise propagated through the first fit's model plus the
+    measurement variance of each joint, floored at ``MEAS_FLOOR`` times its residual variance.
+    """
+    noise = state_noise_std(state_noise, robot.dof)
+    first = _complete(data.relations, step.fit.theta, prior)
+    var = np.concatenate([torque_variance(data.model, s.q, s.qd, s.qdd, *noise, standard=first)
+                          for s in data.samples]).reshape(-1)
+    # sigma_meas^2: what the propagated variance leaves of each joint's residual variance
+    prop = np.array([np.mean(var[step.joint == j]) for j in range(robot.dof)])
+    meas = np.maximum(step.fit.sigma**2 - prop, MEAS_FLOOR * step.fit.sigma**2)
+    return fit_linear(step.phi, step.y, step.theta0, step.joint, step.blocks,
+                      regularization=regularization, row_sigma=np.sqrt(meas[step.joint] + var))
+
+
+def _estimate_standard(robot: Robot, relations: BaseRelations, step: _LinearStep, prior: np.ndarray,
+                       method: str, bounds: dict[str, tuple[float, float]] | None
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """Base parameters (b,) and the full standard set (15 n,) of the estimate (steps 6 and 7).
+
+    ``method="consistent"``: the physically consistent standard set; otherwise the linear fit
+    completed with ``prior`` (15 n,) for the dependent parameters.
+    """
+    if method == "consistent":
+        from robodyn.identification.consistent import consistent_standard
+
+        standard = consistent_standard(robot, relations, step.phi, step.y, step.joint, step.fit, prior,
+                                       bounds)
+        return relations.to_base(standard), standard
+    theta = step.fit.theta
+    return theta, _complete(relations, theta, prior)
+
+
+def _identification(robot: Robot, data: _Prepared, step: _LinearStep, theta: np.ndarray,
+                    standard: np.ndarray, drive: _Drive, target: str, method: str) -> Identification:
+    """The :class:`Identification` of base parameters ``theta`` (b,) and standard set (15 n,)."""
+    table = _table(data.relations, theta, step.fit, step.theta0)
+    ident_robot = robot_with_parameters(robot, standard, drive.k if target == "current" else None,
+                                        source=f"identified ({method}) from {robot.source}")
+    s = step.fit.singular_values
+    weak = step.fit.directions[:, s < UNEXCITED_RTOL * s[0]]
+    return Identification(
+        robot=ident_robot, base_parameters=table, standard=standard, preprocess=data.settings,
+        target=target, method=method, gains=drive.k, gains_source=drive.source, gains_std=drive.std,
+        regularization=step.fit.lam,
+        condition=step.fit.condition, singular_values=s, unexcited_directions=weak,
+        residual_std=step.fit.sigma / drive.k, samples=data.count, relations=data.relations,
+        _model=data.model)
+
+
+def _without_friction_columns(relations: BaseRelations) -> BaseRelations:
+    """The base relations with the friction parameters (Fv, Fcp, Fcn, Fo) left out; they only
+    ever combine among themselves, so the other base parameters are unchanged."""
+    keep = np.array([c % PER_JOINT <= len(INERTIAL_NAMES) for c in relations.independent])
+    return replace(relations, independent=relations.independent[keep], beta=relations.beta[keep])
+
+
+def filtered_regressor(model: Model, s: Samples, settings: Preprocess) -> np.ndarray:
+    """The fit's regressor rows (N / decimate, n, 15 n)
+    (:func:`robodyn.identification.preprocess.regressor_rows`)."""
+    return regressor_rows(model, s, settings)
+
+
+def _decimated(s: Samples, settings: Preprocess) -> Samples:
+    d = settings.decimate
+    if d == 1:
+        return s
+    return Samples(s.t[::d], s.q[::d], s.qd[::d], s.qdd[::d], None if s.y is None else s.y[::d],
+                   s.source)
+
+
+def _complete(relations: Any, theta: np.ndarray, nominal: np.ndarray) -> np.ndarray:
+    """Standard vector with the dependent parameters at their nominal values and the
+    independent ones set so that its base parameters equal ``theta``."""
+    p = nominal.copy()
+    # theta = p_b + beta p_d  ->  p_b = theta - beta p_d
+    p[relations.independent] = theta - relations.beta @ nominal[relations.dependent]
+    return _split_coulomb(relations, p)
+
+
+def _split_coulomb(relations: BaseRelations, p: np.ndarray) -> np.ndarray:
+    """Move along the one direction the data cannot see among a joint's (Fcp, Fcn, Fo) (an
+    offset against asymmetric Coulomb friction) so that both Coulomb levels are non-negative,
+    as a description requires, staying as close as possible to the prior's split."""
+    k = relations.matrix
+    out = p.copy()
+    for j in range(p.size // PER_JOINT):
+        idx = PER_JOINT * j + len(INERTIAL_NAMES) + np.array([2, 3, 4])  # Fcp, Fcn, Fo
+        _, sv, vt = np.linalg.svd(k[:, idx])
+        null = vt[np.sum(sv > 1e-9 * max(sv[0], 1e-300)):]
+        if null.shape[0] != 1:
+            continue
+        d = null[0]
+        c = out[idx[:2]]
+        # Fcp, Fcn + t d[:2] >= 0: an interval of t (or none)
+        lo, hi = -np.inf, np.inf
+        for ci, di in zip(c, d[:2], strict=True):
+            if abs(di) < 1e-12:
+                continue
+            if di > 0:
+                lo = max(lo, -ci / di)
+            else:
+                hi = min(hi, -ci / di)
+        if lo <= hi:
+            t = float(np.clip(0.0, lo, hi))
+        elif abs(d[0] - d[1]) > 1e-12:
+            t = float((c[1] - c[0]) / (d[0] - d[1]))  # no such split: equal levels
+        else:
+            continue
+        out[idx] += t * d
+    return out
+
+
+def _table(relations: Any, theta: np.ndarray, fit: LinearFit, theta0: np.ndarray) -> BaseParameters:
+    std = np.sqrt(np.clip(np.diag(fit.cov), 0.0, np.inf))
+    return BaseParameters(names=relations.names, values=theta, std=std, nominal=theta0,
+                          base=relations, identifiable=~fit.unexcited)
+

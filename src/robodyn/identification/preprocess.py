@@ -1,0 +1,270 @@
+"""From a raw recording to the samples an identification fits: filter, differentiate, decimate.
+
+One rule, used by :func:`robodyn.identification` and again by :meth:`Identification.predict`, so that a
+prediction processes a new recording exactly as the fit processed its data:
+
+* positions ``q`` are low-passed with a zero-phase Butterworth filter (order 4 per pass, run
+  forward and backward: :func:`robodyn.measure.filtering.differentiate`), and ``qd``, ``qdd`` are
+  the derivatives of the filtered positions (measured velocities are used, filtered the same
+  way, only with ``velocity="measured"``; their spikes make position differences the safer
+  default); a joint whose position spans less than 1 mrad (1 mm) is held still: its ``qd`` and
+  ``qdd`` are exactly zero;
+* the target (torque or current) is low-passed with the SAME filter, so that the fit of a
+  filtered target on filtered motion is not biased by different filter gains;
+* for fitting only, the filtered samples are then decimated by an integer factor (keeping every
+  ``decimate``-th sample), which thins the strongly correlated neighbouring rows the filter
+  leaves; :meth:`Identification.predict` returns every sample.
+
+The regressor rows of a prediction (:func:`prediction_rows`) are the compiled regressor of the
+processed states with its Coulomb columns set to zero wherever ``|qd_j|`` is below the dead band
+(``dead_band``, 0 or ``DEAD_BAND`` = 1e-3 rad/s chosen from the data: a joint at rest, or
+creeping within its velocity noise, carries no Coulomb step and only the friction offset ``Fo``,
+a base parameter of its own, :mod:`robodyn.identification.base`); the fit's rows
+(:func:`regressor_rows`) are the same rows low-passed column by column with the target's filter
+(parallel filtering), so that the fit of the filtered target estimates the parameters of the
+unfiltered model ``Y p`` that ``predict`` returns: the Coulomb sign is handled the same way in
+both.
+
+``cutoff=None`` turns all filtering off: the recording's own ``qd`` and ``qdd`` (measured or
+estimated when the recording was built) and its raw target are used (simulated data).
+
+Default cut-off (``cutoff="auto"``): the largest bandwidth of the moving joints' positions
+(:func:`robodyn.measure.filtering.bandwidth_cutoff`) over the recordings, clamped to
+``[AUTO_MIN_HZ, AUTO_MAX_HZ]`` = [2, 5] Hz and to 0.2 x the sampling rate: manipulator motion
+(and with it the rigid-body torque) lives below a few hertz, while the second derivative of
+encoder noise grows with the square of frequency. Default decimation (``decimate="auto"``): the
+largest integer not above ``fs / (5 cutoff)``, i.e. about five samples per cut-off period.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from robodyn.identification.stacking import regressor_rows_of
+from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass
+from robodyn.robot.errors import IdentificationError
+
+__all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "DEAD_BAND", "MID_RATE", "Preprocess", "Samples",
+           "coulomb_dead_band", "evaluation_step", "filtered_rows", "prediction_rows", "preprocess",
+           "regressor_rows", "resolve_preprocess"]
+
+AUTO_MIN_HZ = 2.0
+AUTO_MAX_HZ = 5.0
+_MOVING_RAD = 1e-3  # a joint whose position spans less than this never moves (rad or m)
+#: Coulomb dead band, rad/s (m/s): below it a joint's Coulomb columns are zero.
+DEAD_BAND = 1e-3
+#: Samples per cut-off period kept for the parallel filtering of the regressor.
+MID_RATE = 100
+
+
+@dataclass(frozen=True)
+class Preprocess:
+    """The frozen preprocessing settings of an identification.
+
+    Attributes
+    ----------
+    cutoff : float or None
+        -3 dB frequency of one pass of the zero-phase Butterworth filter, Hz; None: no filtering.
+    order : int
+        Butterworth order of one pass.
+    decimate : int
+        Keep every ``decimate``-th filtered sample for fitting (1: all).
+    velocity : {"position", "measured"}
+        Whether ``qd`` is the derivative of the filtered positions or the filtered measured one.
+    dead_band : float
+        Coulomb dead band, rad/s (m/s); 0: the sign of ``qd`` everywhere.
+    """
+
+    cutoff: float | None
+    order: int = 4
+    decimate: int = 1
+    velocity: Literal["position", "measured"] = "position"
+    dead_band: float = DEAD_BAND
+
+
+@dataclass(frozen=True, eq=False)
+class Samples:
+    """Processed samples of one recording, all (N, n) at the recording's own times.
+
+    Attributes
+    ----------
+    t : numpy.ndarray, shape (N,)
+    q, qd, qdd : numpy.ndarray, shape (N, n)
+        rad, rad/s, rad/s^2 (m for prismatic joints).
+    y : numpy.ndarray or None, shape (N, n)
+        The (filtered) target: N m (N) or A; None when the recording has no such signal.
+    source : str
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    y: np.ndarray | None
+    source: str
+
+
+def _source(rec: Any) -> str:
+    return str(getattr(rec, "source", "") or "Recording")
+
+
+def target_signal(rec: Any, target: str) -> np.ndarray | None:
+    """The recording's raw target (N, n) (``tau`` or ``current``), or None when absent."""
+    return getattr(rec, target, None)
+
+
+def resolve_preprocess(recordings: list[Any], cutoff: float | str | None, decimate: int | str,
+                       velocity: str = "position", order: int = 4,
+                       dead_band: float = DEAD_BAND) -> Preprocess:
+    """Settings for these recordings: the ``"auto"`` rules of the module docstring resolved."""
+    if velocity not in ("position", "measured"):
+        raise IdentificationError(f"velocity: expected 'position' or 'measured', got {velocity!r}")
+    if not (isinstance(dead_band, (int, float)) and np.isfinite(dead_band) and 0 <= dead_band < 1e3):
+        raise IdentificationError(f"dead_band: expected a velocity in [0, 1000) rad/s, got {dead_band!r}")
+    fs = min(1.0 / float(np.median(np.diff(np.asarray(r.t, float)))) for r in recordings)
+    if isinstance(cutoff, str):
+        if cutoff != "auto":
+            raise IdentificationError(f"cutoff: expected a frequency in Hz, None or 'auto', got {cutoff!r}")
+        bands = []
+        for r in recordings:
+            q = np.asarray(r.q, float)
+            moving = np.ptp(q, axis=0) > _MOVING_RAD
+            if np.any(moving) and q.shape[0] >= 16:
+                bands.append(bandwidth_cutoff(np.asarray(r.t, float), q[:, moving]))
+        band = max(bands) if bands else AUTO_MIN_HZ
+        cut = float(np.clip(band, AUTO_MIN_HZ, AUTO_MAX_HZ))
+        cut = min(cut, 0.2 * fs)
+    elif cutoff is None:
+        cut = None
+    else:
+        cut = float(cutoff)
+        if not 0.0 < cut < 0.5 * fs:
+            raise IdentificationError(f"cutoff: must lie in (0, {0.5 * fs:g}) Hz (the Nyquist "
+                                      f"frequency of the slowest recording), got {cut:g}")
+    if isinstance(decimate, str):
+        if decimate != "auto":
+            raise IdentificationError(f"decimate: expected a positive integer or 'auto', got {decimate!r}")
+        dec = 1 if cut is None else max(1, int(np.floor(fs / (5.0 * cut))))
+        if cut is not None:
+            # a multiple of the step at which regressor_rows evaluates and filters the regressor
+            step = max(1, int(fs / (MID_RATE * cut)))
+            dec = max(dec // step * step, 1)
+    else:
+        dec = int(decimate)
+        if dec < 1 or dec != decimate:
+            raise IdentificationError(f"decimate: expected a positive integer, got {decimate!r}")
+    return Preprocess(cutoff=cut, order=order, decimate=dec, velocity=velocity,  # type: ignore[arg-type]
+                      dead_band=float(dead_band))
+
+
+def preprocess(rec: Any, settings: Preprocess, target: str | None) -> Samples:
+    """Process one recording (not decimated; see the module docstring).
+
+    Parameters
+    ----------
+    rec : Recording
+        Raw recording: ``t`` (N,) s, ``q`` (N, n), optional ``qd``/``qdd``/``tau``/``current``.
+    settings : Preprocess
+    target : {"tau", "current"} or None
+        Which signal to filter as the target (None: none).
+
+    Returns
+    -------
+    Samples
+    """
+    t = np.asarray(rec.t, dtype=float)
+    q = np.asarray(rec.q, dtype=float)
+    raw_y = target_signal(rec, target) if target is not None else None
+    y = None if raw_y is None else np.asarray(raw_y, dtype=float)
+    if settings.cutoff is None:
+        if rec.qd is None or rec.qdd is None:
+            raise IdentificationError(f"{_source(rec)}: qd/qdd: cutoff=None uses the recording's own "
+                                      f"velocities and accelerations, but it has none")
+        return Samples(t, q, np.asarray(rec.qd, float), np.asarray(rec.qdd, float), y, _source(rec))
+    cut, order = settings.cutoff, settings.order
+    # q_f = H q (zero-phase low-pass), qd = d q_f / dt, qdd = d^2 q_f / dt^2
+    q_f, qd, qdd = differentiate(t, q, cut, order=order)
+    estimated = getattr(rec, "estimated", frozenset())
+    if settings.velocity == "measured" and rec.qd is not None and "qd" not in estimated:
+        # qd = H qd_measured, qdd = d qd / dt
+        qd_f, qdd, _ = differentiate(t, np.asarray(rec.qd, float), cut, order=order)
+        qd = qd_f
+    held = np.ptp(q, axis=0) < _MOVING_RAD
+    qd[:, held] = 0.0  # a joint held still: its filtered encoder noise is no motion
+    qdd[:, held] = 0.0
+    y_f = None if y is None else lowpass(t, y, cut, order=order)  # the same H on the target
+    return Samples(t, q_f, qd, qdd, y_f, _source(rec))
+
+
+def coulomb_dead_band(y: np.ndarray, qd: np.ndarray, band: float) -> np.ndarray:
+    """The regressor ``y`` (N, n, 15 n) with joint j's Coulomb columns (``Fcp``, ``Fcn``) zero
+    wherever ``|qd_j| < band`` (``qd`` (N, n), rad/s); ``y`` is changed in place and returned."""
+    from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
+
+    if band <= 0:
+        return y
+    for j in range(qd.shape[1]):
+        still = np.abs(qd[:, j]) < band
+        if np.any(still):
+            c = PER_JOINT * j + len(INERTIAL_NAMES) + 2  # Fcp, then Fcn
+            y[still, j, c:c + 2] = 0.0
+    return y
+
+
+def prediction_rows(model: Any, s: Samples, settings: Preprocess) -> np.ndarray:
+    """Regressor (N, n, 15 n) of processed samples for a prediction: the compiled regressor of
+    ``model`` at ``(s.q, s.qd, s.qdd)`` with the Coulomb dead band (:func:`coulomb_dead_band`)."""
+    return coulomb_dead_band(regressor_rows_of(model, s.q, s.qd, s.qdd), s.qd, settings.dead_band)
+
+
+def regressor_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool = True) -> np.ndarray:
+    """Full regressor (N / decimate, n, 15 n) of processed samples for a fit or a prediction.
+
+    The compiled regressor of ``model`` at ``(s.q, s.qd, s.qdd)`` with the Coulomb dead band
+    (:func:`coulomb_dead_band`), low-passed column by column with the target's filter before
+    decimation (parallel filtering, Gautier 1997): the filter is linear, so ``H(Y p) = H(Y) p``
+    holds exactly, and the fit of the filtered target is not biased by terms the filter smooths
+    (Coulomb steps at velocity reversals). ``decimate=False``: every sample (a prediction).
+
+    To bound memory and time on long fast logs, ``Y`` is evaluated and filtered on every
+    ``m``-th sample, ``m`` the largest divisor of the decimation factor with at least
+    ``MID_RATE`` samples per cut-off period left (the filtered states are smooth there; only the
+    timing of a Coulomb step moves, by less than ``1 / (MID_RATE cutoff)``).
+    """
+    d = settings.decimate if decimate else 1
+    band = settings.dead_band
+    if settings.cutoff is None:
+        return coulomb_dead_band(regressor_rows_of(model, s.q[::d], s.qd[::d], s.qdd[::d]), s.qd[::d],
+                                 band)
+    m = evaluation_step(s.t, settings, d)
+    y = coulomb_dead_band(regressor_rows_of(model, s.q[::m], s.qd[::m], s.qdd[::m]), s.qd[::m], band)
+    return filtered_rows(s.t[::m], y, settings, d // m)
+
+
+def evaluation_step(t: np.ndarray, settings: Preprocess, d: int) -> int:
+    """The step ``m`` (a divisor of the decimation ``d``) at which rows are evaluated and filtered:
+    the largest with at least ``MID_RATE`` samples per cut-off period (:func:`regressor_rows`)."""
+    if settings.cutoff is None:
+        return d
+    fs = 1.0 / float(np.median(np.diff(t)))
+    limit = max(1, int(fs / (MID_RATE * settings.cutoff)))
+    return max(k for k in range(1, d + 1) if d % k == 0 and k <= limit)
+
+
+def filtered_rows(t: np.ndarray, y: np.ndarray, settings: Preprocess, keep: int) -> np.ndarray:
+    """Rows ``y`` (N, ...) at times ``t`` (N,) low-passed along time with the target's filter,
+    then every ``keep``-th kept (N / keep, ...)."""
+    count = y.shape[0]
+    flat = y.reshape(count, -1)
+    if settings.cutoff is None:
+        return flat[::keep].reshape((-1,) + y.shape[1:])
+    # H Y: the same zero-phase low-pass as the target, along time, on the columns that vary (a
+    # constant column, most of them structural zeros, is its own low-pass)
+    varying = np.flatnonzero(np.ptp(flat, axis=0) > 0)
+    out = flat[::keep].copy()
+    if varying.size:
+        out[:, varying] = lowpass(t, flat[:, varying], settings.cutoff, order=settings.order)[::keep]
+    return out.reshape((-1,) + y.shape[1:])

@@ -1,0 +1,203 @@
+"""Frozen results of an identification: the base parameter table and :class:`Identification`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+from robodyn.identification.base import BaseRelations
+from robodyn.identification.choices import Choices
+from robodyn.identification.friction import FrictionFit, without_friction
+from robodyn.identification.preprocess import Preprocess, prediction_rows, preprocess
+from robodyn.identification.thermal import ThermalFit, temperatures
+from robodyn.numeric.model import Model
+from robodyn.robot.model import Robot
+
+__all__ = ["BaseParameters", "Identification"]
+
+
+@dataclass(frozen=True, eq=False)
+class BaseParameters:
+    """Table of the identified base parameters, one row each.
+
+    Attributes
+    ----------
+    names : tuple of str, length b
+    values : numpy.ndarray, shape (b,)
+        SI units (kg m^2, kg m, kg, N m s/rad, N m), target-torque units.
+    std : numpy.ndarray, shape (b,)
+        Standard deviations (inf: not identifiable from these data; the value is then the prior).
+    nominal : numpy.ndarray, shape (b,)
+        The prior's values of the same combinations (the description completed by the
+        per-joint drive and friction fit, :mod:`robodyn.identification.prior`).
+    base : BaseRelations
+        The numerical relations (:attr:`relations` gives them symbolically).
+    identifiable : numpy.ndarray of bool, shape (b,)
+        False where the data do not excite the parameter (it keeps its prior value).
+    """
+
+    names: tuple[str, ...]
+    values: np.ndarray
+    std: np.ndarray
+    nominal: np.ndarray
+    base: BaseRelations
+    identifiable: np.ndarray
+
+    @cached_property
+    def relations(self) -> tuple[sp.Expr, ...]:
+        """Each base parameter in the standard parameter symbols (``XX1``, ``MY2``, ...)."""
+        return self.base.expressions
+
+    @property
+    def relative_std(self) -> np.ndarray:
+        """``100 std / |value|`` (%), shape (b,); inf for a zero value or infinite std."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rel = 100.0 * self.std / np.abs(self.values)
+        return np.where(np.isfinite(rel), rel, np.inf)
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def to_frame(self) -> Any:
+        """The table as a pandas DataFrame (columns name, value, std, relative_std_percent,
+        nominal, identifiable, relation)."""
+        import pandas as pd
+
+        return pd.DataFrame({
+            "name": self.names, "value": self.values, "std": self.std,
+            "relative_std_percent": self.relative_std, "nominal": self.nominal,
+            "identifiable": self.identifiable, "relation": [str(r) for r in self.relations],
+        })
+
+    def __str__(self) -> str:
+        lines = [f"{'name':<8} {'value':>13} {'std':>11} {'rel std %':>10}  relation"]
+        for i, name in enumerate(self.names):
+            flag = "" if self.identifiable[i] else "  (not excited)"
+            lines.append(f"{name:<8} {self.values[i]:>13.6g} {self.std[i]:>11.3g} "
+                         f"{self.relative_std[i]:>10.3g}  {self.relations[i]}{flag}")
+        return "\n".join(lines)
+
+
+@dataclass(frozen=True, eq=False)
+class Identification:
+    """Result of :func:`robodyn.identification`.
+
+    Attributes
+    ----------
+    robot : Robot
+        The description carrying the identified parameters (the full standard set: physically
+        consistent with ``method="consistent"``; otherwise the nominal values of the dependent
+        standard parameters completed by the identified base combinations).
+    base_parameters : BaseParameters
+    standard : numpy.ndarray, shape (15 n,)
+        The standard parameter vector of ``robot``.
+    preprocess : Preprocess
+        Filter cut-off, order and decimation used (applied again by :meth:`predict`).
+    target : {"tau", "current"}
+    method : {"ols", "wls", "consistent"}
+    gains : numpy.ndarray, shape (n,)
+        Drive gains ``K_j`` (N m / A) dividing the predicted torque when ``target="current"``
+        (ones for ``target="tau"``).
+    gains_source : {"none", "description", "absorbed", "payload"}
+        "payload": estimated from a run with a known payload (:mod:`robodyn.identification.drive_gains`).
+    regularization : float
+        Tikhonov weight used (dimensionless; 0: none).
+    condition : float
+        Condition number of the weighted, column-scaled identification matrix.
+    singular_values : numpy.ndarray, shape (b,)
+    unexcited_directions : numpy.ndarray, shape (b, k)
+        Unit directions in base-parameter space (column-scaled) whose singular value is below
+        1e-6 of the largest: what the data cannot tell apart.
+    residual_std : numpy.ndarray, shape (n,)
+        Per-joint residual standard deviation of the fit (target units).
+    samples : int
+        Samples (after decimation) used in the fit.
+    relations : BaseRelations
+    gains_std : numpy.ndarray, shape (n,)
+        Standard deviations of ``gains`` (N m / A) when they were estimated (``"payload"``);
+        inf when absorbed (current alone leaves a common scale of the gains free: not
+        identified); nan when given (description) or not used (``target="tau"``).
+    friction_fit : FrictionFit or None
+        A nonlinear friction law fitted after the linear step
+        (:func:`robodyn.identification.friction.fit_friction`); :meth:`predict` then uses it in place
+        of the linear friction.
+    choices : Choices or None
+        The preprocessing chosen from the data (velocity source, Coulomb dead band, cut-off,
+        regularisation) with every candidate's cross-validated score
+        (:mod:`robodyn.identification.choices`).
+    thermal_fit : ThermalFit or None
+        Temperature coefficients of the friction (``thermal=True``,
+        :mod:`robodyn.identification.thermal`): :meth:`predict` adds their torque (the recording then
+        needs temperatures); ``robot`` carries the friction at the reference temperature.
+    """
+
+    robot: Robot
+    base_parameters: BaseParameters
+    standard: np.ndarray
+    preprocess: Preprocess
+    target: str
+    method: str
+    gains: np.ndarray
+    gains_source: str
+    regularization: float
+    condition: float
+    singular_values: np.ndarray
+    unexcited_directions: np.ndarray
+    residual_std: np.ndarray
+    samples: int
+    relations: BaseRelations
+    _model: Model
+    friction_fit: FrictionFit | None = None
+    gains_std: np.ndarray | None = None
+    choices: Choices | None = None
+    thermal_fit: ThermalFit | None = None
+
+    @property
+    def gains_identified(self) -> bool:
+        """Whether the drive gains were identified from the data (a known-payload run)."""
+        return self.gains_source == "payload"
+
+    def predict(self, recording: Any, payload: Any = None) -> np.ndarray:
+        """Predicted target at the recording's own samples.
+
+        The raw recording is processed as the identification data were, by the same functions
+        (same filter cut-off and order, same derivative estimates, the same Coulomb dead band),
+        without decimation; the prediction is the model's effort ``Y(q, qd, qdd) p`` at the
+        processed states (:func:`robodyn.identification.preprocess.prediction_rows`).
+
+        Parameters
+        ----------
+        recording : Recording
+            ``t`` (N,), ``q`` (N, n) in the robot's joint order.
+        payload : Payload, optional
+            A known payload on the last link during this recording; its torque is added.
+
+        Returns
+        -------
+        numpy.ndarray, shape (N, n)
+            N m (N) for ``target="tau"``, A for ``target="current"``.
+        """
+        from robodyn.identification.inputs import check_recording
+
+        check_recording(self.robot, recording, 0, None)
+        s = preprocess(recording, self.preprocess, None)
+        y = prediction_rows(self._model, s, self.preprocess)
+        thermal = 0.0
+        if self.thermal_fit is not None:
+            temp = temperatures(recording, 0, self.robot.dof)
+            thermal = self.thermal_fit.torque(s.qd, temp, self.preprocess.dead_band)
+        if self.friction_fit is None:
+            tau = y @ self.standard  # tau = Y(q, qd, qdd) p
+        else:
+            load = y @ without_friction(self.standard)  # rigid body and rotor inertia
+            tau = load + self.friction_fit.torque(s.qd, load)
+        tau = tau + thermal  # (T - T_ref)(cv qd + cc sign qd)
+        if payload is not None:
+            from robodyn.identification.payload import payload_standard, payload_torque
+
+            tau = tau + payload_torque(y, payload_standard(self.robot, payload))
+        return tau / self.gains[None, :]

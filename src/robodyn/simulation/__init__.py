@@ -1,0 +1,51 @@
+"""Simulation: integrators, controllers, planned trajectories, inverse kinematics, case studies.
+
+Public entry points::
+
+    from robodyn.simulation import simulate, PD, quintic
+    model = rd.compile_model(rd.load("puma560"))
+    traj = simulate(model, q0, None, duration=2.0, dt=1e-3, controller=PD(100, 20, q_ref))
+
+The AA300 design study and the double-pendulum balance are in
+:mod:`robodyn.simulation.aa300_study` and :mod:`robodyn.simulation.balance` (they import matplotlib).
+"""
+
+from robodyn.simulation.controllers import LQR, PD, PID, ComputedTorque, Controller, GravityCompensation
+from robodyn.simulation.energy import frame_origins, potential_energy
+from robodyn.simulation.ik import IKResult, UnreachableError, inverse_kinematics
+from robodyn.simulation.linearize import Linearization, linearize
+from robodyn.simulation.simulation import ADAPTIVE, FIXED_STEP, Trajectory, simulate
+from robodyn.simulation.trajectory import (
+    JointTrajectory,
+    cartesian_line,
+    concatenate,
+    quintic,
+    trapezoidal,
+    via_points,
+)
+
+__all__ = [
+    "ADAPTIVE",
+    "FIXED_STEP",
+    "IKResult",
+    "JointTrajectory",
+    "LQR",
+    "PD",
+    "PID",
+    "ComputedTorque",
+    "Controller",
+    "GravityCompensation",
+    "Linearization",
+    "Trajectory",
+    "UnreachableError",
+    "cartesian_line",
+    "concatenate",
+    "frame_origins",
+    "inverse_kinematics",
+    "linearize",
+    "potential_energy",
+    "quintic",
+    "simulate",
+    "trapezoidal",
+    "via_points",
+]
