@@ -30,8 +30,8 @@ from timing import best_of_with_result as best_of
 import robodyn as rd
 from robodyn.calibration import calibrate, random_configurations
 from robodyn.calibration.kinematics import rot, trans
-from robodyn.calibration.simulate_study import perturbed_robot, robot_positions
 from robodyn.calibration.solve import fit
+from robodyn.studies.calibration_study import perturbed_robot, robot_positions
 
 SIGMA = 5e-5
 POSES = 200
@@ -87,7 +87,7 @@ def combined(robot, true, repeat: int) -> None:
     from pathlib import Path
 
     from robodyn.calibration.io import write_calibration_csv  # noqa: F401 (format reference)
-    from robodyn.calibration.simulate_study import robot_frames
+    from robodyn.studies.calibration_study import robot_frames
 
     n, targets = 1000, np.array([[0.031, -0.018, 0.076], [-0.045, 0.052, 0.060], [0.06, 0.04, 0.03]])
     rng = np.random.default_rng(3)

@@ -20,7 +20,7 @@ import warnings
 import numpy as np
 
 import robodyn as rd
-from robodyn.measure.excitation import (
+from robodyn.studies.excitation import (
     _Layout,
     _null_bases,
     _Problem,

@@ -127,8 +127,8 @@ def _gapped(rec: rd.Recording, rng: np.random.Generator, gaps: int, length: int)
 
 
 def virtual_cases(quick: bool) -> list[Case]:
-    from robodyn.measure.testprog import jointwise
-    from robodyn.measure.virtual_lab import Sensors, virtual_lab
+    from robodyn.studies.testprog import jointwise
+    from robodyn.studies.virtual_lab import Sensors, virtual_lab
 
     cases = []
     # a 6-DOF arm like the current-driven cobot: ~94 Hz (10/12 ms stamps), 4 decimals, currents

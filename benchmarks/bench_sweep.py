@@ -16,10 +16,10 @@ import argparse
 import time
 from concurrent.futures import ProcessPoolExecutor
 
-from robodyn.study import LatinHypercube, expand_cases, run_batch, sweep
-from robodyn.study.models import RobotSource
-from robodyn.study.sizing import ActuatorSizing
-from robodyn.study.sweep import batches, local_cluster
+from robodyn.studies import LatinHypercube, expand_cases, run_batch, sweep
+from robodyn.studies.models import RobotSource
+from robodyn.studies.sizing import ActuatorSizing
+from robodyn.studies.sweeps import batches, local_cluster
 
 
 def _task() -> ActuatorSizing:

@@ -3,12 +3,12 @@
     .venv/bin/python benchmarks/bench_sweep_faults.py                      # 10,000 cases, 3 workers
     .venv/bin/python benchmarks/bench_sweep_faults.py --cases 2000 --workers 2 --no-serial
 
-Each case sizes the actuators of the planar 2R arm (``robodyn.study.ActuatorSizing``: a trapezoidal
+Each case sizes the actuators of the planar 2R arm (``robodyn.studies.ActuatorSizing``: a trapezoidal
 move, PD + gravity compensation, RK4 in C at 1 ms, about 1 ms per case) for a payload on a grid and
 a bandwidth and damping from a Latin hypercube. One case (the middle one) dereferences a null
 pointer through ctypes every time it runs: a segfault in compiled code, which kills its worker
 process. When a quarter of the cases have finished, one worker process is killed with SIGKILL by
-its PID. The sweep runs with the default batching (``robodyn.study.sweep.default_batch``) and
+its PID. The sweep runs with the default batching (``robodyn.studies.sweeps.default_batch``) and
 ships the compiled models to the workers.
 
 Printed: the cases finished, failed (with the crashing case's message), duplicated (delivered by
@@ -29,10 +29,10 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from robodyn.study import LatinHypercube, case_seed, expand_cases, run_serial, sweep
-from robodyn.study.models import ModelSpec, RobotSource
-from robodyn.study.sizing import ActuatorSizing
-from robodyn.study.sweep import default_batch, local_cluster
+from robodyn.studies import LatinHypercube, case_seed, expand_cases, run_serial, sweep
+from robodyn.studies.models import ModelSpec, RobotSource
+from robodyn.studies.sizing import ActuatorSizing
+from robodyn.studies.sweeps import default_batch, local_cluster
 
 
 @dataclass(frozen=True)

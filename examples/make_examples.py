@@ -4,7 +4,7 @@
 
 * ``poses.csv`` / ``held.csv``: 60 / 20 PUMA 560 poses measured by a simulated laser tracker
   (0.05 mm noise per coordinate) on a "true" PUMA with about 1 mm / 0.1 degree of manufacturing
-  errors (:func:`robodyn.calibration.simulate_study.perturbed_robot`), in the instrument frame;
+  errors (:func:`robodyn.studies.calibration_study.perturbed_robot`), in the instrument frame;
   input of ``robodyn calibrate``.
 * ``cycles.csv``: ISO 9283 pose accuracy and repeatability data, 5 commanded poses (the test
   cube's P1-P5) each attained 30 times; input of ``robodyn iso9283``.
@@ -27,7 +27,7 @@ import numpy as np
 import robodyn as rd
 from robodyn.calibration.iso9283 import cube_points
 from robodyn.calibration.pipeline import random_configurations
-from robodyn.calibration.simulate_study import perturbed_robot, robot_positions
+from robodyn.studies.calibration_study import perturbed_robot, robot_positions
 
 HERE = Path(__file__).resolve().parent
 
@@ -81,7 +81,7 @@ def approach() -> None:
 
 def bag() -> None:
     from robodyn.measure.mcap_io import write_mcap
-    from robodyn.measure.virtual_lab import Sensors, virtual_lab
+    from robodyn.studies.virtual_lab import Sensors, virtual_lab
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

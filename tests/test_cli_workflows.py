@@ -12,8 +12,8 @@ import pytest
 
 import robodyn as rd
 from robodyn.calibration.io import write_calibration_csv
-from robodyn.calibration.simulate_study import perturbed_robot, robot_positions
 from robodyn.cli import main
+from robodyn.studies.calibration_study import perturbed_robot, robot_positions
 from tests.calibration.helpers import TARGET, TRACKER, poses, robot
 
 # --- simulate ----------------------------------------------------------------------------------

@@ -14,6 +14,8 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
+from robodyn._version import __version__ as __version__
+
 # Public names and the module each comes from. They are imported on first use (PEP 562), so
 # ``import robodyn`` and the command line do not pay for SciPy's signal processing, cvxpy or
 # Dask unless a command needs them. The packages beside the public functions ``simulate``,
@@ -27,7 +29,7 @@ _EXPORTS = {
     "identify": "robodyn.identification",
     "Payload": "robodyn.identification",
     "Recording": "robodyn.measure",
-    "excitation": "robodyn.measure",
+    "excitation": "robodyn.studies.excitation",
     "read_recording": "robodyn.measure",
     "Model": "robodyn.numeric.model",
     "compile_model": "robodyn.numeric.model",
@@ -40,7 +42,7 @@ _EXPORTS = {
     "Robot": "robodyn.robot.model",
     "Trajectory": "robodyn.simulation",
     "simulate": "robodyn.simulation",
-    "sweep": "robodyn.study.sweep",
+    "sweep": "robodyn.studies.sweeps",
     "EquationsOfMotion": "robodyn.symbolic.eom",
     "derive": "robodyn.symbolic.eom",
     "Validation": "robodyn.validation",
@@ -50,12 +52,13 @@ _EXPORTS = {
 if TYPE_CHECKING:  # static analysers see ordinary imports
     from robodyn.calibration import Calibration, calibrate
     from robodyn.identification import Identification, Payload, identify
-    from robodyn.measure import Recording, excitation, read_recording
+    from robodyn.measure import Recording, read_recording
     from robodyn.numeric.model import Model, compile_model
     from robodyn.robot.load import builtin_names, load
     from robodyn.robot.model import Drive, Friction, Joint, Link, Robot
     from robodyn.simulation import Trajectory, simulate
-    from robodyn.study.sweep import sweep
+    from robodyn.studies.excitation import excitation
+    from robodyn.studies.sweeps import sweep
     from robodyn.symbolic.eom import EquationsOfMotion, derive
     from robodyn.validation import Validation, validate
 
@@ -99,4 +102,3 @@ __all__ = [
     "sweep",
     "validate",
 ]
-__version__ = "0.1.0"

@@ -30,11 +30,11 @@ from robodyn.cli_record import add_record_parser
 from robodyn.cli_sweep import add_sweep_parser
 from robodyn.cli_underwater import add_underwater_parser
 from robodyn.cli_workflows import add_parsers
-from robodyn.report.text import err as _err
-from robodyn.report.text import progress as _progress
-from robodyn.report.text import steps as _steps
-from robodyn.report.text import table as _table
 from robodyn.robot.errors import RobodynError
+from robodyn.text import err as _err
+from robodyn.text import progress as _progress
+from robodyn.text import steps as _steps
+from robodyn.text import table as _table
 
 if TYPE_CHECKING:
     import sympy as sp

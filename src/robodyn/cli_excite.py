@@ -1,6 +1,6 @@
 """``robodyn excite`` and ``robodyn testprog``: excitation design and the thesis' test programs.
 
-Thin: parse, call :func:`robodyn.excitation` / :mod:`robodyn.measure.testprog`, write CSV, print.
+Thin: parse, call :func:`robodyn.excitation` / :mod:`robodyn.studies.testprog`, write CSV, print.
 Bad input raises ``ValueError`` (or a description error), which ``robodyn.cli.main`` turns into
 one line and exit code 2.
 """
@@ -15,7 +15,7 @@ import robodyn as rd
 
 
 def _cmd_excite(args: argparse.Namespace) -> int:
-    from robodyn.measure.excitation import excitation_limits
+    from robodyn.studies.excitation import excitation_limits
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -35,7 +35,7 @@ def _cmd_excite(args: argparse.Namespace) -> int:
 
 
 def _cmd_testprog(args: argparse.Namespace) -> int:
-    from robodyn.measure.testprog import iso_cube, jointwise
+    from robodyn.studies.testprog import iso_cube, jointwise
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -19,8 +19,8 @@ import numpy as np
 import robodyn as rd
 from robodyn.cli_workflows import floats
 from robodyn.output_names import check_stem
-from robodyn.report.text import err, progress
 from robodyn.robot.errors import InputError
+from robodyn.text import err, progress
 
 __all__ = ["add_parsers"]
 

@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 
 import robodyn as rd
-from robodyn.report.text import err, table
 from robodyn.robot.errors import InputError
+from robodyn.text import err, table
 
 __all__ = ["add_record_parser"]
 

@@ -28,8 +28,8 @@ _SHIP = {"auto": None, "always": True, "never": False}
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from robodyn.report.html import page
     from robodyn.report.study_report import study_figures, study_section
-    from robodyn.study.study_file import read_study
-    from robodyn.study.sweep import SweepInterrupted, sweep, write_table
+    from robodyn.studies.study_file import read_study
+    from robodyn.studies.sweeps import SweepInterrupted, sweep, write_table
 
     study = read_study(args.study)
     out = Path(args.output)

@@ -1,7 +1,7 @@
 """``robodyn underwater ROBOT -o DIR``: the effect series of an underwater arm (thesis ch. 7).
 
 Kept apart from :mod:`robodyn.cli` (which registers it); it parses, calls
-:func:`robodyn.hydro.study.effect_series` and :func:`robodyn.hydro.study_plots.write_study`, and
+:func:`robodyn.studies.underwater.effect_series` and :func:`robodyn.report.underwater.write_study`, and
 prints the files written. A robot without hydro blocks is a
 :class:`~robodyn.robot.errors.StudyError` (exit 2, one line).
 """
@@ -11,7 +11,12 @@ from __future__ import annotations
 import argparse
 
 import robodyn as rd
-from robodyn.hydro.effects import DEFAULT_CD_VALUES, DEFAULT_CURRENT, DEFAULT_CURRENT_SPEEDS, EFFECTS
+from robodyn.studies.underwater_effects import (
+    DEFAULT_CD_VALUES,
+    DEFAULT_CURRENT,
+    DEFAULT_CURRENT_SPEEDS,
+    EFFECTS,
+)
 
 __all__ = ["add_underwater_parser"]
 
@@ -36,10 +41,10 @@ def _assignment(text: str) -> tuple[str, float]:
 def _cmd_underwater(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from robodyn.hydro.model_error import model_error_study
-    from robodyn.hydro.sensitivity import sensitivity
-    from robodyn.hydro.study import effect_series
-    from robodyn.hydro.study_plots import write_study
+    from robodyn.report.underwater import write_study
+    from robodyn.studies.underwater import effect_series
+    from robodyn.studies.underwater_model_error import model_error_study
+    from robodyn.studies.underwater_sensitivity import sensitivity
 
     robot = rd.load(args.robot)
     params = dict(args.set or [])

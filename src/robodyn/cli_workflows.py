@@ -16,8 +16,8 @@ import numpy as np
 
 import robodyn as rd
 from robodyn.output_names import check_stem, output_path
-from robodyn.report.text import err, progress, table
 from robodyn.robot.errors import InputError
+from robodyn.text import err, progress, table
 
 __all__ = ["add_parsers"]
 
@@ -108,7 +108,7 @@ def _check_size(args: argparse.Namespace, n: int) -> None:
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from robodyn.codegen.build import CompilerNotFoundError
-    from robodyn.simulation.plots import trajectory_figure
+    from robodyn.studies.simulation_plots import trajectory_figure
 
     robot = rd.load(args.robot, tool=args.tool)
     n = robot.dof
@@ -215,8 +215,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
                            deflection=args.deflection, **units)
     validation = None
     if args.validate:
+        from robodyn.calibration.frames import robot_positions
         from robodyn.calibration.result import ErrorStats
-        from robodyn.calibration.simulate_study import robot_positions
 
         held = read_calibration_csv(args.validate, robot, targets=args.targets, joint_map=jmap)
         held_q, held_pts = si(held)

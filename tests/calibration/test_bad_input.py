@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from robodyn.calibration import calibrate, compensate
-from robodyn.calibration.simulate_study import perturbed_robot, robot_positions
+from robodyn.studies.calibration_study import perturbed_robot, robot_positions
 from tests.calibration.helpers import TARGET, TRACKER, poses, robot
 
 

@@ -8,7 +8,7 @@ import pytest
 from robodyn.calibration import calibrate, circle_point, robot_geometry, validate
 from robodyn.calibration.circle_point import fit_circle, fit_line, joint_axis
 from robodyn.calibration.kinematics import rot, trans
-from robodyn.calibration.simulate_study import HOME, circle_sets, perturbed_robot, robot_positions
+from robodyn.studies.calibration_study import HOME, circle_sets, perturbed_robot, robot_positions
 from tests.calibration.helpers import TARGET, TRACKER, poses, robot
 
 

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from robodyn.calibration.io import read_calibration_csv, read_joint_map
-from robodyn.calibration.simulate_study import perturbed_robot
 from robodyn.cli import main
 from robodyn.robot.errors import DataFileError
+from robodyn.studies.calibration_study import perturbed_robot
 from tests.calibration.helpers import TRACKER, poses, robot
 from tests.calibration.test_nongeometric import TARGETS, measured
 
@@ -114,7 +114,7 @@ def test_circle_files_with_multi_turn_joints_as_given_or_wrapped(tmp_path, capsy
     """``--circle`` in degrees: q4 sweeps 400 deg in 16 readings, q6 680 deg in 4 (steps of 227
     deg); the same poses with the readings wrapped to (-180, 180] by the controller give the
     identical calibration, at the noise level."""
-    from robodyn.calibration.simulate_study import HOME, robot_positions
+    from robodyn.studies.calibration_study import HOME, robot_positions
 
     r = robot("puma560")
     true = perturbed_robot(r, 6, base=TRACKER, target=(0.031, -0.018, 0.076))
@@ -157,7 +157,7 @@ def test_cli_warns_when_sigma_is_off_by_more_than_3x(data, tmp_path, capsys):
 
 
 def test_circle_file_whose_readings_do_not_follow_the_arc_says_what_to_do(tmp_path, capsys):
-    from robodyn.calibration.simulate_study import HOME, robot_positions
+    from robodyn.studies.calibration_study import HOME, robot_positions
 
     r = robot("puma560")
     true = perturbed_robot(r, 6, base=TRACKER, target=(0.031, -0.018, 0.076))
@@ -200,7 +200,7 @@ def test_nongeometric_terms_cross_validated_and_the_description_alone_stated(dat
     # the written description alone, evaluated here independently (loaded from the file, placed
     # by its own base and tool), against the figure its header and the report state
     import robodyn as rd
-    from robodyn.calibration.simulate_study import robot_positions
+    from robodyn.studies.calibration_study import robot_positions
 
     alone_robot = rd.load(str(tmp_path / "puma560_calibrated.yaml"))
     held = read_calibration_csv(data / "si_test.csv", alone_robot, targets=2)

@@ -18,7 +18,7 @@ from robodyn.calibration.deflection import exact_deflection
 from robodyn.calibration.kinematics import trans
 from robodyn.calibration.models import extend_model
 from robodyn.calibration.nongeometric import build_nongeometric, gravity_torque, nominal_frames
-from robodyn.calibration.simulate_study import perturbed_robot
+from robodyn.studies.calibration_study import perturbed_robot
 from tests.calibration.helpers import TARGET, TRACKER, poses, robot
 from tests.calibration.test_nongeometric import TARGETS, measured
 

@@ -14,8 +14,8 @@ import pytest
 
 from robodyn.calibration import calibrate
 from robodyn.calibration.pipeline import validate, validate_orientation
-from robodyn.calibration.simulate_study import perturbed_robot, robot_frames
 from robodyn.cli import main
+from robodyn.studies.calibration_study import perturbed_robot, robot_frames
 from tests.calibration.helpers import TRACKER, poses, robot
 from tests.calibration.test_nongeometric import TARGETS, measured
 

@@ -12,7 +12,7 @@ import pytest
 import robodyn as rd
 from robodyn.calibration import calibrate
 from robodyn.calibration.io import read_calibration_csv, write_calibration, write_calibration_csv
-from robodyn.calibration.simulate_study import perturbed_robot, robot_positions
+from robodyn.studies.calibration_study import perturbed_robot, robot_positions
 from tests.calibration.helpers import TARGET, TRACKER, poses, robot, symbolic_fk
 
 

@@ -12,8 +12,8 @@ import sympy as sp
 
 import robodyn as rd
 from robodyn.calibration import calibrate, validate
-from robodyn.calibration.simulate_study import perturbed_robot, robot_frames, robot_positions
 from robodyn.calibration.solve import fit
+from robodyn.studies.calibration_study import perturbed_robot, robot_frames, robot_positions
 from tests.calibration.helpers import TARGET, TRACKER, poses, robot, symbolic_fk
 
 SIGMA = 5e-5  # m per coordinate: a laser tracker

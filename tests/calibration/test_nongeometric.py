@@ -15,7 +15,7 @@ import pytest
 
 import robodyn as rd
 from robodyn.calibration import calibrate, validate
-from robodyn.calibration.simulate_study import perturbed_robot, robot_frames
+from robodyn.studies.calibration_study import perturbed_robot, robot_frames
 from tests.calibration.helpers import TRACKER, poses, robot
 
 #: Target offsets on the flange (three reflectors), m.

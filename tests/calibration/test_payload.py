@@ -13,7 +13,7 @@ import pytest
 
 import robodyn as rd
 from robodyn.calibration import calibrate, validate
-from robodyn.calibration.simulate_study import perturbed_robot, robot_frames
+from robodyn.studies.calibration_study import perturbed_robot, robot_frames
 from tests.calibration.helpers import TRACKER, poses, robot
 from tests.calibration.test_nongeometric import TARGETS, measured, true_terms
 
@@ -142,7 +142,7 @@ def test_compliance_compiles_nothing():
     code = ("import warnings, numpy as np, robodyn as rd\nwarnings.simplefilter('ignore')\n"
             "from robodyn.calibration import calibrate, random_configurations\n"
             "r = rd.load('puma560'); q = random_configurations(r, 40, 1)\n"
-            "from robodyn.calibration.simulate_study import robot_positions\n"
+            "from robodyn.studies.calibration_study import robot_positions\n"
             "calibrate(r, q, robot_positions(r, q), 'hayati', nongeometric=('compliance',))\n"
             "import sys, json; print(json.dumps(sorted(m for m in ('cffi', 'robodyn.numeric.model',"
             " 'robodyn.codegen.build') if m in sys.modules)))")

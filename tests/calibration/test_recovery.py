@@ -10,7 +10,7 @@ import pytest
 import robodyn as rd
 from robodyn.calibration import MODELS, calibrate, validate
 from robodyn.calibration.models import model_frames
-from robodyn.calibration.simulate_study import perturbed_robot, robot_positions
+from robodyn.studies.calibration_study import perturbed_robot, robot_positions
 from tests.calibration.helpers import TARGET, TRACKER, in_model_truth, poses, robot, symbolic_fk
 
 PARAM_TOL = 1e-8  # m, rad

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from robodyn.calibration.simulate_study import puma_study
+from robodyn.studies.calibration_study import puma_study
 
 
 @pytest.fixture(scope="module")

@@ -18,8 +18,8 @@ import pytest
 
 import robodyn as rd
 from robodyn.calibration import calibrate, random_configurations, validate
-from robodyn.calibration.simulate_study import perturbed_robot, robot_positions
 from robodyn.cli import main
+from robodyn.studies.calibration_study import perturbed_robot, robot_positions
 from tests.calibration.helpers import TRACKER
 
 UR5 = Path(__file__).resolve().parents[1] / "robot" / "fixtures" / "ur5_ros_industrial.urdf"

@@ -58,7 +58,7 @@ def test_bad_blocks_are_named(text: str, pattern: str) -> None:
 
 
 def test_hydro_without_fluid_block_is_still_fresh_water() -> None:
-    from robodyn.hydro.schema import fluid_of
+    from robodyn.robot.hydro import fluid_of
 
     robot = load_yaml_text(doc("{cylinders: [" + CYL + "]}", None), source="w.yaml")
     fluid = fluid_of(robot)

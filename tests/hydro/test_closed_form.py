@@ -7,8 +7,8 @@ import pytest
 import sympy as sp
 
 import robodyn as rd
-from robodyn.hydro.quadrature import gauss_legendre
 from robodyn.robot.yaml_loader import load_yaml_text
+from robodyn.symbolic.hydro.quadrature import gauss_legendre
 
 # one uniform solid cylinder pivoted at one end, hanging along -y at q = 0 (angle from the
 # vertical), turning about z; gravity along -y

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from robodyn.hydro.model_error import model_error_study, model_without
-from robodyn.hydro.schema import fluid_of, hydro_of
-from robodyn.hydro.sensitivity import sensitivity, with_drag_coefficient
-from robodyn.hydro.study import effect_variant
 from robodyn.robot.errors import StudyError
+from robodyn.robot.hydro import fluid_of, hydro_of
 from robodyn.robot.yaml_loader import load_yaml_text
 from robodyn.simulation.trajectory import quintic
+from robodyn.studies.underwater import effect_variant
+from robodyn.studies.underwater_model_error import model_error_study, model_without
+from robodyn.studies.underwater_sensitivity import sensitivity, with_drag_coefficient
 from tests.hydro.test_closed_form import PENDULUM
 
 

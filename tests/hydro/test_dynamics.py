@@ -8,7 +8,7 @@ import sympy as sp
 
 import robodyn as rd
 from robodyn import spatial as S
-from robodyn.hydro.schema import fluid_of, hydro_of
+from robodyn.robot.hydro import fluid_of, hydro_of
 from robodyn.robot.yaml_loader import load_yaml_text
 from robodyn.symbolic.kinematics import forward_kinematics
 from tests.hydro.test_closed_form import PENDULUM

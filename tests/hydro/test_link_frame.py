@@ -9,10 +9,10 @@ import sympy as sp
 
 import robodyn as rd
 from robodyn import spatial as S
-from robodyn.hydro.geometry import link_frame_jacobian
-from robodyn.hydro.quadrature import gauss_legendre
-from robodyn.hydro.terms import hydro_terms
 from robodyn.robot.yaml_loader import load_yaml_text
+from robodyn.symbolic.hydro.geometry import link_frame_jacobian
+from robodyn.symbolic.hydro.quadrature import gauss_legendre
+from robodyn.symbolic.hydro.terms import hydro_terms
 from robodyn.symbolic.kinematics import forward_kinematics, point_jacobian
 
 # three revolute joints: z, then a 90-degree twisted axis, then an origin with rpy and an

@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from robodyn.hydro.lift_reach import lift_reaches_joints
-from robodyn.hydro.study import (
+from robodyn.report.underwater import study_section, write_study
+from robodyn.robot.errors import StudyError
+from robodyn.robot.yaml_loader import load_yaml_text
+from robodyn.studies.underwater import (
     EFFECTS,
     LIFT_DROPPED,
     LIFT_IN_CURRENT,
@@ -17,9 +19,7 @@ from robodyn.hydro.study import (
     effect_series,
     effect_variant,
 )
-from robodyn.hydro.study_plots import study_section, write_study
-from robodyn.robot.errors import StudyError
-from robodyn.robot.yaml_loader import load_yaml_text
+from robodyn.symbolic.hydro.lift_reach import lift_reaches_joints
 from tests.hydro.test_link_frame import SPATIAL
 
 RHO, CA, CD = 1000.0, 1.0, 1.2

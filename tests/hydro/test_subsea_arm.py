@@ -17,7 +17,7 @@ import sympy as sp
 
 import robodyn as rd
 from robodyn.cli import main
-from robodyn.hydro.schema import fluid_of, hydro_of
+from robodyn.robot.hydro import fluid_of, hydro_of
 
 NAME = "reach_alpha5"
 RHO, G, R = 1025.0, 9.81, 0.020

@@ -9,7 +9,7 @@ import sympy as sp
 
 import robodyn as rd
 from robodyn.cli import main
-from robodyn.hydro.textbook import underwater_textbook
+from robodyn.symbolic.hydro.textbook import underwater_textbook
 from robodyn.symbolic.render import render_latex, render_text
 
 # every effect on: a current along x and some lift (zero torque in the plane, see below)

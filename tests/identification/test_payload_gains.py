@@ -17,9 +17,9 @@ import robodyn as rd
 from robodyn.identification.payload import payload_standard
 from robodyn.identification.pipeline import nominal_standard
 from robodyn.identification.to_robot import robot_with_parameters
-from robodyn.measure.virtual_lab import Sensors, virtual_lab
 from robodyn.robot.errors import IdentificationError
 from robodyn.simulation.trajectory import via_points
+from robodyn.studies.virtual_lab import Sensors, virtual_lab
 from robodyn.symbolic.regressor import PER_JOINT
 from tests.identification.helpers import load_quiet
 

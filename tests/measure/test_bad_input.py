@@ -159,7 +159,7 @@ def test_huge_spec_refused_before_parsing(tmp_path):
 
 def test_study_file_alias_refused(tmp_path):
     from robodyn.robot.errors import StudyError
-    from robodyn.study.study_file import read_study
+    from robodyn.studies.study_file import read_study
 
     path = tmp_path / "study.yaml"
     path.write_text(BOMB)

@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from robodyn.measure.excitation import (
+from robodyn.studies.excitation import (
     ExcitationLimits,
     FourierTrajectory,
     base_columns,

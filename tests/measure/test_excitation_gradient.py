@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from robodyn.measure.excitation import (
+from robodyn.studies.excitation import (
     _STEP_COLUMNS,
     _Layout,
     _null_bases,

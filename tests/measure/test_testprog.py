@@ -6,8 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from robodyn.measure.testprog import iso_cube, jointwise
 from robodyn.simulation import UnreachableError
+from robodyn.studies.testprog import iso_cube, jointwise
 
 
 @pytest.fixture(scope="module")

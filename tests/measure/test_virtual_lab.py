@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from robodyn.measure.testprog import jointwise
-from robodyn.measure.virtual_lab import Sensors, virtual_lab
+from robodyn.studies.testprog import jointwise
+from robodyn.studies.virtual_lab import Sensors, virtual_lab
 
 IDEAL = Sensors(jitter=0.0, counts_per_rev=0.0, current_noise=0.0, current_offset=0.0,
                 torque_constant_error=0.0, torque_noise=0.0, tracker_noise=0.0, tracker_latency=0.005)
@@ -103,7 +103,7 @@ def test_bad_input(puma, program):
 def test_synchronisation_recovers_the_lab_tracker_latency(puma):
     """The tracker stream of the virtual lab lags by a latency the sync step must find (1 sample)."""
     from robodyn.measure.sync import synchronise
-    from robodyn.measure.testprog import jointwise as program_of
+    from robodyn.studies.testprog import jointwise as program_of
 
     prog = program_of(puma, joints=["q1", "q2"], speeds=(1.0,), dwell=0.1)
     latency = 0.0137

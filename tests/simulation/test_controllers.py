@@ -15,7 +15,7 @@ from robodyn.simulation import (
     quintic,
     simulate,
 )
-from robodyn.simulation.balance import balance_double_pendulum
+from robodyn.studies.balance import balance_double_pendulum
 
 Q_REF = np.array([0.5, 0.3])
 Q_START = np.array([-1.0, 0.5])

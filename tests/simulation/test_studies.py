@@ -6,7 +6,7 @@ import numpy as np
 from PIL import Image
 
 import robodyn as rd
-from robodyn.simulation.aa300_study import run_study, with_payload
+from robodyn.studies.aa300 import run_study, with_payload
 
 
 def test_payload_is_merged_into_the_last_link(aa300):

@@ -306,9 +306,9 @@ def _compiled_gravity(robot: Robot, extra: Callable[[np.ndarray], np.ndarray] | 
 
     def model():
         if "m" not in state:
-            import robodyn as rd
+            from robodyn.numeric.model import compile_model  # on first use only
 
-            state["m"] = rd.compile_model(robot)
+            state["m"] = compile_model(robot)
         return state["m"]
 
     def torque(x: np.ndarray) -> np.ndarray:

@@ -138,7 +138,7 @@ def _si_angles(robot: Robot, q: np.ndarray, options: dict[str, Any]) -> np.ndarr
 def description_alone(cal: Any, q: np.ndarray, points: np.ndarray) -> tuple[float, float]:
     """RMS position error (m) on poses ``q`` (N, n, rad) against ``points`` (N, 3) or (N, K, 3)
     (m, first target) of the written description alone and of ``cal.predict`` (with its terms)."""
-    from robodyn.calibration.simulate_study import robot_positions
+    from robodyn.calibration.frames import robot_positions
 
     first = points if points.ndim == 2 else points[:, 0]
     alone = robot_positions(cal.robot, q)

@@ -12,7 +12,6 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from robodyn import __name__ as _package
 from robodyn.codegen.kernels import Argument, Kernel, KernelSet
 
 
@@ -44,7 +43,7 @@ def provenance(kset: KernelSet, language: str, layout: str = ROW_MAJOR) -> list[
     from importlib.metadata import PackageNotFoundError, version
 
     try:
-        ver = version(_package)
+        ver = version("robodyn")
     except PackageNotFoundError:  # running from a source tree
         ver = "unknown"
     params = ", ".join(f"{k}={v!r}" for k, v in kset.parameters) or "none"

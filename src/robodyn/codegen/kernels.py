@@ -10,7 +10,7 @@ Kernels (``n`` joints, all arrays row-major)::
 
 Under water (a robot with hydro blocks) ``M`` includes the added mass, ``C qd`` its Christoffel
 terms, ``g`` the buoyancy, and the inverse and forward dynamics also drag, skin friction and lift
-(see :mod:`robodyn.hydro`); ``|u|`` is printed as ``sqrt(u . u)``, without branches.
+(see :mod:`robodyn.symbolic.hydro`); ``|u|`` is printed as ``sqrt(u . u)``, without branches.
     mass_matrix(q)               -> M (n, n)      composite-rigid-body algorithm + G^2 J_m
     gravity(q)                   -> g (n)
     coriolis(q, qd)              -> c (n)         C(q, qd) qd
@@ -43,11 +43,11 @@ from dataclasses import dataclass, fields
 import sympy as sp
 
 from robodyn.codegen import optimize as opt
-from robodyn.hydro.terms import HydroTerms, hydro_terms
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 from robodyn.symbolic import crba, forward_mode
 from robodyn.symbolic import newton_euler as ne
+from robodyn.symbolic.hydro.terms import HydroTerms, hydro_terms
 from robodyn.symbolic.kinematics import end_effector_jacobian, forward_kinematics, joint_symbols
 from robodyn.symbolic.program import Recorder
 from robodyn.symbolic.regressor import friction_columns, reflected_rotor_inertia, regressor

@@ -4,7 +4,8 @@ Public entry point: :func:`identify` (``rd.identify``), returning an :class:`Ide
 """
 
 from robodyn.identification.base import BaseRelations, base_relations
-from robodyn.identification.friction import FrictionFit, fit_friction, friction_table
+from robodyn.identification.friction import FrictionFit, fit_friction
+from robodyn.identification.friction_table import friction_table
 from robodyn.identification.jointwise import JointIdentification, identify_joint
 from robodyn.identification.payload import Payload
 from robodyn.identification.pipeline import identify

@@ -34,7 +34,7 @@ from robodyn.identification.preprocess import Samples, preprocess, regressor_row
 from robodyn.robot.errors import IdentificationError
 from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
 
-__all__ = ["FRICTION_MODELS", "NONLINEAR", "V_EPS", "FrictionFit", "fit_friction", "friction_table"]
+__all__ = ["FRICTION_MODELS", "NONLINEAR", "V_EPS", "FrictionFit", "fit_friction"]
 
 V_EPS = 0.01
 NONLINEAR = ("stribeck", "load", "polynomial")
@@ -158,50 +158,3 @@ def fit_friction(ident: Any, recordings: Any, model: str = "stribeck") -> Any:
         y_full.append(regressor_rows(ident._model, s, ident.preprocess))
         samples.append(Samples(s.t[::d], s.q[::d], s.qd[::d], s.qdd[::d], s.y[::d], s.source))
     return replace(ident, friction_fit=fit_friction_samples(ident, samples, y_full, model))
-
-
-def friction_table(robot: Any, train: Any, test: Sequence[Any], models: Sequence[str] = FRICTION_MODELS,
-                   **options: Any) -> Any:
-    """Held-out error of each friction model.
-
-    Each model is identified on ``train`` (``rd.identify(robot, train, friction=model,
-    **options)``) and predicts every recording of ``test``.
-
-    Parameters
-    ----------
-    robot : Robot
-    train : Recording or sequence of Recording
-    test : sequence of Recording
-    models : sequence of str
-        Among ``FRICTION_MODELS``.
-    **options
-        Passed to :func:`robodyn.identification` (target, method, cutoff, ...).
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per model: ``relative_error`` (``||e|| / ||y||`` against the raw target over all
-        test samples and joints), ``relative_error_filtered`` (against the target low-passed with
-        the reference filter of :mod:`robodyn.validation.heldout`), ``noise_floor``
-        (``||y - y_f|| / ||y||``) and
-        ``relative_error_<joint>`` per joint (raw).
-    """
-    import pandas as pd
-
-    from robodyn.identification.pipeline import identify
-    from robodyn.validation.heldout import held_out_error
-
-    rows = []
-    for model in models:
-        ident = identify(robot, train, friction=model, **options)
-        preds = [ident.predict(r) for r in test]
-        ys = [np.asarray(getattr(r, ident.target), float) for r in test]
-        fig = held_out_error([np.asarray(r.t, float) for r in test], ys, preds, robot.joint_names)
-        pred, y = np.vstack(preds), np.vstack(ys)
-        row = {"model": model, "relative_error": fig.raw, "relative_error_filtered": fig.filtered,
-               "noise_floor": fig.noise_floor}
-        for j, name in enumerate(robot.joint_names):
-            row[f"relative_error_{name}"] = float(np.linalg.norm(pred[:, j] - y[:, j])
-                                                  / np.linalg.norm(y[:, j]))
-        rows.append(row)
-    return pd.DataFrame(rows)

@@ -4,8 +4,7 @@
 recording spec, or a ROS 2 bag (MCAP) of ``sensor_msgs/JointState`` messages.
 """
 
-from robodyn.measure.excitation import excitation
 from robodyn.measure.read import read_recording
 from robodyn.measure.recording import Recording
 
-__all__ = ["Recording", "excitation", "read_recording"]
+__all__ = ["Recording", "read_recording"]

@@ -84,7 +84,7 @@ class Model:
         :class:`~robodyn.robot.errors.SingularMassMatrixError` with this reason.
     sources : tuple of Path
         The cache files the model was generated into (``rd_model_<key>.c`` and ``.cdef``, or
-        ``.py``; and ``.singular`` when it exists): what :mod:`robodyn.study.shipping` sends to
+        ``.py``; and ``.singular`` when it exists): what :mod:`robodyn.studies.shipping` sends to
         workers with the compiled library so that they need neither the derivation nor a compiler.
     """
 
@@ -792,11 +792,11 @@ def _generator_hash() -> str:
     generates under the hash of the edited files.
     """
     import robodyn.codegen as codegen_pkg
-    import robodyn.hydro as hydro_pkg
     import robodyn.symbolic as symbolic_pkg
+    import robodyn.symbolic.hydro as hydro_pkg
 
     digest = hashlib.sha256()
-    # the hydrodynamic terms (robodyn.hydro) are part of every underwater model's kernels
+    # the hydrodynamic terms (robodyn.symbolic.hydro) are part of every underwater model's kernels
     for pkg in (codegen_pkg, hydro_pkg, symbolic_pkg):
         for path in sorted(Path(pkg.__file__).parent.glob("*.py")):
             digest.update(path.read_bytes())

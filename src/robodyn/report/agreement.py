@@ -8,9 +8,9 @@ from dataclasses import dataclass
 import numpy as np
 import sympy as sp
 
-import robodyn as rd
-from robodyn.report.text import progress as _progress
-from robodyn.symbolic.eom import METHODS
+from robodyn.robot.model import Robot
+from robodyn.symbolic.eom import METHODS, EquationsOfMotion, derive
+from robodyn.text import progress as _progress
 
 #: Relative difference above which two formulations are reported as disagreeing.
 TOLERANCE = 1e-9
@@ -53,7 +53,7 @@ class Agreement:
                 and not vacuous and not self.singular)
 
 
-def _evaluator(eom: rd.EquationsOfMotion) -> Callable[..., dict[str, np.ndarray]]:
+def _evaluator(eom: EquationsOfMotion) -> Callable[..., dict[str, np.ndarray]]:
     """``f(q, qd, qdd) -> {"M": (n, n), "g": (n,), "tau": (n,)}`` at the default parameters.
 
     Each formulation is evaluated on its own straight-line form
@@ -83,7 +83,7 @@ def _singular(matrices: Sequence[np.ndarray]) -> bool:
     return False
 
 
-def _symbolically_equal(a: rd.EquationsOfMotion, b: rd.EquationsOfMotion) -> bool:
+def _symbolically_equal(a: EquationsOfMotion, b: EquationsOfMotion) -> bool:
     for name in _QUANTITIES:
         diff = sp.Matrix(getattr(a, name)) - sp.Matrix(getattr(b, name))
         if any(sp.simplify(sp.expand(e)) != 0 for e in diff):
@@ -91,7 +91,7 @@ def _symbolically_equal(a: rd.EquationsOfMotion, b: rd.EquationsOfMotion) -> boo
     return True
 
 
-def agreement(eoms: Sequence[rd.EquationsOfMotion], samples: int = 20, seed: int = 0,
+def agreement(eoms: Sequence[EquationsOfMotion], samples: int = 20, seed: int = 0,
               symbolic: bool = False) -> list[Agreement]:
     """Compare every pair of formulations on random states (and symbolically if asked).
 
@@ -154,11 +154,11 @@ def verdict(results: Sequence[Agreement]) -> str:
     return "the formulations DISAGREE"
 
 
-def derive_all(robot: rd.Robot) -> list[rd.EquationsOfMotion]:
+def derive_all(robot: Robot) -> list[EquationsOfMotion]:
     eoms = []
     for method in METHODS:
         with _progress(f"deriving {method}"):
-            eoms.append(rd.derive(robot, method))
+            eoms.append(derive(robot, method))
     for eom in eoms:
         with _progress(f"counting operations of {eom.method} (after CSE)"):
             eom.op_counts()
@@ -169,7 +169,7 @@ COUNT_HEADERS = ("method", "derive [s]", "tau +", "tau *", "tau fn", "M +", "M *
                   "g +", "g *", "g fn")
 
 
-def count_rows(eoms: Sequence[rd.EquationsOfMotion]) -> list[list[object]]:
+def count_rows(eoms: Sequence[EquationsOfMotion]) -> list[list[object]]:
     rows = []
     for eom in eoms:
         counts = eom.op_counts()

@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from robodyn.calibration.result import Calibration, ErrorStats
-from robodyn.calibration.simulate_study import StudyResult
 from robodyn.report.html import figure, html_table, page
+from robodyn.studies.calibration_study import StudyResult
 
 __all__ = ["calibration_figure", "calibration_html", "study_section"]
 

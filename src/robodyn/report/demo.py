@@ -18,7 +18,7 @@ from pathlib import Path
 import sympy as sp
 from markupsafe import Markup
 
-import robodyn as rd
+from robodyn._version import __version__
 from robodyn.report.agreement import (
     AGREEMENT_HEADERS,
     COUNT_HEADERS,
@@ -32,8 +32,11 @@ from robodyn.report.agreement import (
 )
 from robodyn.report.html import html_table, render
 from robodyn.report.simulation_sections import simulation_sections
-from robodyn.report.text import progress, steps, table
+from robodyn.robot.load import load
+from robodyn.robot.model import Robot
+from robodyn.symbolic.eom import EquationsOfMotion, derive
 from robodyn.symbolic.render import render_json, render_latex, render_mathml, render_text
+from robodyn.text import progress, steps, table
 
 #: The thesis the demo re-creates, cited in the report.
 CITATION = ("The thesis: a PhD thesis on robotic manipulator modelling (dynamic formulations, "
@@ -59,7 +62,7 @@ class DemoContext:
     """
 
     out: Path
-    robot: rd.Robot
+    robot: Robot
     backend: str
 
 
@@ -76,7 +79,7 @@ class DemoSection:
         (escape anything that comes from data), its figures embedded with
         :func:`robodyn.report.html.figure`.
     steps : int
-        Number of :func:`robodyn.report.text.progress` steps it runs (for the progress bar).
+        Number of :func:`robodyn.text.progress` steps it runs (for the progress bar).
     """
 
     name: str
@@ -90,8 +93,8 @@ def _simulation(ctx: DemoContext) -> tuple[str, bool]:
 
 def _calibration(ctx: DemoContext) -> tuple[str, bool]:
     """Run the PUMA 560 calibration study into ``out/calibration``; (HTML section, all ok)."""
-    from robodyn.calibration.simulate_study import puma_study
     from robodyn.report.calibration_report import study_section
+    from robodyn.studies.calibration_study import puma_study
 
     with progress("PUMA 560 calibration study (DH, Hayati, S-model, POE; 2 tracker noises)"):
         study = puma_study(ctx.out / "calibration")
@@ -113,12 +116,12 @@ def _underwater(ctx: DemoContext) -> tuple[str, bool]:
     """The thesis's chapter-7 effect series on the built-in two-link underwater arm."""
     import numpy as np
 
-    from robodyn.hydro.model_error import model_error_study
-    from robodyn.hydro.sensitivity import sensitivity
-    from robodyn.hydro.study import effect_series
-    from robodyn.hydro.study_plots import write_study
+    from robodyn.report.underwater import write_study
+    from robodyn.studies.underwater import effect_series
+    from robodyn.studies.underwater_model_error import model_error_study
+    from robodyn.studies.underwater_sensitivity import sensitivity
 
-    robot = rd.load("underwater_2r")
+    robot = load("underwater_2r")
     with progress("underwater effect series (underwater_2r: dry, buoyancy, added mass, drag, ...)"):
         series = effect_series(robot, move_time=1.0, hold_time=0.5,
                                free_time=1.5, dt=2e-3, backend=ctx.backend)
@@ -145,7 +148,7 @@ def _sweep(ctx: DemoContext) -> tuple[str, bool]:
     """A small AA300 actuator-sizing sweep (3 payloads x 3 bandwidths) on a local Dask cluster."""
     import numpy as np
 
-    from robodyn.study.demo import aa300_sweep_demo
+    from robodyn.report.sweep_demo import aa300_sweep_demo
 
     with progress("AA300 actuator-sizing sweep on a local Dask cluster (9 cases)"):
         table, fragment = aa300_sweep_demo(ctx.out / "aa300_sweep", workers=2, progress=False)
@@ -171,7 +174,7 @@ def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
     """Write the demo files into ``output``; returns 0 when every check passed, else 1."""
     out = Path(output)
     out.mkdir(parents=True, exist_ok=True)
-    robot = rd.load("puma560")
+    robot = load("puma560")
     ctx = DemoContext(out, robot, demo_backend())
     with steps(_OWN_STEPS + sum(s.steps for s in SECTIONS), "demo"):
         eoms = derive_all(robot)
@@ -185,7 +188,7 @@ def run_demo(output: str | Path, samples: int = 20, seed: int = 0) -> int:
         with progress("writing puma560_equations.tex"):
             (out / "puma560_equations.tex").write_text(render_latex(by_method["newton_euler"]))
         with progress("deriving trolley_pendulum (kane) and checking eqs. 2.46-2.47"):
-            teom = rd.derive(rd.load("trolley_pendulum"), "kane")
+            teom = derive(load("trolley_pendulum"), "kane")
             closed = _trolley_closed_form_ok(teom)
             (out / "trolley_pendulum.tex").write_text(render_latex(teom))
         counts = count_rows(eoms)
@@ -220,7 +223,7 @@ def demo_backend() -> str:
     return "c"
 
 
-def _trolley_closed_form_ok(eom: rd.EquationsOfMotion) -> bool:
+def _trolley_closed_form_ok(eom: EquationsOfMotion) -> bool:
     """tau of the trolley pendulum equals the thesis' eqs. 2.46-2.47 (solved for F and tau)."""
     big_m, m, length, g = (sp.Symbol(k, real=True) for k in ("M", "m", "l", "g"))
     q2 = eom.q[1]
@@ -248,14 +251,14 @@ def _csv(counts: list[list[object]]) -> str:
     return text.getvalue()
 
 
-def _markdown(robot: rd.Robot, counts: list[list[object]], results: Sequence[Agreement],
+def _markdown(robot: Robot, counts: list[list[object]], results: Sequence[Agreement],
               samples: int) -> str:
     def mdtable(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> list[str]:
         out = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
         return out + ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
 
     lines = [f"# Efficiency of the formulations: {robot.name}", "",
-             f"robodyn {rd.__version__}; description sha256 `{robot.description_hash}`.", "",
+             f"robodyn {__version__}; description sha256 `{robot.description_hash}`.", "",
              f"Derivation time (s) and {_CSV_NOTE}.", ""]
     lines += mdtable(COUNT_HEADERS, counts)
     lines += ["", f"## Agreement (max relative difference over {samples} random states, "
@@ -264,13 +267,13 @@ def _markdown(robot: rd.Robot, counts: list[list[object]], results: Sequence[Agr
     return "\n".join(lines) + "\n"
 
 
-def _page_context(robot: rd.Robot, counts: list[list[object]], results: Sequence[Agreement],
-                  samples: int, trolley: rd.EquationsOfMotion, closed_ok: bool) -> dict[str, object]:
+def _page_context(robot: Robot, counts: list[list[object]], results: Sequence[Agreement],
+                  samples: int, trolley: EquationsOfMotion, closed_ok: bool) -> dict[str, object]:
     """The values of ``demo.html.j2`` before its sections (strings are escaped by the template)."""
     return {
         "title": f"robodyn report: {robot.name}",
         "robot": robot,
-        "version": rd.__version__,
+        "version": __version__,
         "stamp": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
         "count_note": _CSV_NOTE,
         "count_table": Markup(html_table(COUNT_HEADERS, counts)),

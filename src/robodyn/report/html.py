@@ -19,8 +19,8 @@ from pathlib import Path
 import jinja2
 from markupsafe import Markup
 
-from robodyn.report.text import is_number
 from robodyn.robot.errors import InputError
+from robodyn.text import is_number
 
 __all__ = ["CSS", "data_uri", "figure", "html_table", "page", "render"]
 

@@ -217,8 +217,10 @@ def kinova_section(out: Path, data_dir: Path | None = None, method: str = "wls",
     (str, bool)
         The HTML section, and whether it ran (True also when the data are absent: it says so).
     """
-    import robodyn as rd
-    from robodyn.report.text import progress
+    from robodyn.identification.pipeline import identify
+    from robodyn.numeric.model import compile_model
+    from robodyn.robot.load import load
+    from robodyn.text import progress
 
     data_dir = Path(data_dir) if data_dir is not None else _default_data_dir()
     head = "<h2>Validation against measurements: Kinova Gen3 (chapter 5)</h2>"
@@ -229,15 +231,15 @@ def kinova_section(out: Path, data_dir: Path | None = None, method: str = "wls",
                 f"<code>{html.escape(str(data_dir))}</code>; this section is skipped.</p>", True)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the URDF's plausibility notes are shown by 'robodyn show'
-        robot = rd.load("kinova_gen3")
-        model = rd.compile_model(robot)
+        robot = load("kinova_gen3")
+        model = compile_model(robot)
         train, test = _split_runs(runs, robot)
         with progress(f"Kinova Gen3: identify ({method}, current) on the first 70 % of "
                       f"{len(runs)} whole-arm runs"):
-            ident = rd.identify(robot, train, target="current", method=method)
+            ident = identify(robot, train, target="current", method=method)
         friction_html = ""
         if friction_models:
-            from robodyn.identification.friction import friction_table
+            from robodyn.identification.friction_table import friction_table
 
             with progress(f"Kinova Gen3: held-out error of {len(friction_models)} friction models"):
                 ft = friction_table(robot, train, test, models=friction_models, target="current",
@@ -256,7 +258,7 @@ def kinova_section(out: Path, data_dir: Path | None = None, method: str = "wls",
                 _verdict(raw, filt)],
                ["manufacturer URDF", f"{raw_u:.3f}", f"{filt_u:.3f}", f"{noise:.3f}",
                 _verdict(raw_u, filt_u)]]
-    scale = _gravity_scale(rd.compile_model(ident.robot), model, np.vstack([r.q for r in test]))
+    scale = _gravity_scale(compile_model(ident.robot), model, np.vstack([r.q for r in test]))
     joint_rows = [_joint_row(j, robot, ident, held_id, held_urdf, jw_id.get(j), jw_urdf.get(j),
                              scale[j]) for j in range(robot.dof)]
     line = (f"Kinova Gen3 held-out relative current error: identified ({method}) {raw:.4f} "
@@ -298,11 +300,11 @@ needs (least-squares scale of g(q)/k over the held-out states; the data README e
 
 def _split_runs(runs: Sequence[Path], robot: Any) -> tuple[list[Any], list[Any]]:
     """Each whole-arm run read and cut at 70 % of its duration: (first parts, last parts)."""
-    import robodyn as rd
+    from robodyn.measure.read import read_recording
 
     train, test = [], []
     for path in runs:
-        rec = rd.read_recording(path, spec="kinova_gen3", robot=robot)
+        rec = read_recording(path, spec="kinova_gen3", robot=robot)
         cut = rec.t[0] + 0.7 * (rec.t[-1] - rec.t[0])
         train.append(rec.slice(rec.t[0], cut))
         test.append(rec.slice(cut, rec.t[-1]))
@@ -318,8 +320,9 @@ def _validations(out: Path, robot: Any, model: Any, ident: Any, test: Sequence[A
     Returns (held-out identified, held-out URDF, jointwise identified by joint index, jointwise
     URDF by joint index, HTML parts with the identified model's figures).
     """
-    import robodyn as rd
-    from robodyn.report.text import progress
+    from robodyn.measure.read import read_recording
+    from robodyn.text import progress
+    from robodyn.validation.validation import validate
 
     gains = KINOVA_CONTROLLER_GAINS
     held_id, held_urdf, parts = [], [], []
@@ -327,17 +330,17 @@ def _validations(out: Path, robot: Any, model: Any, ident: Any, test: Sequence[A
     jw_urdf: dict[int, Validation] = {}
     with progress("Kinova Gen3: validating on the held-out 30 % and the jointwise runs"):
         for rec in test:
-            v_id = rd.validate(ident.robot, rec, "current", ident=ident)
+            v_id = validate(ident.robot, rec, "current", ident=ident)
             held_id.append(v_id)
-            held_urdf.append(rd.validate(robot, rec, "current", model=model, gains=gains))
+            held_urdf.append(validate(robot, rec, "current", model=model, gains=gains))
             parts.append(validation_section(v_id, out, "kinova", f"heldout_{_slug(rec.source)}",
                                             f"Held-out last 30 % of {rec.source}, identified "
                                             "model", kinds=("prediction", "friction"), level=4))
         for path in jointwise:
-            rec = rd.read_recording(path, spec="kinova_gen3", robot=robot)
+            rec = read_recording(path, spec="kinova_gen3", robot=robot)
             j = int(path.name.split("_")[1]) - 1
-            jw_id[j] = rd.validate(ident.robot, rec, "current", ident=ident)
-            jw_urdf[j] = rd.validate(robot, rec, "current", model=model, gains=gains)
+            jw_id[j] = validate(ident.robot, rec, "current", ident=ident)
+            jw_urdf[j] = validate(robot, rec, "current", model=model, gains=gains)
             parts.append(validation_section(jw_id[j], out, "kinova", f"jointwise_{j + 1}",
                                             f"{rec.source}: joint {j + 1} moves, identified "
                                             "model", kinds=("prediction",), level=4))
@@ -396,7 +399,7 @@ def _joint_row(j: int, robot: Any, ident: Any, held_id: Sequence[Validation],
 
 
 def _friction_html(ft: Any, names: Sequence[str]) -> str:
-    """The friction-model table (``robodyn.identification.friction.friction_table``) as HTML."""
+    """The friction-model table (``robodyn.identification.friction_table.friction_table``) as HTML."""
     rows = [[r["model"], f"{r['relative_error']:.3f}", f"{r['relative_error_filtered']:.3f}",
              f"{r['noise_floor']:.3f}", *(f"{r[f'relative_error_{n}']:.3f}" for n in names)]
             for _, r in ft.iterrows()]
@@ -404,7 +407,7 @@ def _friction_html(ft: Any, names: Sequence[str]) -> str:
                *names)
     return f"""<h3>What friction adds (held-out current error by friction model)</h3>
 <p>Each friction model identified anew on the same 70 % and evaluated on the same held-out 30 %
-(<code>robodyn.identification.friction.friction_table</code>; "against filtered" and the noise floor
+(<code>robodyn.identification.friction_table.friction_table</code>; "against filtered" and the noise floor
 use the identification's own low-pass cut-off). "none" is the rigid-body and drive model
 alone: the difference to the other rows is what friction is worth here.</p>
 {html_table(headers, rows)}"""

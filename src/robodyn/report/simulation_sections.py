@@ -7,18 +7,21 @@ from pathlib import Path
 
 import numpy as np
 
-import robodyn as rd
 from robodyn.codegen.emit import generate
+from robodyn.numeric.model import compile_model
 from robodyn.report.html import figure
-from robodyn.report.text import progress
-from robodyn.simulation.aa300_study import run_study
-from robodyn.simulation.balance import balance_double_pendulum
+from robodyn.robot.load import load
+from robodyn.robot.model import Robot
 from robodyn.simulation.controllers import ComputedTorque
-from robodyn.simulation.plots import balance_figure
+from robodyn.simulation.simulation import simulate
 from robodyn.simulation.trajectory import quintic
+from robodyn.studies.aa300 import run_study
+from robodyn.studies.balance import balance_double_pendulum
+from robodyn.studies.simulation_plots import balance_figure
+from robodyn.text import progress
 
 
-def simulation_sections(robot: rd.Robot, out: Path, backend: str = "c") -> tuple[str, bool]:
+def simulation_sections(robot: Robot, out: Path, backend: str = "c") -> tuple[str, bool]:
     """Run the chapter-3 demo steps, write their files into ``out``; return (HTML, all ok).
 
     ``backend``: "c" (compiled) or "numpy" (no compiler needed) for every simulated model.
@@ -33,13 +36,13 @@ def simulation_sections(robot: rd.Robot, out: Path, backend: str = "c") -> tuple
                  f"--lang c|python|octave|fortran|julia|latex|mex</code> writes the others.</p>")
 
     with progress(f"computed-torque tracking of a quintic move (PUMA 560, {where})"):
-        model = rd.compile_model(robot, backend=backend)
+        model = compile_model(robot, backend=backend)
         q0 = np.zeros(robot.dof)
         q1 = np.array([0.8, -0.6, 0.9, 0.5, -0.7, 1.0])[: robot.dof]
         plan = quintic(q0, q1, 2.0, dt=1e-3)
         ctrl = ComputedTorque(plan, kp=400.0, kd=40.0)
-        sim = rd.simulate(model, q0, None, 2.0, 1e-3, controller=ctrl, control="continuous")
-        held = rd.simulate(model, q0, None, 2.0, 1e-3, controller=ctrl)
+        sim = simulate(model, q0, None, 2.0, 1e-3, controller=ctrl, control="continuous")
+        held = simulate(model, q0, None, 2.0, 1e-3, controller=ctrl)
         err = float(np.max(np.abs(sim.q - plan.q[: len(sim.t)])))
         err_held = float(np.max(np.abs(held.q - plan.q[: len(held.t)])))
     # continuous law, exact model (rotor inertia and friction included): RK4's own error only
@@ -62,7 +65,7 @@ def simulation_sections(robot: rd.Robot, out: Path, backend: str = "c") -> tuple
 
     with progress("LQR balance of the trolley double inverted pendulum"):
         bal = balance_double_pendulum(
-            model=rd.compile_model(rd.load("trolley_double_pendulum"), backend=backend))
+            model=compile_model(load("trolley_double_pendulum"), backend=backend))
         fig = balance_figure(bal, out / "balance.png")
     parts.append(
         "<h2>Double inverted pendulum on a trolley (the thesis' Fig. 3.1), LQR</h2>"

@@ -191,7 +191,7 @@ class Robot:
         Where the description came from (file path or ``builtin:NAME``).
     fluid : Mapping or None
         The description's ``fluid`` block (density, current), kept verbatim like ``Link.hydro``;
-        read by :func:`robodyn.hydro.schema.fluid_of`.
+        read by :func:`robodyn.robot.hydro.fluid_of`.
     """
 
     name: str

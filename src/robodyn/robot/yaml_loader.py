@@ -21,11 +21,11 @@ import sympy as sp
 import yaml
 
 from robodyn import spatial as S
-from robodyn.hydro.schema import parse_fluid, parse_hydro
 from robodyn.robot import placement, validation
 from robodyn.robot.chain import ChainElement, assemble
 from robodyn.robot.errors import DescriptionError
 from robodyn.robot.expressions import parameter_symbol, parse_value
+from robodyn.robot.hydro import parse_fluid, parse_hydro
 from robodyn.robot.model import Drive, Friction, Link, Robot
 
 __all__ = [

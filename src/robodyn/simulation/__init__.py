@@ -7,7 +7,7 @@ Public entry points::
     traj = simulate(model, q0, None, duration=2.0, dt=1e-3, controller=PD(100, 20, q_ref))
 
 The AA300 design study and the double-pendulum balance are in
-:mod:`robodyn.simulation.aa300_study` and :mod:`robodyn.simulation.balance` (they import matplotlib).
+:mod:`robodyn.studies.aa300` and :mod:`robodyn.studies.balance` (they import matplotlib).
 """
 
 from robodyn.simulation.controllers import LQR, PD, PID, ComputedTorque, Controller, GravityCompensation

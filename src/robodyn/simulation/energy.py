@@ -8,7 +8,7 @@ is built once per robot (and parameter values) from the symbolic forward kinemat
 with ``p_ci`` the centre of mass of link ``i`` in the world frame, ``g`` the gravity vector and,
 for a robot under water (``fluid``/``hydro`` blocks), the buoyancy potential of each wet link:
 displaced volume ``V_i`` at its centre of buoyancy ``p_Bi`` in a fluid of density ``rho``
-(:mod:`robodyn.hydro.buoyancy`). The compiled mass matrix holds the added mass, so the kinetic
+(:mod:`robodyn.symbolic.hydro.buoyancy`). The compiled mass matrix holds the added mass, so the kinetic
 energy ``1/2 qd^T M qd`` of a simulation includes the added-mass (fluid) kinetic energy, and
 ``K + V`` is conserved in a passive run without drag, skin friction and lift.
 It is exact (no quadrature) and consistent with the model's gravity load: ``dV/dq = g(q)``, the
@@ -24,9 +24,9 @@ import numpy as np
 import sympy as sp
 
 from robodyn import spatial as S
-from robodyn.hydro.schema import fluid_of, hydro_of
 from robodyn.numeric.model import Model
 from robodyn.robot.errors import InputError
+from robodyn.robot.hydro import fluid_of, hydro_of
 from robodyn.symbolic.kinematics import forward_kinematics, joint_symbols
 
 _MEMO: dict[tuple, Callable[..., object]] = {}

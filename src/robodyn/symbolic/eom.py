@@ -20,7 +20,6 @@ import numpy as np
 import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
-from robodyn.hydro.terms import HydroTerms, hydro_terms
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 from robodyn.symbolic import crba
@@ -28,6 +27,7 @@ from robodyn.symbolic import kane as kane_mod
 from robodyn.symbolic import lagrange as lagrange_mod
 from robodyn.symbolic import newton_euler as ne
 from robodyn.symbolic.coriolis import christoffel_coriolis, christoffel_program
+from robodyn.symbolic.hydro.terms import HydroTerms, hydro_terms
 from robodyn.symbolic.kinematics import (
     Kinematics,
     end_effector_jacobian,
@@ -114,7 +114,7 @@ class EquationsOfMotion:
     @cached_property
     def hydro(self) -> HydroTerms | None:
         """The hydrodynamic terms one by one (added mass, buoyancy, drag, skin friction, lift),
-        or None for a robot without ``fluid``/``hydro`` blocks (see :mod:`robodyn.hydro`)."""
+        or None for a robot without ``fluid``/``hydro`` blocks (see :mod:`robodyn.symbolic.hydro`)."""
         return hydro_terms(self.robot, self.q, self.qd, self.qdd)
 
     @cached_property

@@ -77,9 +77,9 @@ class _Layout:
 
 
 def _version() -> str:
-    import robodyn
+    from robodyn._version import __version__
 
-    return getattr(robodyn, "__version__", "unknown")
+    return __version__
 
 
 def _joint_types(eom: EquationsOfMotion) -> str:
@@ -240,8 +240,8 @@ def _layout(eom: EquationsOfMotion) -> _Layout:
 
 def _underwater_layout(eom: EquationsOfMotion) -> _Layout:
     """Textbook form of a small underwater arm, each hydrodynamic term on its own
-    (:mod:`robodyn.hydro.textbook`)."""
-    from robodyn.hydro.textbook import underwater_textbook
+    (:mod:`robodyn.symbolic.hydro.textbook`)."""
+    from robodyn.symbolic.hydro.textbook import underwater_textbook
 
     book = underwater_textbook(eom)
     sections = [(sec.title, [_Row(ln.name, ln.index, list(ln.terms), ln.mirror)
@@ -342,7 +342,7 @@ class _Latex(LatexPrinter):
             self._settings["fold_func_brackets"] = fold
 
 
-#: Left-hand sides of the hydrodynamic terms (:mod:`robodyn.hydro.textbook`).
+#: Left-hand sides of the hydrodynamic terms (:mod:`robodyn.symbolic.hydro.textbook`).
 _HYDRO_TEX = {"M_A": r"\mathbf{M}^{\mathrm{A}}", "C_A": r"\mathbf{C}^{\mathrm{A}}",
               "g_B": r"\mathbf{g}^{\mathrm{B}}", "tau_D": r"\tau^{\mathrm{D}}",
               "tau_F": r"\tau^{\mathrm{F}}", "tau_L": r"\tau^{\mathrm{L}}",

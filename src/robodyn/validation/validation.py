@@ -148,7 +148,7 @@ class Validation:
 
     def summary(self) -> str:
         """A few lines of text: what was compared, and the whole-arm figures."""
-        from robodyn.report.text import table
+        from robodyn.text import table
 
         lines = [f"{self.robot} vs {self.source or 'recording'}: target {self.target} "
                  f"({self.unit}), {len(self.t)} samples, {self.t[-1] - self.t[0]:.3g} s"

@@ -1,0 +1,147 @@
+"""robodyn's layers, read from the import graph of src/robodyn (docs/architecture.md).
+
+Every ``import`` and ``from ... import`` of a robodyn module counts, also those inside functions
+(they are dependencies all the same); only imports under ``if TYPE_CHECKING:`` do not. The graph
+must have no cycle between files or between packages, and no import may run up the layers.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections import defaultdict
+from pathlib import Path
+
+SRC = Path(__file__).resolve().parent.parent / "src" / "robodyn"
+
+#: Layer of every top-level package or module of robodyn, from the bottom. A module may import
+#: only from its own layer or below (and the graph stays acyclic within a layer).
+LAYERS: dict[str, int] = {
+    "_version": 0, "spatial": 0, "text": 0,
+    "robot": 1, "errors": 1, "output_names": 1,           # the description, immutable data
+    "symbolic": 2,                                        # equations (hydro terms included)
+    "codegen": 3, "export": 3,                            # code and file writers
+    "numeric": 4,                                         # compiled models
+    "simulation": 5, "measure": 5,                        # algorithms
+    "calibration": 6, "validation": 6,
+    "identification": 7,
+    "studies": 8,                                         # case studies, experiment design, sweeps
+    "report": 9,                                          # HTML, figures, the demo
+    "<root>": 10,                                         # the public facade (lazy)
+    "cli": 11, "cli_cache": 11, "cli_excite": 11, "cli_identify": 11, "cli_record": 11,
+    "cli_sweep": 11, "cli_underwater": 11, "cli_workflows": 11,
+}
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(SRC.parent).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _package(module: str) -> str:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "<root>"
+
+
+def _imports(path: Path, known: set[str]) -> set[str]:
+    """The robodyn modules ``path`` imports (the longest known prefix of each name)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    hidden = {id(x) for node in ast.walk(tree)
+              if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
+              for sub in node.body for x in ast.walk(sub)}
+    out = set()
+    for node in ast.walk(tree):
+        if id(node) in hidden:
+            continue
+        if isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            subs = [f"{node.module}.{a.name}" for a in node.names]
+            names = [s for s in subs if s in known] or [node.module]
+        else:
+            continue
+        for name in names:
+            parts = name.split(".")
+            while parts and ".".join(parts) not in known:
+                parts.pop()
+            if parts and parts[0] == "robodyn":
+                out.add(".".join(parts))
+    return out
+
+
+def _graph() -> dict[str, set[str]]:
+    files = {_module_name(p): p for p in SRC.rglob("*.py")}
+    known = set(files)
+    return {m: _imports(p, known) - {m} for m, p in files.items()}
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components with more than one node (Tarjan, iterative)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    out: list[list[str]] = []
+    counter = 0
+    for root in sorted(graph):
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph.get(root, ()))))]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on.add(root)
+        while work:
+            node, it = work[-1]
+            nxt = next(it, None)
+            if nxt is not None:
+                if nxt not in index:
+                    index[nxt] = low[nxt] = counter
+                    counter += 1
+                    stack.append(nxt)
+                    on.add(nxt)
+                    work.append((nxt, iter(sorted(graph.get(nxt, ())))))
+                elif nxt in on:
+                    low[node] = min(low[node], index[nxt])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[node])
+            if low[node] == index[node]:
+                comp = []
+                while True:
+                    w = stack.pop()
+                    on.discard(w)
+                    comp.append(w)
+                    if w == node:
+                        break
+                if len(comp) > 1:
+                    out.append(sorted(comp))
+    return out
+
+
+def test_every_package_has_a_layer() -> None:
+    packages = {_package(m) for m in _graph()}
+    assert packages <= set(LAYERS), sorted(packages - set(LAYERS))
+
+
+def test_no_cycle_between_files() -> None:
+    assert _cycles(_graph()) == []
+
+
+def test_no_cycle_between_packages() -> None:
+    packages: dict[str, set[str]] = defaultdict(set)
+    for a, targets in _graph().items():
+        packages[_package(a)] |= {_package(b) for b in targets} - {_package(a)}
+    assert _cycles(packages) == []
+
+
+def test_no_import_runs_up_the_layers() -> None:
+    upward = sorted(f"{a} -> {b}" for a, targets in _graph().items() for b in targets
+                    if LAYERS.get(_package(b), 99) > LAYERS.get(_package(a), -1))
+    assert upward == []
+
+
+def test_the_checks_can_fail() -> None:
+    # a cycle and an upward import, made up, are found
+    assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    assert LAYERS["robot"] < LAYERS["studies"]
