@@ -27,8 +27,7 @@ LAYERS: dict[str, int] = {
     "studies": 8,                                         # case studies, experiment design, sweeps
     "report": 9,                                          # HTML, figures, the demo
     "<root>": 10,                                         # the public facade (lazy)
-    "cli": 11, "cli_cache": 11, "cli_excite": 11, "cli_identify": 11, "cli_record": 11,
-    "cli_sweep": 11, "cli_underwater": 11, "cli_workflows": 11,
+    "cli": 11,                                            # the robodyn command
 }
 
 

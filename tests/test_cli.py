@@ -337,3 +337,22 @@ def _show_lines(argv):
     with contextlib.redirect_stdout(buf):
         assert main(argv) == 0
     return buf.getvalue().rstrip().splitlines()
+
+
+def test_every_command_group_registers_itself_the_same_way():
+    # robodyn.cli's modules share one protocol: register(subparsers, formatter) adds commands
+    import argparse
+    import importlib
+    import pkgutil
+
+    import robodyn.cli as cli
+
+    groups = [m.name for m in pkgutil.iter_modules(cli.__path__) if m.name not in ("args", "__main__")]
+    assert len(groups) == 7
+    for name in groups:
+        parser = argparse.ArgumentParser()
+        sub = parser.add_subparsers()
+        importlib.import_module(f"robodyn.cli.{name}").register(sub, argparse.HelpFormatter)
+        assert sub.choices, name
+        for command in sub.choices.values():
+            assert command.format_help()

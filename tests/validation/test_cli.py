@@ -119,7 +119,7 @@ def test_validate_command_rejects_bad_gains(files, tmp_path, capsys):
 
 
 def test_identify_gains_set_the_drives_and_are_checked(files, tmp_path, capsys):
-    from robodyn.cli_identify import _with_gains
+    from robodyn.cli.identify import _with_gains
     from robodyn.validation.effort import drive_gains
 
     with warnings.catch_warnings():
@@ -169,7 +169,7 @@ def test_identified_description_with_non_physical_inertia_exits_1(tmp_path, caps
 
     import sympy as sp
 
-    from robodyn.cli_identify import _check_loadable
+    from robodyn.cli.identify import _check_loadable
     from robodyn.robot.yaml_writer import dump_yaml
 
     robot = rd.load("planar_2r")

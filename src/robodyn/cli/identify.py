@@ -17,12 +17,12 @@ from typing import Any
 import numpy as np
 
 import robodyn as rd
-from robodyn.cli_workflows import floats
+from robodyn.cli.args import ROBOT_HELP, floats
 from robodyn.output_names import check_stem
 from robodyn.robot.errors import InputError
 from robodyn.text import err, progress
 
-__all__ = ["add_parsers"]
+__all__ = ["register"]
 
 # The --friction choices, kept here so that building the parser does not import the
 # identification package; tests/calibration/test_startup.py checks them against
@@ -322,8 +322,9 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 # ----------------------------------------------------------------------------------------------
 
 
-def add_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
+def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     """Register ``identify`` and ``validate`` on the ``robodyn`` sub-parsers."""
+    robot_help = ROBOT_HELP
     _identify_parser(sub, fmt, robot_help)
     _validate_parser(sub, fmt, robot_help)
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import argparse
 
-__all__ = ["add_cache_parser"]
+__all__ = ["register"]
 
 # robodyn.codegen.build (and cffi) is imported by the command itself, not to build the parser;
 # tests/calibration/test_startup.py checks this against codegen.build.DEFAULT_CACHE_MAX_MB.
@@ -34,7 +34,7 @@ def _cmd_cache(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_cache_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
+def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     """Register ``robodyn cache`` on the main parser's subcommands."""
     p = sub.add_parser(
         "cache", help="show or empty the compiled-model cache", formatter_class=fmt,

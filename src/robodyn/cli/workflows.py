@@ -15,11 +15,12 @@ from typing import Any
 import numpy as np
 
 import robodyn as rd
+from robodyn.cli.args import ROBOT_HELP, floats
 from robodyn.output_names import check_stem, output_path
 from robodyn.robot.errors import InputError
 from robodyn.text import err, progress, table
 
-__all__ = ["add_parsers"]
+__all__ = ["register"]
 
 # The parsers' choices and defaults, kept here so that building the parser (every command, and
 # --help) imports neither the simulation nor the calibration package; test_startup.py in
@@ -29,14 +30,6 @@ ADAPTIVE: tuple[str, ...] = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 MAX_SAMPLES = 1_000_000
 MODELS: tuple[str, ...] = ("dh", "hayati", "s-model", "poe")
 DEFLECTIONS: tuple[str, ...] = ("linear", "exact")
-
-
-def floats(text: str) -> np.ndarray:
-    """A comma-separated list of numbers (``0,0.5,-1``); an argparse type."""
-    try:
-        return np.array([float(v) for v in text.replace(" ", "").split(",") if v], dtype=float)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
 
 
 def _vector(value: np.ndarray | None, n: int, option: str, default: float = 0.0) -> np.ndarray:
@@ -359,8 +352,9 @@ def _cmd_iso9283(args: argparse.Namespace) -> int:
 # ----------------------------------------------------------------------------------------------
 
 
-def add_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
+def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     """Register ``simulate``, ``calibrate`` and ``iso9283`` on the ``robodyn`` sub-parsers."""
+    robot_help = ROBOT_HELP
     _simulate_parser(sub, fmt, robot_help)
     _calibrate_parser(sub, fmt, robot_help)
     _iso9283_parser(sub, fmt)

@@ -13,10 +13,11 @@ from pathlib import Path
 import numpy as np
 
 import robodyn as rd
+from robodyn.cli.args import ROBOT_HELP
 from robodyn.robot.errors import InputError
 from robodyn.text import err, table
 
-__all__ = ["add_record_parser"]
+__all__ = ["register"]
 
 _FIELDS = ("q", "qd", "qdd", "tau", "current", "temperature")
 
@@ -114,8 +115,9 @@ def _cmd_convert(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_record_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
+def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     """Register ``record`` with its ``info``, ``plot`` and ``convert`` subcommands."""
+    robot_help = ROBOT_HELP
     p = sub.add_parser("record", help="inspect, plot and convert measured recordings",
                        formatter_class=fmt,
                        description="Measured joint data: CSV/TSV (optionally .gz) read through a "

@@ -2,8 +2,8 @@
 
 Subcommands: ``list``, ``show``, ``derive``, ``check``, ``codegen``, ``export``, ``simulate``,
 ``calibrate``, ``iso9283``, ``identify``, ``validate`` and ``demo`` (``robodyn --help``);
-``simulate``, ``calibrate`` and ``iso9283`` live in :mod:`robodyn.cli_workflows`, ``identify`` and
-``validate`` in :mod:`robodyn.cli_identify`.
+``simulate``, ``calibrate`` and ``iso9283`` live in :mod:`robodyn.cli.workflows`, ``identify`` and
+``validate`` in :mod:`robodyn.cli.identify`.
 Exit codes: 0 success; 1 the formulations disagree (check, demo), the calibration did not
 converge (calibrate), or an internal error (a bug: one line, the traceback in a log file); 2 bad
 input (a :class:`~robodyn.errors.RobodynError`: unknown robot, invalid description, unreadable
@@ -23,13 +23,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import robodyn as rd
-from robodyn.cli_cache import add_cache_parser
-from robodyn.cli_excite import add_excite_parsers
-from robodyn.cli_identify import add_parsers as add_identify_parsers
-from robodyn.cli_record import add_record_parser
-from robodyn.cli_sweep import add_sweep_parser
-from robodyn.cli_underwater import add_underwater_parser
-from robodyn.cli_workflows import add_parsers
+from robodyn.cli import cache, excite, identify, record, sweep, underwater, workflows
+from robodyn.cli.args import ROBOT_HELP as _ROBOT_HELP
 from robodyn.robot.errors import RobodynError
 from robodyn.text import err as _err
 from robodyn.text import progress as _progress
@@ -218,7 +213,6 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 # argument parsing
 # ----------------------------------------------------------------------------------------------
 
-_ROBOT_HELP = "built-in robot name (see 'robodyn list') or path to a .yaml/.yml/.urdf description"
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -250,13 +244,9 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     _add_model_parsers(sub, fmt)
     _add_output_parsers(sub, fmt)
-    add_parsers(sub, fmt, _ROBOT_HELP)
-    add_identify_parsers(sub, fmt, _ROBOT_HELP)
-    add_record_parser(sub, fmt, _ROBOT_HELP)
-    add_excite_parsers(sub, fmt, _ROBOT_HELP)
-    add_cache_parser(sub, fmt)
-    add_sweep_parser(sub, fmt)
-    add_underwater_parser(sub, fmt)
+    # each command group registers itself: register(subparsers, formatter)
+    for group in (workflows, identify, record, excite, cache, sweep, underwater):
+        group.register(sub, fmt)
     _add_demo_parser(sub, fmt)
     for command in ("show", "derive", "check", "codegen", "export", "simulate", "calibrate",
                     "identify", "validate"):

@@ -18,7 +18,7 @@ from robodyn.studies.underwater_effects import (
     EFFECTS,
 )
 
-__all__ = ["add_underwater_parser"]
+__all__ = ["register"]
 
 
 def _seconds(text: str) -> float:
@@ -73,7 +73,7 @@ def _cmd_underwater(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_underwater_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
+def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     """Register ``robodyn underwater`` on the main parser's subcommands."""
     p = sub.add_parser(
         "underwater", help="effect series of an underwater arm (buoyancy, added mass, drag, ...)",

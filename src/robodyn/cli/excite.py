@@ -12,6 +12,7 @@ import warnings
 from pathlib import Path
 
 import robodyn as rd
+from robodyn.cli.args import ROBOT_HELP
 
 
 def _cmd_excite(args: argparse.Namespace) -> int:
@@ -51,8 +52,9 @@ def _cmd_testprog(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_excite_parsers(sub: argparse._SubParsersAction, fmt: type, robot_help: str) -> None:
+def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     """Register ``excite`` and ``testprog`` on the ``robodyn`` sub-parsers."""
+    robot_help = ROBOT_HELP
     p = sub.add_parser("excite", help="design an optimal excitation trajectory (CSV a controller can play)",
                        formatter_class=fmt,
                        epilog="example:\n  robodyn excite puma560 -o traj.csv")

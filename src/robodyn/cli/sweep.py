@@ -11,7 +11,7 @@ import argparse
 import sys
 from pathlib import Path
 
-__all__ = ["add_sweep_parser"]
+__all__ = ["register"]
 
 
 def _positive(text: str) -> int:
@@ -66,7 +66,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_sweep_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
+def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     """Register ``robodyn sweep`` on the main parser's subcommands."""
     p = sub.add_parser(
         "sweep", help="run a parameter study (study file) on Dask", formatter_class=fmt,
