@@ -14,6 +14,7 @@ from robodyn.robot.errors import (
     DescriptionWarning,
     IdentificationError,
     InputError,
+    MissingExtraError,
     RecordingError,
     RecordingWarning,
     RobodynError,
@@ -24,5 +25,5 @@ from robodyn.robot.errors import (
 )
 
 __all__ = ["DataFileError", "DescriptionError", "DescriptionWarning", "IdentificationError",
-           "InputError", "RecordingError", "RecordingWarning", "RobodynError", "SimulationError",
-           "SingularMassMatrixError", "StudyError", "ValidationError"]
+           "InputError", "MissingExtraError", "RecordingError", "RecordingWarning", "RobodynError",
+           "SimulationError", "SingularMassMatrixError", "StudyError", "ValidationError"]

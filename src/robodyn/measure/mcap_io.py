@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from robodyn.extras import require
 from robodyn.measure.recording import Recording
 from robodyn.robot.errors import RecordingError
 
@@ -64,8 +65,8 @@ def read_mcap(path: str | PathLike[str], robot: Any = None, joint_topic: str | N
         ``q`` from ``position``; ``qd`` from ``velocity`` and ``tau`` from ``effort`` when the
         messages carry them; ``tool_t``/``tool_points`` from the tracker topic.
     """
-    from mcap.reader import make_reader
-    from mcap_ros2.decoder import DecoderFactory
+    make_reader = require("mcap.reader", f"reading the ROS 2 bag {path}").make_reader
+    DecoderFactory = require("mcap_ros2.decoder", f"reading the ROS 2 bag {path}").DecoderFactory  # noqa: N806
 
     p = Path(path)
     joints: list[tuple[int, list[str], Any, Any, Any, str]] = []
@@ -166,7 +167,7 @@ def write_mcap(rec: Recording, path: str | PathLike[str], *, joint_topic: str = 
     -------
     Path
     """
-    from mcap_ros2.writer import Writer
+    Writer = require("mcap_ros2.writer", "writing a ROS 2 bag (MCAP)").Writer  # noqa: N806
 
     p = Path(path)
     velocity = rec.qd is not None and "qd" not in rec.estimated

@@ -11,6 +11,7 @@ __all__ = [
     "DescriptionWarning",
     "IdentificationError",
     "InputError",
+    "MissingExtraError",
     "SimulationError",
     "SingularMassMatrixError",
     "StudyError",
@@ -113,3 +114,8 @@ class DataFileError(RobodynError, ValueError):
     repeated column, a value that is not a finite number).
     """
 
+
+
+class MissingExtraError(RobodynError, ImportError):
+    """A feature needs an optional dependency that is not installed; the message names the
+    pip extra that installs it (:mod:`robodyn.extras`)."""

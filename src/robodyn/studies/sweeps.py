@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from robodyn.extras import require
 from robodyn.robot.errors import StudyError
 from robodyn.studies.cases import expand_cases
 
@@ -193,7 +194,7 @@ def _check_task(task: object) -> None:
     """Refuse a task that is not callable or cannot be sent to a worker (named)."""
     if not callable(task):
         raise StudyError(f"task {task!r} is not callable: expected a function of one case (dict)")
-    import cloudpickle
+    cloudpickle = require("cloudpickle", "rd.sweep on Dask (run_serial needs no extra)")
 
     try:
         cloudpickle.dumps(task)
@@ -223,7 +224,8 @@ def run_serial(task: Callable[[dict[str, Any]], Mapping[str, Any]], cases: Any, 
 @contextmanager
 def _connect(client: Any, scheduler: str | None, workers: int | None, timeout: float) -> Iterator[Any]:
     """The Dask client to use; those opened here are closed on exit."""
-    from distributed import Client
+    require("dask", "rd.sweep on Dask (run_serial needs no extra)")
+    Client = require("distributed", "rd.sweep on Dask (run_serial needs no extra)").Client  # noqa: N806
 
     if client is not None:
         yield client
@@ -485,6 +487,7 @@ def write_table(frame: pd.DataFrame, directory: str | Path, stem: str = "results
     out = Path(directory)
     out.mkdir(parents=True, exist_ok=True)
     parquet, csv = out / f"{stem}.parquet", out / f"{stem}.csv"
+    require("pyarrow", f"writing the study table {parquet}")
     frame.to_parquet(parquet, engine="pyarrow")
     frame.to_csv(csv)
     return parquet, csv

@@ -1,0 +1,79 @@
+"""Every third-party package robodyn imports is declared in pyproject.toml, optional ones in the
+extra robodyn.extras names, and a missing extra is one clear error naming the pip command."""
+
+from __future__ import annotations
+
+import ast
+import re
+import sys
+import tomllib
+from importlib.metadata import packages_distributions
+from pathlib import Path
+
+import pytest
+
+from robodyn.errors import MissingExtraError, RobodynError
+from robodyn.extras import EXTRAS, require
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _requirement_names(reqs: list[str]) -> set[str]:
+    return {re.split(r"[\[<>=!~ ;]", r, maxsplit=1)[0].lower().replace("_", "-") for r in reqs}
+
+
+def _declared() -> tuple[set[str], dict[str, set[str]]]:
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    extras = {k: _requirement_names(v) for k, v in project["optional-dependencies"].items()}
+    return _requirement_names(project["dependencies"]), extras
+
+
+def _imported_modules() -> set[str]:
+    out = set()
+    for path in (ROOT / "src" / "robodyn").rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                out |= {a.name.split(".")[0] for a in node.names}
+            elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                out.add(node.module.split(".")[0])
+    return {m for m in out if m not in sys.stdlib_module_names and m != "robodyn"}
+
+
+def test_every_direct_import_is_declared() -> None:
+    core, extras = _declared()
+    dists = packages_distributions()
+    undeclared = []
+    for module in sorted(_imported_modules() | set(EXTRAS)):
+        names = {d.lower().replace("_", "-") for d in dists.get(module, [module])}
+        wanted = extras[EXTRAS[module]] if module in EXTRAS else core
+        if not names & wanted:
+            undeclared.append(f"{module} ({', '.join(sorted(names))})")
+    assert undeclared == []
+
+
+#: Modules that may import an optional package at their top: each is itself imported only
+#: inside the feature, after robodyn.extras.require has checked the extra.
+LAZY_MODULES = {"robodyn.studies.shipping"}  # imported inside rd.sweep after require("distributed")
+
+
+def test_optional_modules_are_not_imported_at_module_level() -> None:
+    # an optional package is imported where the feature runs (robodyn.extras.require), so the
+    # rest of robodyn works without it
+    offenders = []
+    for path in (ROOT / "src" / "robodyn").rglob("*.py"):
+        module = ".".join(path.relative_to(ROOT / "src").with_suffix("").parts)
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import)
+                     else [node.module] if isinstance(node, ast.ImportFrom) and node.module else [])
+            offenders += [f"{module}: {n}" for n in names
+                          if (n.split(".")[0] in EXTRAS and module not in LAZY_MODULES)
+                          or n in LAZY_MODULES]
+    assert offenders == [], offenders
+
+
+def test_a_missing_extra_names_the_pip_command(monkeypatch) -> None:
+    monkeypatch.setitem(sys.modules, "cvxpy", None)  # import cvxpy now raises ImportError
+    with pytest.raises(MissingExtraError, match=r"pip install 'robodyn\[sdp\]'") as info:
+        require("cvxpy", "identify(method='consistent')")
+    assert isinstance(info.value, RobodynError) and isinstance(info.value, ImportError)
+    assert "identify(method='consistent')" in str(info.value)
