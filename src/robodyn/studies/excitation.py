@@ -57,6 +57,7 @@ import scipy.linalg
 from scipy.interpolate import BPoly, PPoly
 from scipy.optimize import minimize
 
+from robodyn.identification.stacking import identification_matrix as stacked_matrix
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
@@ -206,9 +207,9 @@ def base_columns(model: Model, rng: np.random.Generator | int | None = 0, *, sam
 
 def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
                           columns: Sequence[int]) -> np.ndarray:
-    """Stacked regressor ``W`` restricted to ``columns``: (N n, p) for samples (N, n)."""
-    y = model.regressor(q, qd, qdd)
-    return y.reshape(-1, y.shape[-1])[:, list(columns)]
+    """Stacked regressor ``W`` restricted to ``columns``: (N n, p) for samples (N, n); the one
+    stacking of :func:`robodyn.identification.stacking.identification_matrix`."""
+    return stacked_matrix(model, q, qd, qdd, list(columns))
 
 
 def condition_number(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
