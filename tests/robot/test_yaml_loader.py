@@ -601,7 +601,7 @@ def test_libyaml_loader_gives_the_pure_python_result() -> None:
     # same checks: the data must be exactly what PyYAML's own pure-Python SafeLoader reads
     import yaml
 
-    from robodyn.robot import yaml_loader
+    from robodyn.robot import safe_yaml, yaml_loader
 
     assert yaml.__with_libyaml__, "PyYAML without libyaml: the fast loader is not exercised"
     library = Path(yaml_loader.__file__).parent / "library"
@@ -610,17 +610,17 @@ def test_libyaml_loader_gives_the_pure_python_result() -> None:
     for text in texts:
         expected = yaml.load(text, Loader=yaml.SafeLoader)  # noqa: S506 - PyYAML's safe loader
         assert yaml_loader._parse_yaml(text, "t.yaml") == expected
-        assert yaml.load(text, Loader=yaml_loader._CUniqueKeyLoader) == expected  # noqa: S506
+        assert yaml.load(text, Loader=safe_yaml._CUniqueKeyLoader) == expected  # noqa: S506
 
 
 def test_libyaml_path_keeps_the_duplicate_key_check() -> None:
     import yaml
 
-    from robodyn.robot import yaml_loader
+    from robodyn.robot import safe_yaml
 
     with pytest.raises(yaml.constructor.ConstructorError, match="found duplicate key 'name'"):
-        yaml.load("name: a\nname: b\n", Loader=yaml_loader._CUniqueKeyLoader)  # noqa: S506
+        yaml.load("name: a\nname: b\n", Loader=safe_yaml._CUniqueKeyLoader)  # noqa: S506
     with pytest.raises(yaml.MarkedYAMLError, match=r"YAML alias \*x is not allowed"):
-        yaml_loader._c_events_checked("a: &x [1]\nb: *x\n")
+        safe_yaml._c_events_checked("a: &x [1]\nb: *x\n")
     with pytest.raises(yaml.MarkedYAMLError, match="nested more than 32 levels deep"):
-        yaml_loader._c_events_checked("a: " + "[" * 33 + "]" * 33 + "\n")
+        safe_yaml._c_events_checked("a: " + "[" * 33 + "]" * 33 + "\n")

@@ -216,7 +216,7 @@ def read_joint_map(spec, robot: Robot) -> JointMap:
     """
     source = "<mapping>"
     if isinstance(spec, (str, Path)):
-        from robodyn.robot.yaml_loader import safe_yaml
+        from robodyn.robot.safe_yaml import safe_yaml
 
         source = str(spec)
         try:

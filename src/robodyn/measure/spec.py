@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from robodyn.robot.errors import RecordingError
-from robodyn.robot.yaml_loader import safe_yaml
+from robodyn.robot.safe_yaml import safe_yaml
 
 __all__ = ["Channel", "Coupling", "RecordingSpec", "builtin_specs", "load_spec"]
 

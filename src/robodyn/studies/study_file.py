@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from robodyn.robot.errors import StudyError
-from robodyn.robot.yaml_loader import safe_yaml
+from robodyn.robot.safe_yaml import safe_yaml
 from robodyn.studies.calibration_mc import CalibrationMonteCarlo
 from robodyn.studies.cases import Grid, LatinHypercube, RandomSampler, Range
 from robodyn.studies.identification_mc import IdentificationMonteCarlo
