@@ -19,7 +19,8 @@ import robodyn as rd
 from robodyn.cli import main
 from robodyn.errors import DescriptionError
 from robodyn.report.agreement import Agreement
-from robodyn.symbolic.render import render_json, render_latex, render_mathml, render_text
+from robodyn.symbolic.render import render_json, render_latex, render_text
+from robodyn.symbolic.render_mathml import render_mathml
 
 NEGATIVE_MASS = """\
 name: bad_arm

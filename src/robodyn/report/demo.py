@@ -35,7 +35,8 @@ from robodyn.report.simulation_sections import simulation_sections
 from robodyn.robot.load import load
 from robodyn.robot.model import Robot
 from robodyn.symbolic.eom import EquationsOfMotion, derive
-from robodyn.symbolic.render import render_json, render_latex, render_mathml, render_text
+from robodyn.symbolic.render import render_json, render_latex, render_text
+from robodyn.symbolic.render_mathml import render_mathml
 from robodyn.text import progress, steps, table
 
 #: The thesis the demo re-creates, cited in the report.
