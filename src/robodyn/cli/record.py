@@ -100,6 +100,9 @@ def _cmd_convert(args: argparse.Namespace) -> int:
         raise InputError(f"{out}: -o is the file being converted; write to another file "
                          "(the input is never overwritten)")
     rec = _read(args)
+    if out.suffix.lower() not in (".mcap", ".csv", ".gz"):
+        raise InputError(f"{out}: -o must end in .csv, .csv.gz or .mcap")
+    out.parent.mkdir(parents=True, exist_ok=True)  # as every command's -o
     if out.suffix.lower() == ".mcap":
         dropped = [name for name in ("current", "temperature") if getattr(rec, name) is not None]
         if dropped:

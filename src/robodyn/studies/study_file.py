@@ -170,7 +170,7 @@ def _task(data: Mapping[str, Any], path: Path) -> Any:
         target = robot if (path.parent / robot).suffix == "" else str(path.parent / robot)
         try:
             kwargs["robot"] = RobotSource.of(target, data.get("tool"))
-        except FileNotFoundError as exc:
+        except (FileNotFoundError, StudyError) as exc:
             raise StudyError(f"{name}: robot: {exc}") from None
     try:
         return TASKS[kind](**kwargs)
