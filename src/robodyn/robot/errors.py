@@ -22,7 +22,8 @@ __all__ = [
 class RobodynError(Exception):
     """Base of every error robodyn raises about its input: catch this to handle them all.
 
-    Each subclass is also a :class:`ValueError` (bad input), as before.
+    Each subclass is also a :class:`ValueError` (bad input), as before, except
+    :class:`MissingExtraError` (an optional package not installed), an :class:`ImportError`.
     """
 
 
