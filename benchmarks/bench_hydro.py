@@ -204,13 +204,9 @@ def main() -> None:
     """Command line: run the parts, merge their figures into the results file."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="only the simulation part, 3 rounds")
-    parser.add_argument("--results", type=Path, default=None,
-                        help="results file (default: benchmarks/results/<machine>.json on full "
-                             "runs, none with --quick)")
-    parser.add_argument("--no-results", action="store_true", help="write no results file")
+    results.add_options(parser)
     args = parser.parse_args()
-    path = None if args.no_results else (
-        args.results or (None if args.quick else results.default_path()))
+    path = results.target(args)
     entry: dict[str, Any] = {
         "command": "python benchmarks/bench_hydro.py" + (" --quick" if args.quick else ""),
         "load_average_at_start": results.load_average()}

@@ -284,14 +284,10 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="fewer states and trajectories")
     parser.add_argument("--only", choices=("pinocchio", "kernels", "ensemble"), action="append",
                         help="run only these sections (repeatable; default: all)")
-    parser.add_argument("--results", type=Path, default=None,
-                        help="results file (default: benchmarks/results/<machine>.json on full "
-                             "runs, none with --quick)")
-    parser.add_argument("--no-results", action="store_true", help="write no results file")
+    results.add_options(parser)
     args = parser.parse_args()
     sections = set(args.only or ("pinocchio", "kernels", "ensemble"))
-    path = None if args.no_results else (
-        args.results or (None if args.quick else results.default_path()))
+    path = results.target(args)
     command = " ".join(["python benchmarks/bench_kernels.py", *(["--quick"] if args.quick else []),
                         *(f"--only {x}" for x in args.only or ())])
     if "pinocchio" in sections:

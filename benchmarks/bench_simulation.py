@@ -457,13 +457,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="fewer repetitions and states")
-    parser.add_argument("--results", type=Path, default=None,
-                        help="results file (default: benchmarks/results/<machine>.json on full "
-                             "runs, none with --quick)")
-    parser.add_argument("--no-results", action="store_true", help="write no results file")
+    results.add_options(parser)
     args = parser.parse_args()
-    path = None if args.no_results else (
-        args.results or (None if args.quick else results.default_path()))
+    path = results.target(args)
     start_load = results.load_average()
     entry: dict[str, Any] = {"command": " ".join(["python benchmarks/bench_simulation.py",
                                                   *(["--quick"] if args.quick else [])]),

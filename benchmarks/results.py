@@ -11,6 +11,7 @@ Used by the benchmarks (run as scripts: ``benchmarks/`` is on ``sys.path``) and 
 
 from __future__ import annotations
 
+import argparse
 import datetime
 import json
 import os
@@ -167,3 +168,18 @@ def merge(path: Path, name: str, entry: dict[str, Any]) -> Path:
 
 if __name__ == "__main__":  # the path of this machine's results file, for the Makefile
     print(default_path().relative_to(RESULTS_DIR.parent.parent))
+
+
+def add_options(parser: argparse.ArgumentParser) -> None:
+    """The ``--results PATH`` and ``--no-results`` options every benchmark that writes here has."""
+    parser.add_argument("--results", type=Path, default=None,
+                        help="results file (default: benchmarks/results/<machine>.json on full "
+                             "runs, none with --quick)")
+    parser.add_argument("--no-results", action="store_true", help="write no results file")
+
+
+def target(args: argparse.Namespace) -> Path | None:
+    """The results file a run writes (None: none), from :func:`add_options` and ``--quick``."""
+    if args.no_results:
+        return None
+    return args.results or (None if args.quick else default_path())

@@ -32,6 +32,9 @@ __all__ = ["lift_reaches_joints"]
 #: Lift below this fraction of the drag at every sampled state counts as none.
 RELATIVE_TOLERANCE = 1e-9
 
+#: Answers by (description hash, current, parameter values, samples, seed).
+_MEMO: dict[tuple, bool] = {}
+
 
 def lift_reaches_joints(robot: Robot, current: Sequence[float],
                         parameters: Mapping[str, float] | None = None, *, samples: int = 8,
@@ -54,6 +57,19 @@ def lift_reaches_joints(robot: Robot, current: Sequence[float],
     -------
     bool
     """
+    values = {**{k: float(v) for k, v in robot.parameters.items()}, **(parameters or {})}
+    key = (robot.description_hash, tuple(float(c) for c in current),
+           tuple(sorted(values.items())), samples, seed)
+    if robot.description_hash and key in _MEMO:
+        return _MEMO[key]  # a study runs the same check for every case
+    answer = _reaches(robot, current, values, samples, seed)
+    if robot.description_hash:
+        _MEMO[key] = answer
+    return answer
+
+
+def _reaches(robot: Robot, current: Sequence[float], values: Mapping[str, float], samples: int,
+             seed: int) -> bool:
     fluid = fluid_of(robot)
     if fluid is None:
         return False
@@ -70,7 +86,6 @@ def lift_reaches_joints(robot: Robot, current: Sequence[float],
             motion = cylinder_motion(robot, kin, i, cyl, q)
             lift += lift_torque(fluid, unit, cyl, motion, qd, h.quadrature)
             drag += drag_torque(fluid, unit, cyl, motion, qd, h.quadrature)
-    values = {**{k: float(v) for k, v in robot.parameters.items()}, **(parameters or {})}
     subs = {sp.Symbol(k, real=True): v for k, v in values.items()}
     f = sp.lambdify([q, qd], [lift.xreplace(subs), drag.xreplace(subs)], "numpy", cse=True)
     rng = np.random.default_rng(seed)
