@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 
 import numpy as np
@@ -197,19 +198,30 @@ def test_nongeometric_terms_cross_validated_and_the_description_alone_stated(dat
     worse = [b.split(" + ")[-1] for a, b in zip(names[:-1], names[1:], strict=True) if cv[b] > cv[a]]
     for family in worse:
         assert f"adding '{family}' made the held-out error worse" in captured.err
-    # the written description alone, evaluated here independently (loaded from the file, placed
-    # by its own base and tool), against the figure its header and the report state
+    # the written description alone, evaluated here by the compiled model's forward kinematics
+    # (loaded from the file, placed by its own base and tool), against the figures its header
+    # and the report state: with its corrections it reproduces cal.predict's figure
     import robodyn as rd
-    from robodyn.studies.calibration_study import robot_positions
 
     alone_robot = rd.load(str(tmp_path / "puma560_calibrated.yaml"))
+    assert alone_robot.corrections is not None
     held = read_calibration_csv(data / "si_test.csv", alone_robot, targets=2)
-    rms = float(np.sqrt(np.mean(np.sum((held.points[:, 0] - robot_positions(alone_robot, held.q)) ** 2,
-                                       axis=1))))
+    model = rd.compile_model(alone_robot)
+
+    def rms(m):
+        return float(np.sqrt(np.mean(np.sum((held.points[:, 0] - m.forward_kinematics(held.q)[:, :3, 3])
+                                            ** 2, axis=1))))
+
     stated = j["description_alone_m"]
     assert stated["poses"] == "si_test.csv"
-    assert stated["alone_rms"] == pytest.approx(rms, rel=1e-9)
+    assert stated["alone_rms"] == pytest.approx(rms(model), rel=1e-9)
+    assert stated["alone_rms"] == pytest.approx(stated["with_terms_rms"], rel=1e-9)
+    geometry_only = rd.compile_model(dataclasses.replace(alone_robot, corrections=None))
+    assert stated["urdf_geometry_only_rms"] == pytest.approx(rms(geometry_only), rel=1e-9)
     header = (tmp_path / "puma560_calibrated.yaml").read_text().splitlines()[0]
-    assert header.startswith("# estimated together with the non-geometric terms")
-    assert f"alone it predicts {rms * 1e3:.4f} mm RMS on si_test.csv" in header
-    assert "<!-- estimated together" in (tmp_path / "puma560_calibrated.urdf").read_text()
+    assert header.startswith("# carries the non-geometric terms as joint-reading corrections")
+    assert f"alone it predicts {rms(model) * 1e3:.4f} mm RMS on si_test.csv" in header
+    urdf = (tmp_path / "puma560_calibrated.urdf").read_text()
+    assert f"alone this file predicts {rms(geometry_only) * 1e3:.4f} mm RMS" in urdf
+    assert "joint-reading corrections (compliance, transmission errors of a calibration) are not " \
+           "written" in urdf

@@ -1,6 +1,6 @@
 """Exact static deflection of compliant joints (``deflection="exact"``).
 
-The truth is independent of :mod:`robodyn.calibration.deflection`: the link angles solve
+The truth is independent of :mod:`robodyn.numeric.deflection`: the link angles solve
 ``x = q - c * g(x)`` by plain fixed-point iteration (a contraction: ``|c dg/dq|`` is about 1e-2)
 with ``g`` from ``rd.compile_model(robot).gravity``; the derivative ``dg/dq`` is checked against
 central differences of that gravity, and the Jacobians against finite differences of the
@@ -14,10 +14,10 @@ import pytest
 
 import robodyn as rd
 from robodyn.calibration import build_model, calibrate, robot_geometry
-from robodyn.calibration.deflection import exact_deflection
 from robodyn.calibration.kinematics import trans
 from robodyn.calibration.models import extend_model
 from robodyn.calibration.nongeometric import build_nongeometric, gravity_torque, nominal_frames
+from robodyn.numeric.deflection import exact_deflection
 from robodyn.studies.calibration_study import perturbed_robot
 from tests.calibration.helpers import TARGET, TRACKER, poses, robot
 from tests.calibration.test_nongeometric import TARGETS, measured

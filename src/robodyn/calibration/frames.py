@@ -6,6 +6,7 @@ import numpy as np
 
 from robodyn.calibration.models import build_model
 from robodyn.calibration.nominal import robot_geometry
+from robodyn.numeric.joint_corrections import link_positions
 from robodyn.robot.model import Robot
 
 __all__ = ["robot_frames", "robot_positions"]
@@ -20,9 +21,13 @@ def robot_positions(robot: Robot, q: np.ndarray) -> np.ndarray:
 
 
 def robot_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """Tool frames of ``robot`` in its world frame for readings (N, n), shape (N, 4, 4)."""
+    """Tool frames of ``robot`` in its world frame for readings (N, n), shape (N, 4, 4).
+
+    The description's joint-reading corrections (``robot.corrections``) are applied first.
+    """
     model = build_model("hayati", robot_geometry(robot), orientation=True)
-    ev = model.evaluate(model.initial, np.atleast_2d(q), derivatives=False)
+    x = link_positions(robot, np.atleast_2d(np.asarray(q, dtype=float)))
+    ev = model.evaluate(model.initial, x, derivatives=False)
     out = np.zeros((len(ev.position), 4, 4))
     out[:, :3, :3], out[:, :3, 3], out[:, 3, 3] = ev.rotation, ev.position, 1.0
     return out

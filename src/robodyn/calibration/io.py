@@ -374,10 +374,12 @@ def _report_data(cal: Calibration) -> dict:
 
 
 def terms_data(cal: Calibration) -> dict:
-    """What the geometric description cannot hold: every target's offset and the non-geometric terms.
+    """Every target's offset and the non-geometric terms, with their names and units.
 
     Targets are positions in the calibrated robot's last link frame (the first is the robot's
-    tool); the terms are ``q_link = q + B(q) theta`` (:mod:`robodyn.calibration.nongeometric`).
+    tool; a description has one tool, so the others live only here); the terms are
+    ``q_link = q + B(q) theta`` (:mod:`robodyn.calibration.nongeometric`), which the YAML
+    description also carries as joint-reading corrections (:mod:`robodyn.robot.corrections`).
     """
     return {"robot": cal.robot.name, "model": cal.model.name,
             "targets_in_last_frame_m": cal.target_offsets().tolist(),
@@ -391,7 +393,8 @@ def write_calibration(cal: Calibration, out_dir: str | Path, *,
     Files: ``<stem>.yaml`` (robodyn description, :func:`robodyn.robot.yaml_writer.dump_yaml`),
     ``<stem>.urdf`` (:func:`robodyn.export.urdf.to_urdf`, when that exporter is available),
     ``<stem>_terms.yaml`` (every target's offset and the non-geometric terms, when there are
-    several targets or non-geometric terms: :func:`terms_data`),
+    several targets or non-geometric terms: :func:`terms_data`; the YAML description carries
+    the terms too, the URDF cannot),
     ``<stem>_report.txt`` (:meth:`Calibration.summary`), ``<stem>_report.json`` (the same as
     data, with the residuals) and ``<stem>_residuals.csv``.
 
@@ -427,7 +430,7 @@ def write_calibration(cal: Calibration, out_dir: str | Path, *,
     if cal.model.targets > 1 or cal.model.nongeometric is not None:
         import yaml
 
-        # the description's schema has no place for them: a companion file next to it
+        # the other targets (and the terms by their calibration names): a companion file
         paths["terms"] = names["terms"]
         paths["terms"].write_text(yaml.safe_dump(terms_data(cal), sort_keys=False), encoding="utf-8")
     try:

@@ -35,10 +35,12 @@ Only revolute joints get harmonics.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from robodyn.numeric.joint_corrections import holding_torque
+from robodyn.robot.corrections import CORRECTION_KINDS, HoldingTorque, JointCorrections
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 
@@ -83,12 +85,17 @@ class NonGeometric:
         ``(m, m r_x, m r_y, m r_z)``, N m per kg (per kg m); None unless the payload is identified.
     deflection : {"linear", "exact"}
         ``"linear"``: the holding torque at the readings, ``dq = -C tau(q)``. ``"exact"``: at the
-        deflected pose, ``x = u - C tau(x)`` (:mod:`robodyn.calibration.deflection`).
+        deflected pose, ``x = u - C tau(x)`` (:mod:`robodyn.numeric.deflection`).
     torque_jacobian : callable or None
         ``torque_jacobian(x)``: ``d tau / d x`` (N, n, n) for ``"exact"``.
     exact_torque : callable or None
         ``exact_torque(x)``: the holding torques (N, n) used by ``"exact"`` (the compiled model's
         gravity, plus a known payload).
+    holding : HoldingTorque or None
+        The point masses whose holding torque ``torque`` evaluates (without an identified
+        payload); what a calibrated description stores (:meth:`corrections`).
+    tool_zero : numpy.ndarray, shape (4, 4), or None
+        The nominal tool frame at zero readings (places an identified payload in ``holding``).
     """
 
     terms: tuple[str, ...]
@@ -104,6 +111,8 @@ class NonGeometric:
     deflection: str = "linear"
     torque_jacobian: Callable[[np.ndarray], np.ndarray] | None = None
     exact_torque: Callable[[np.ndarray], np.ndarray] | None = None
+    holding: HoldingTorque | None = None
+    tool_zero: np.ndarray | None = None
     _cache: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -158,7 +167,7 @@ class NonGeometric:
                           ) -> tuple[np.ndarray, np.ndarray]:
         """``dq = x - q`` (N, n) with ``x = u - C tau(x)``, ``u = q + B_h theta_h`` (the terms other
         than compliance), and its exact Jacobian (N, n, M) by the implicit function theorem."""
-        from robodyn.calibration.deflection import exact_deflection
+        from robodyn.numeric.deflection import exact_deflection
 
         kinds = np.array(self.kinds)
         comp = np.flatnonzero(kinds == "compliance")
@@ -193,6 +202,32 @@ class NonGeometric:
             # payload_mass, payload_moment: bilinear, in correction()
         return out
 
+    def corrections(self, theta: np.ndarray) -> JointCorrections:
+        """The terms at parameters ``theta`` (M,) as a description's joint-reading corrections.
+
+        Loaded with a calibrated description, forward kinematics then gives what
+        ``cal.predict`` gives (:mod:`robodyn.robot.corrections`): the same transmission terms, and
+        the compliance's holding torque of the same point masses (an identified payload added
+        as a point mass, or a mass and first moment, at the tool).
+        """
+        theta = np.asarray(theta, dtype=float)
+        column = {"ratio": 0, "cos": 1, "sin": 2, "motor_cos": 3, "motor_sin": 4, "compliance": 5}
+        table = np.zeros((len(self.gear_ratio), len(CORRECTION_KINDS)))
+        for j, kind, value in zip(self.joints, self.kinds, theta, strict=True):
+            if kind in column:
+                table[j, column[kind]] = value
+        holding = self.holding if "compliance" in self.terms else None
+        pay = [m for m, kind in enumerate(self.kinds) if kind.startswith("payload")]
+        if holding is not None and pay and self.tool_zero is not None:
+            pi = theta[pay]  # (m, m r) in the tool frame
+            moment = self.tool_zero[:3, :3] @ pi[1:] + pi[0] * self.tool_zero[:3, 3]
+            holding = replace(holding, masses=holding.masses + (float(pi[0]),),
+                              moments=holding.moments + _rows(moment),
+                              moved_by=holding.moved_by + (len(self.gear_ratio),),
+                              source=holding.source + " + identified payload")
+        return JointCorrections(tuple(tuple(float(v) for v in row) for row in table), holding,
+                                self.deflection)
+
     def as_dict(self, values: np.ndarray) -> dict:
         """The terms and their values as plain data (for the YAML/JSON output)."""
         return {
@@ -205,47 +240,11 @@ class NonGeometric:
         }
 
 
-def _point_mass_torque(frames: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
-                       types: Sequence[str], gravity: np.ndarray, masses: Sequence[tuple[int, float]],
-                       payload: tuple[float, np.ndarray] | None = None,
-                       ) -> Callable[[np.ndarray], np.ndarray]:
-    """Holding torques of point masses on the nominal chain.
-
-    ``frames(q)`` gives joint origins (N, n, 3), axes (N, n, 3) and tool frames (N, 4, 4) in the
-    frame of ``gravity``; ``masses`` are (after-joint index, kg) with the mass at the origin of the
-    next joint's frame (index n: the tool); ``payload`` is (kg, point in the tool frame).
-    """
-    types = tuple(types)
-    n = len(types)
-
-    def torque(q: np.ndarray) -> np.ndarray:
-        origins, axes, tool = frames(q)
-        pts = np.concatenate((origins, tool[:, None, :3, 3]), axis=1)  # (N, n + 1, 3)
-        out = np.zeros((len(q), n))
-        loads = [(pts[:, k], m, k) for k, m in masses]
-        if payload is not None:
-            p = tool[:, :3, :3] @ payload[1] + tool[:, :3, 3]
-            loads.append((p, payload[0], n))
-        for p, m, k in loads:
-            for j in range(min(k, n)):
-                z = axes[:, j]
-                # dp/dq_j = z x (p - o_j) (revolute) or z (prismatic); g_j = -m gravity . dp/dq_j
-                dp = np.cross(z, p - origins[:, j]) if types[j] == "revolute" else z
-                out[:, j] -= m * dp @ gravity
-        return out
-
-    return torque
-
-
-def gravity_torque(robot: Robot) -> Callable[[np.ndarray], np.ndarray]:
-    """``g(q)`` (N, n), N m (N): the holding torques of the robot's own links, evaluated numerically.
+def robot_holding(robot: Robot) -> HoldingTorque:
+    """The robot's own links as point masses on its nominal geometry (world frame, zero readings).
 
     The links' masses and centres of mass ride on the nominal geometry at ``q = 0``
-    (:func:`robodyn.calibration.nominal.robot_geometry`) moved by the joints' screw motions
-    (product of exponentials); ``g_j = -sum_{i >= j} m_i gravity . dc_i/dq_j`` with
-    ``dc/dq_j = u_j x (c - p_j)`` (revolute) or ``u_j`` (prismatic) about the moved axis
-    ``(p_j, u_j)``. The same as ``rd.compile_model(robot).gravity(q)`` without deriving or
-    compiling the whole model (tests/calibration/test_payload.py compares them).
+    (:func:`robodyn.calibration.nominal.robot_geometry`); link ``j`` moves with joints ``1 .. j``.
     """
     from robodyn.calibration.nominal import numeric, robot_geometry
 
@@ -255,40 +254,35 @@ def gravity_torque(robot: Robot) -> Callable[[np.ndarray], np.ndarray]:
     masses = np.array([float(link.mass.xreplace(subs)) for link in robot.links])
     coms = np.array([numeric(link.com, subs).ravel() for link in robot.links])
     com0 = np.einsum("nij,nj->ni", geometry.link_frames[:, :3, :3], coms) + geometry.link_frames[:, :3, 3]
-    pts, dirs, types = geometry.points, geometry.directions, geometry.joint_types
-    n = len(types)
+    dirs = geometry.directions / np.linalg.norm(geometry.directions, axis=1, keepdims=True)
+    return HoldingTorque(_rows(geometry.points), _rows(dirs), tuple(geometry.joint_types),
+                         tuple(float(m) for m in masses), _rows(masses[:, None] * com0),
+                         tuple(range(1, robot.dof + 1)), tuple(float(g) for g in gravity), "gravity model")
 
-    def torque(q: np.ndarray) -> np.ndarray:
-        q = np.asarray(q, dtype=float)
-        big_n = len(q)
-        rot = np.broadcast_to(np.eye(3), (big_n, 3, 3)).copy()  # G = prod exp(S_k q_k), k < j
-        trans = np.zeros((big_n, 3))
-        axis_p, axis_u, c = (np.zeros((big_n, n, 3)) for _ in range(3))
-        for j in range(n):
-            axis_p[:, j] = rot @ pts[j] + trans
-            axis_u[:, j] = rot @ dirs[j]
-            if types[j] == "revolute":
-                k = np.array([[0, -dirs[j][2], dirs[j][1]], [dirs[j][2], 0, -dirs[j][0]],
-                              [-dirs[j][1], dirs[j][0], 0]])
-                s, co = np.sin(q[:, j])[:, None, None], np.cos(q[:, j])[:, None, None]
-                r = np.eye(3) + s * k + (1 - co) * (k @ k)  # Rodrigues
-                t = pts[j] - r @ pts[j]  # rotation about the line through p_j
-            else:
-                r = np.broadcast_to(np.eye(3), (big_n, 3, 3))
-                t = q[:, j, None] * dirs[j]
-            trans = np.einsum("nij,nj->ni", rot, t) + trans
-            rot = rot @ r
-            c[:, j] = rot @ com0[j] + trans  # link j moves with joints 1..j
-        out = np.zeros((big_n, n))
-        for j in range(n):
-            if types[j] == "revolute":
-                dc = np.cross(axis_u[:, j, None], c[:, j:] - axis_p[:, j, None])
-            else:
-                dc = np.broadcast_to(axis_u[:, j, None], c[:, j:].shape)
-            out[:, j] = -(dc @ gravity) @ masses[j:]
-        return out
 
-    return torque
+def _rows(a: np.ndarray) -> tuple[tuple[float, float, float], ...]:
+    return tuple(tuple(float(v) for v in row) for row in np.asarray(a, dtype=float).reshape(-1, 3))
+
+
+def _with_points(holding: HoldingTorque, masses: Sequence[float], points: np.ndarray,
+                 moved_by: Sequence[int], source: str) -> HoldingTorque:
+    """``holding`` with point masses added (kg at ``points`` (K, 3), m, zero readings)."""
+    moments = np.asarray(masses, dtype=float)[:, None] * np.asarray(points, dtype=float).reshape(-1, 3)
+    return replace(holding, masses=holding.masses + tuple(float(m) for m in masses),
+                   moments=holding.moments + _rows(moments),
+                   moved_by=holding.moved_by + tuple(int(b) for b in moved_by), source=source)
+
+
+def gravity_torque(robot: Robot) -> Callable[[np.ndarray], np.ndarray]:
+    """``g(q)`` (N, n), N m (N): the holding torques of the robot's own links, evaluated numerically.
+
+    :func:`robot_holding` evaluated by :func:`robodyn.numeric.joint_corrections.holding_torque`
+    (product of exponentials on the nominal geometry): the same as
+    ``rd.compile_model(robot).gravity(q)`` without deriving or compiling the whole model
+    (tests/calibration/test_payload.py compares them).
+    """
+    holding = robot_holding(robot)
+    return lambda q: holding_torque(holding, q)
 
 
 def _compiled_gravity(robot: Robot, extra: Callable[[np.ndarray], np.ndarray] | None,
@@ -398,7 +392,7 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
         ``.mz``, its first moments in the tool frame, kg m); needs ``"compliance"``.
     deflection : {"linear", "exact"}
         ``"exact"`` solves the static equilibrium at the deflected pose
-        (:mod:`robodyn.calibration.deflection`) with the holding torques and their analytic
+        (:mod:`robodyn.numeric.deflection`) with the holding torques and their analytic
         derivatives from ``rd.compile_model(robot)`` (compiled on first use, cached); a known
         payload's torque derivative is taken by central differences of its closed form. Needs
         masses in the description; not combined with ``identify_payload``.
@@ -443,25 +437,34 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
             load = (mass, com)
         known = None if identify_payload else load
         types = [j.type for j in robot.joints]
+        origins0, axes0, tool0 = (a[0] for a in frames(np.zeros((1, n))))
+        payload_point = [] if known is None else [tool0[:3, :3] @ known[1] + tool0[:3, 3]]
         if any(m > 0 for m in masses):
-            own = gravity_torque(robot)  # numerically: no model to derive or compile
-            extra = _point_mass_torque(frames, types, gravity, [], known) if known else None
-
-            def torque(q: np.ndarray, own=own, extra=extra) -> np.ndarray:
-                tau = own(q)
-                return tau + extra(q) if extra is not None else tau
-
-            source = "gravity model" + (" + payload" if known else "")
+            holding = robot_holding(robot)  # numerically: no model to derive or compile
+            if known:
+                holding = _with_points(holding, [known[0]], payload_point, [n], "gravity model + payload")
             if deflection == "exact":
+                extra = None
+                if known:
+                    alone = _with_points(replace(holding, masses=(), moments=(), moved_by=()),
+                                         [known[0]], payload_point, [n], "payload")
+                    extra = lambda x, alone=alone: holding_torque(alone, x)  # noqa: E731
                 exact_torque, torque_jacobian = _compiled_gravity(robot, extra)
         else:
             if deflection == "exact":
                 raise InputError(f"deflection='exact' needs the link masses of {robot.name}: its "
                                  "description has none, so the compliance torques are a gravity-shaped "
                                  "basis of unknown scale; use deflection='linear'")
-            torque = _point_mass_torque(frames, types, gravity, [(k, 1.0) for k in range(1, n + 1)],
-                                        known)
-            source = "gravity-shaped basis"
+            # a 1 kg point mass on the axis of every joint after the first (riding on the link
+            # before it) and at the tool
+            empty = HoldingTorque(_rows(origins0), _rows(axes0), tuple(types), (), (), (),
+                                  tuple(float(g) for g in gravity))
+            holding = _with_points(empty, [1.0] * n + ([known[0]] if known else []),
+                                   np.vstack([origins0[1:], tool0[None, :3, 3], *payload_point]),
+                                   list(range(1, n + 1)) + ([n] if known else []),
+                                   "gravity-shaped basis" + (" + payload" if known else ""))
+        torque = lambda q, holding=holding: holding_torque(holding, q)  # noqa: E731
+        source = holding.source
         for j, joint in enumerate(robot.joints):
             names.append(f"{joint.name}.compliance")
             units.append("rad/(N m)" if joint.type == "revolute" else "m/N")
@@ -480,7 +483,9 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
                 joints.append(j)
                 kinds.append(kind)
     initial = [0.0] * len(names)
-    payload_torque = None
+    payload_torque = holding_block = tool_zero = None
+    if "compliance" in terms:
+        holding_block, tool_zero = holding, tool0
     if identify_payload:
         payload_torque = _payload_unit_torque(frames, [j.type for j in robot.joints], gravity)
         source += " + identified payload"
@@ -497,4 +502,4 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
         deflection = "linear"  # nothing deflects: the option changes nothing
     return NonGeometric(terms, tuple(names), tuple(units), tuple(joints), tuple(kinds), gear, torque,
                         source, np.array(initial), payload_torque, deflection, torque_jacobian,
-                        exact_torque)
+                        exact_torque, holding_block, tool_zero)

@@ -404,7 +404,7 @@ def calibrate(
         Compliance model: the holding torque at the readings (``"linear"``, first order, compiles
         nothing), or the static equilibrium at the deflected pose, ``x = u - C tau(x)``, solved by
         Newton with the compiled model's analytic gravity derivatives and an exact Jacobian
-        (``"exact"``, :mod:`robodyn.calibration.deflection`; compiles the model on first use). Needs
+        (``"exact"``, :mod:`robodyn.numeric.deflection`; compiles the model on first use). Needs
         ``"compliance"`` and link masses; not with ``identify_payload``.
 
     Returns

@@ -8,10 +8,12 @@ Two checks for a calibration with non-geometric terms (joint compliance, harmoni
   set says whether a family helps on poses it has not seen. A family that fits its own poses
   better but predicts held-out poses worse overfits (25 tracker poses with compliance and
   harmonics: held-out 0.31 -> 0.49 mm).
-* :func:`description_alone`: the written description (``cal.robot``) holds the geometry only;
-  the geometry was estimated together with the terms, so loaded alone (the way a controller or a
-  simulator takes it) it predicts differently from ``cal.predict``. The RMS of that prediction on
-  given poses is what the files' headers and the command line state.
+* :func:`description_alone`: what the written files predict loaded alone (the way a controller
+  or a simulator takes them). The YAML description carries the terms as joint-reading
+  corrections (``cal.robot.corrections``, :mod:`robodyn.robot.corrections`) and reproduces
+  ``cal.predict``; a URDF cannot hold them, and its geometry alone, estimated together with the
+  terms, predicts differently. The RMS of each on given poses is what the files' headers and the
+  command line state.
 """
 
 from __future__ import annotations
@@ -135,14 +137,23 @@ def _si_angles(robot: Robot, q: np.ndarray, options: dict[str, Any]) -> np.ndarr
     return out
 
 
-def description_alone(cal: Any, q: np.ndarray, points: np.ndarray) -> tuple[float, float]:
-    """RMS position error (m) on poses ``q`` (N, n, rad) against ``points`` (N, 3) or (N, K, 3)
-    (m, first target) of the written description alone and of ``cal.predict`` (with its terms)."""
+def description_alone(cal: Any, q: np.ndarray, points: np.ndarray) -> tuple[float, float, float]:
+    """RMS position errors (m) on poses ``q`` (N, n, rad) against ``points`` (N, 3) or (N, K, 3)
+    (m, first target).
+
+    Returns
+    -------
+    description, geometry, predict : float
+        The written description ``cal.robot`` with its joint-reading corrections, the same
+        geometry without them (what a URDF holds), and ``cal.predict``.
+    """
+    from dataclasses import replace
+
     from robodyn.calibration.frames import robot_positions
 
     first = points if points.ndim == 2 else points[:, 0]
-    alone = robot_positions(cal.robot, q)
     full = cal.predict(q)
-    full = full if full.ndim == 2 else full[:, 0]
-    rms = [float(np.sqrt(np.mean(np.sum((first - p) ** 2, axis=1)))) for p in (alone, full)]
-    return rms[0], rms[1]
+    preds = (robot_positions(cal.robot, q), robot_positions(replace(cal.robot, corrections=None), q),
+             full if full.ndim == 2 else full[:, 0])
+    rms = [float(np.sqrt(np.mean(np.sum((first - p) ** 2, axis=1)))) for p in preds]
+    return rms[0], rms[1], rms[2]

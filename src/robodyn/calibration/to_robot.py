@@ -70,6 +70,10 @@ def calibrated_robot(nominal: Robot, geometry: RobotGeometry, model: ErrorModel,
     name : str, optional
         Name of the new robot (default ``<nominal name>_calibrated``).
 
+    With non-geometric terms in ``model``, the robot carries them as joint-reading corrections
+    (``robot.corrections``, :meth:`~robodyn.calibration.nongeometric.NonGeometric.corrections`), so
+    that its forward kinematics of the readings equal the model's.
+
     Returns
     -------
     Robot
@@ -98,7 +102,10 @@ def calibrated_robot(nominal: Robot, geometry: RobotGeometry, model: ErrorModel,
         tool[:3, :3] = model.tool_rotation
     rot = base[:3, :3] @ geometry.base[:3, :3].T  # instrument <- robot world
     gravity = rot @ numeric(nominal.gravity, subs).ravel()
+    ng = model.nongeometric
+    corrections = ng.corrections(params[model.nongeometric_slice]) if ng is not None else None
     return Robot(
+        corrections=corrections,
         name=name or f"{nominal.name}_calibrated",
         joints=tuple(joints),
         links=nominal.links,

@@ -259,7 +259,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
 
 def _terms_check(args: argparse.Namespace, robot: rd.Robot, cal: Any, data: Any, sigma: Any,
                  units: dict[str, str], poses: tuple[str, Any, Any], paths: dict[str, Any],
-                 stem: str) -> tuple[Any, tuple[str, float, float]]:
+                 stem: str) -> tuple[Any, tuple[str, float, float, float]]:
     """The non-geometric terms cross-validated over the poses, and the written description's own
     figure on ``poses`` (name, q rad, points m), stated in its files and the JSON report."""
     from robodyn.calibration.term_check import description_alone, terms_cross_validation
@@ -275,7 +275,7 @@ def _terms_check(args: argparse.Namespace, robot: rd.Robot, cal: Any, data: Any,
         "terms_cross_validation_m": {" + ".join(("geometry",) + t): r
                                      for t, r in zip(check.term_sets, check.rms, strict=True)},
         "description_alone_m": {"poses": alone[0], "alone_rms": alone[1],
-                                "with_terms_rms": alone[2]}})
+                                "urdf_geometry_only_rms": alone[2], "with_terms_rms": alone[3]}})
     return check, alone
 
 
@@ -288,34 +288,40 @@ def _add_to_report(path: Path, entries: dict[str, Any]) -> None:
     path.write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
 
 
-def _print_terms(check: Any, alone: tuple[str, float, float], yaml_name: str, stem: str) -> None:
-    """The terms' cross-validation, a warning per family that overfits, and the description's
-    own figure (:mod:`robodyn.calibration.term_check`)."""
+def _print_terms(check: Any, alone: tuple[str, float, float, float], yaml_name: str, stem: str) -> None:
+    """The terms' cross-validation, a warning per family that overfits, and what the written
+    files predict alone (:mod:`robodyn.calibration.term_check`)."""
     print(f"\n{check.text()}")
     for family in check.overfitting:
         err(f"robodyn: warning: adding '{family}' made the held-out error worse "
             "(cross-validation over poses): it fits these poses, not the arm; consider "
             "leaving it out")
-    err(f"robodyn: note: {yaml_name} holds the geometry only, estimated together with the "
-        f"non-geometric terms of {stem}_terms.yaml: loaded alone it predicts "
-        f"{alone[1] * 1e3:.4f} mm RMS on {alone[0]} (with the terms, cal.predict: "
-        f"{alone[2] * 1e3:.4f} mm)")
+    err(f"robodyn: note: {yaml_name} carries the non-geometric terms as joint-reading corrections: "
+        f"loaded alone it predicts {alone[1] * 1e3:.4f} mm RMS on {alone[0]} (cal.predict: "
+        f"{alone[3] * 1e3:.4f} mm); {stem}.urdf cannot hold them and predicts "
+        f"{alone[2] * 1e3:.4f} mm")
 
 
-def _state_alone(paths: dict[str, Any], alone: tuple[str, float, float], stem: str) -> None:
+def _state_alone(paths: dict[str, Any], alone: tuple[str, float, float, float], stem: str) -> None:
     """Say in the written description's header (YAML and URDF) what it predicts alone."""
-    line = (f"estimated together with the non-geometric terms of {stem}_terms.yaml, which this "
-            f"file cannot hold: alone it predicts {alone[1] * 1e3:.4f} mm RMS on {alone[0]} "
-            f"(with the terms: {alone[2] * 1e3:.4f} mm)")
+    lines = {
+        "yaml": (f"carries the non-geometric terms as joint-reading corrections (block "
+                 f"'corrections'): alone it predicts {alone[1] * 1e3:.4f} mm RMS on {alone[0]} "
+                 f"(cal.predict: {alone[3] * 1e3:.4f} mm)"),
+        "urdf": (f"geometry estimated together with non-geometric terms that URDF cannot hold "
+                 f"(they are in {stem}.yaml): alone this file predicts {alone[2] * 1e3:.4f} mm RMS "
+                 f"on {alone[0]} (with them: {alone[1] * 1e3:.4f} mm)"),
+    }
     yaml_path = paths.get("yaml")
     if yaml_path is not None:
-        yaml_path.write_text(f"# {line}\n" + yaml_path.read_text(encoding="utf-8"), encoding="utf-8")
+        yaml_path.write_text(f"# {lines['yaml']}\n" + yaml_path.read_text(encoding="utf-8"),
+                             encoding="utf-8")
     urdf = paths.get("urdf")
     if urdf is not None:
         text = urdf.read_text(encoding="utf-8")
         head, sep, rest = text.partition("?>")
-        comment = "\n<!-- " + line.replace("--", "- -") + " -->"
-        urdf.write_text(head + sep + comment + rest if sep else f"<!-- {line} -->\n" + text,
+        comment = "\n<!-- " + lines["urdf"].replace("--", "- -") + " -->"
+        urdf.write_text(head + sep + comment + rest if sep else f"<!-- {lines['urdf']} -->\n" + text,
                         encoding="utf-8")
 
 

@@ -137,6 +137,12 @@ def to_urdf(
             f"gravity {nm.vector_text(gravity)} m/s^2 is not written (URDF has no gravity; "
             f"readers assume {nm.vector_text(URDF_GRAVITY)})"
         )
+    if robot.corrections is not None:
+        note = ("joint-reading corrections (compliance, transmission errors of a calibration) are "
+                "not written: URDF has no element for them, so this file's forward kinematics are "
+                "those of the geometry alone; the robodyn YAML description keeps them")
+        dropped.notes.append(note)
+        root.insert(1, etree.Comment(" " + note + " "))
     dropped.warn(robot)
     document = etree.tostring(root, pretty_print=True, xml_declaration=True, encoding="UTF-8").decode()
     if path is not None:

@@ -7,6 +7,7 @@ Array rules (DESIGN.md): one state is ``(n,)``, a batch is ``(N, n)``; results a
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 import hashlib
 import importlib.util
@@ -43,6 +44,7 @@ from robodyn.codegen.kernels import (
 from robodyn.codegen.python import PythonPrinter
 from robodyn.numeric.checks import out_buffer, structural_singularity, without_infinities
 from robodyn.numeric.integrate_numpy import integrate_numpy as _integrate_numpy
+from robodyn.numeric.joint_corrections import link_positions
 from robodyn.numeric.runtime_parameters import check_physics, parameter_array, runtime_names
 from robodyn.robot.errors import InputError, SimulationError, SingularMassMatrixError
 from robodyn.robot.model import Robot
@@ -240,13 +242,27 @@ class Model:
 
     def forward_kinematics(self, q: np.ndarray, *, threads: int = 1,
                            parameters: ParameterValues = None) -> np.ndarray:
-        """End-effector pose in the base frame, (4, 4) or (N, 4, 4)."""
+        """End-effector pose in the base frame, (4, 4) or (N, 4, 4).
+
+        When the description carries joint-reading corrections (a calibration's compliance and
+        transmission errors, ``robot.corrections``), ``q`` are the joint readings and the pose is
+        that of the corrected link angles (:func:`robodyn.numeric.joint_corrections.link_positions`).
+        """
+        if self.robot.corrections is not None:
+            q = link_positions(self.robot, q)
         return self._call("forward_kinematics", q, threads=threads, parameters=parameters)
 
     def jacobian(self, q: np.ndarray, *, threads: int = 1,
                  parameters: ParameterValues = None) -> np.ndarray:
-        """Geometric Jacobian ``[v; omega]`` of the tool origin, base frame, (6, n) or (N, 6, n)."""
-        return self._call("jacobian", q, threads=threads, parameters=parameters)
+        """Geometric Jacobian ``[v; omega]`` of the tool origin, base frame, (6, n) or (N, 6, n).
+
+        With joint-reading corrections (see :meth:`forward_kinematics`), with respect to the
+        readings: ``J(x) dx/dq``.
+        """
+        if self.robot.corrections is None:
+            return self._call("jacobian", q, threads=threads, parameters=parameters)
+        x, dx = link_positions(self.robot, q, derivative=True)
+        return self._call("jacobian", x, threads=threads, parameters=parameters) @ dx
 
     def regressor(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, *,
                   threads: int = 1, parameters: ParameterValues = None,
@@ -653,7 +669,7 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
     runtime = runtime_names(robot, runtime_parameters)
     # generated sources are cached by (description, folded values, runtime names, generator)
     folded = sorted((k, v) for k, v in values.items() if k not in runtime)
-    key = hashlib.sha256(repr((robot.description_hash, folded, backend, _generator_hash())
+    key = hashlib.sha256(repr((_code_hash(robot), folded, backend, _generator_hash())
                               + ((runtime,) if runtime else ())).encode()).hexdigest()[:24]
     directory = cache_dir()
     marker = directory / f"rd_model_{key}.singular"
@@ -683,6 +699,15 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
     if singular is not None:
         sources += (marker,)
     return Model(robot, backend, tuple(sorted(values.items())), impl, runtime, singular, sources)
+
+
+def _code_hash(robot: Robot) -> str:
+    """The description's hash without what the generated code does not depend on (joint-reading
+    corrections, applied in NumPy before the kernels): a calibrated description shares its
+    compiled model with the same geometry without corrections."""
+    if robot.corrections is None:
+        return robot.description_hash
+    return dataclasses.replace(robot, corrections=None, description_hash="").description_hash
 
 
 def _from_cache(paths: Sequence[Path], write: Callable[[], None], load: Callable[[], Any]) -> Any:
@@ -722,7 +747,7 @@ def _compile_derivatives(model: Model, names: tuple[str, ...] = DERIVATIVE_KERNE
     runtime = model.runtime_parameters
     folded = sorted((k, v) for k, v in values.items() if k not in runtime)
     what = "derivatives" if tag == "deriv" else tag
-    key = hashlib.sha256(repr((robot.description_hash, folded, backend, what,
+    key = hashlib.sha256(repr((_code_hash(robot), folded, backend, what,
                                _generator_hash()) + ((runtime,) if runtime else ()))
                          .encode()).hexdigest()[:24]
     directory = cache_dir()

@@ -28,6 +28,7 @@ from typing import Any, Literal
 
 import sympy as sp
 
+from robodyn.robot.corrections import JointCorrections
 from robodyn.robot.errors import InputError
 
 JointType = Literal["revolute", "prismatic"]
@@ -192,6 +193,10 @@ class Robot:
     fluid : Mapping or None
         The description's ``fluid`` block (density, current), kept verbatim like ``Link.hydro``;
         read by :func:`robodyn.robot.hydro.fluid_of`.
+    corrections : JointCorrections or None
+        Joint-reading corrections of a kinematic calibration (compliance, transmission errors),
+        honoured by forward kinematics (:mod:`robodyn.robot.corrections`); None for a rigid,
+        exactly transmitted arm.
     """
 
     name: str
@@ -204,6 +209,7 @@ class Robot:
     source: str = "<memory>"
     description_hash: str = ""
     fluid: Mapping[str, Any] | None = None
+    corrections: JointCorrections | None = None
 
     def __post_init__(self) -> None:
         if len(self.joints) != len(self.links):
@@ -211,6 +217,9 @@ class Robot:
                 f"{self.source}: robot {self.name!r} has {len(self.joints)} joints but "
                 f"{len(self.links)} links; every joint moves exactly one link"
             )
+        if self.corrections is not None and len(self.corrections.table) != len(self.joints):
+            raise InputError(f"{self.source}: corrections for {len(self.corrections.table)} joints, "
+                             f"robot {self.name!r} has {len(self.joints)}")
         if not isinstance(self.parameters, MappingProxyType):
             object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
         if not self.description_hash:
@@ -262,6 +271,8 @@ def _canonical_text(robot: Robot) -> str:
     }
     if robot.fluid is not None:  # only then: hashes of robots without one stay as they were
         data["fluid"] = _plain(robot.fluid)
+    if robot.corrections is not None:  # likewise
+        data["corrections"] = robot.corrections.as_plain(robot.joint_names)
     return json.dumps(data, sort_keys=True, default=_json_default)
 
 

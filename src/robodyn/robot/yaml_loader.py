@@ -22,6 +22,7 @@ import sympy as sp
 from robodyn import spatial as S
 from robodyn.robot import placement, validation
 from robodyn.robot.chain import ChainElement, assemble
+from robodyn.robot.corrections import corrections_from_plain
 from robodyn.robot.errors import DescriptionError
 from robodyn.robot.expressions import parameter_symbol, parse_value
 from robodyn.robot.hydro import parse_fluid, parse_hydro
@@ -43,7 +44,8 @@ JOINT_TYPES: Mapping[str, str] = MappingProxyType(
     {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic", "fixed": "fixed"}
 )
 
-_TOP_KEYS = ("name", "description", "parameters", "gravity", "base", "tool", "fluid", "joints")
+_TOP_KEYS = ("name", "description", "parameters", "gravity", "base", "tool", "fluid", "corrections",
+             "joints")
 _JOINT_KEYS = ("name", "type", "dh", "mdh", "origin", "axis", "limits", "drive", "friction", "link")
 _PLACEMENTS = ("dh", "mdh", "origin")
 _DH_KEYS = ("a", "alpha", "d", "theta")
@@ -266,8 +268,13 @@ class _Reader:
             name, elements, gravity=gravity, parameters=dict(self.defaults),
             source=self.source, **kwargs,
         )
-        return robot if fluid is None else dataclasses.replace(
-            robot, fluid=fluid, description_hash="")
+        extra: dict[str, Any] = {}
+        if fluid is not None:
+            extra["fluid"] = fluid
+        if "corrections" in top:
+            extra["corrections"] = corrections_from_plain(top["corrections"], robot.joint_names,
+                                                          self.source)
+        return dataclasses.replace(robot, **extra, description_hash="") if extra else robot
 
     def check_immersion(self, fluid: Any, elements: Sequence[ChainElement]) -> None:
         """A fluid block needs a link with hydro data (hydro alone means still fresh water)."""

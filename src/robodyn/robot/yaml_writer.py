@@ -328,6 +328,10 @@ def dump_yaml(robot: Robot) -> str:
     if robot.fluid is not None:
         text = yaml.safe_dump(_plain_data(robot.fluid), default_flow_style=True, width=10**6)
         lines.append(f"fluid: {text.strip()}")
+    if robot.corrections is not None:  # floats as repr: read back bit for bit
+        block = yaml.safe_dump({"corrections": robot.corrections.as_plain(robot.joint_names)},
+                               default_flow_style=None, sort_keys=False, width=10**6)
+        lines += block.rstrip("\n").split("\n")
     lines.append("joints:")
     for k, (joint, xyz, rpy, link) in enumerate(joints):
         lines += _joint_lines(joint, xyz, rpy, link, value, f"joints[{k}]")
