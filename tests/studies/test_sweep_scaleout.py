@@ -141,3 +141,43 @@ def test_bundle_limits_and_refusals():
         ModelBundle("cpu", (("../../.bashrc", b""),))
     assert bundle_models([]).files == ()
     assert ModelSpec(RobotSource.of("planar_2r")).model().backend == "c"
+
+
+_UNDERWATER_WORKER = """
+import json, pickle, sys
+from robodyn.studies.shipping import install_once
+from robodyn.studies.underwater_task import UnderwaterEffects
+from tests.studies.tasks import has_compiler
+
+assert not has_compiler()
+install_once(pickle.loads(open(sys.argv[1], "rb").read()))
+task = UnderwaterEffects(move_time=0.2, hold_time=0.1, free_time=0.2, dt=5e-3)
+print(json.dumps([task(c) for c in json.loads(sys.argv[2])]))
+"""
+
+
+@pytest.mark.tool("gcc|cc")
+def test_underwater_task_ships_the_models_it_uses(tmp_path):
+    # issue 24: UnderwaterEffects listed no models, so its workers needed a compiler. A process
+    # with an empty cache and no compiler runs its cases from the shipped bundle alone.
+    import json
+    import pickle
+
+    from robodyn.studies.underwater_task import UnderwaterEffects
+
+    task = UnderwaterEffects(move_time=0.2, hold_time=0.1, free_time=0.2, dt=5e-3)
+    cases = [{"Cd": 1.0}, {"Cd": 1.4, "vc": 0.3}, {"Cd": 1.0, "seed": 3}, {"nonsense": 1.0}]
+    specs = task.compiled_models(cases)
+    assert [s.effect for s in specs] == ["dry", "current"] * 2  # the refused case lists nothing
+    bundle = models_to_ship(task, cases, None)
+    assert bundle is not None and len([n for n, _ in bundle.files if n.endswith(".so")]) == 4
+    (tmp_path / "bundle.pkl").write_bytes(pickle.dumps(bundle))
+    empty = tmp_path / "bin"
+    empty.mkdir()
+    run = subprocess.run(
+        [sys.executable, "-c", _UNDERWATER_WORKER, str(tmp_path / "bundle.pkl"), json.dumps(cases[:3])],
+        cwd=ROOT, capture_output=True, text=True, timeout=300,
+        env={**os.environ, "ROBODYN_CACHE": str(tmp_path / "cache"), "PATH": str(empty),
+             "CC": str(tmp_path / "no-such-cc")})
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert json.loads(run.stdout) == [task(c) for c in cases[:3]]  # bit for bit (JSON floats: repr)

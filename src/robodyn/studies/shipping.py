@@ -8,7 +8,8 @@ without deriving or compiling anything when the cache holds the generated source
 
 1. it asks the task which compiled models its cases use (an optional method
    ``compiled_models(cases) -> list of ModelSpec``: :class:`~robodyn.studies.ActuatorSizing` and
-   :class:`~robodyn.studies.IdentificationMonteCarlo` have one), builds or loads them here
+   :class:`~robodyn.studies.IdentificationMonteCarlo` and
+   :class:`~robodyn.studies.underwater_task.UnderwaterEffects` have one), builds or loads them here
    (:func:`bundle_models`) and reads their cache files into one :class:`ModelBundle`;
 2. the bundle travels with the sweep as a Dask worker plugin (:class:`ShipModels`, registered
    for the sweep's duration), which Dask sends to every worker before that worker takes a task:
@@ -177,8 +178,8 @@ def models_to_ship(task: Any, cases: Sequence[dict[str, Any]], ship: bool | None
     Parameters
     ----------
     task : callable
-        A study task; one with ``compiled_models(cases) -> list of ModelSpec`` has those built
-        (or loaded from the cache) here.
+        A study task; one with ``compiled_models(cases) -> list of ModelSpec`` (or of other specs
+        with a ``model()`` method) has those built (or loaded from the cache) here.
     cases : sequence of dict
     ship : bool or None
         None: ship when the task lists at most :data:`SHIP_LIMIT` models; True: whatever the
@@ -195,7 +196,9 @@ def models_to_ship(task: Any, cases: Sequence[dict[str, Any]], ship: bool | None
     if ship is False or listed is None:
         return None
     try:
-        specs = list(dict.fromkeys(ModelSpec(*s) for s in listed(cases)))
+        # a ModelSpec, or any spec with a model() method (UnderwaterEffects' EffectModelSpec)
+        specs = list(dict.fromkeys(s if callable(getattr(s, "model", None)) else ModelSpec(*s)
+                                   for s in listed(cases)))
     except Exception as exc:  # noqa: BLE001 - listing is an optimisation: the cases still run
         log.warning("robodyn.sweep: compiled models not shipped: listing them failed (%s: %s)",
                     type(exc).__name__, exc)
@@ -210,8 +213,7 @@ def models_to_ship(task: Any, cases: Sequence[dict[str, Any]], ship: bool | None
         try:
             models.append(spec.model())
         except Exception as exc:  # noqa: BLE001 - the cases report it, or the workers build it
-            log.warning("robodyn.sweep: model of %s (payload %g) not shipped: %s: %s",
-                        spec.source.name, spec.payload, type(exc).__name__, exc)
+            log.warning("robodyn.sweep: model %s not shipped: %s: %s", spec, type(exc).__name__, exc)
     if not models:
         return None
     try:

@@ -280,6 +280,19 @@ def _rms(a: np.ndarray) -> np.ndarray:
     return np.sqrt(np.mean(a**2, axis=0))
 
 
+def effect_model(robot: Robot, effect: str, parameters: Mapping[str, float], *, backend: str = "c",
+                 current: Sequence[float] | None = None, lift: float | None = None) -> Model:
+    """The compiled model :func:`effect_series` simulates for ``effect`` (one of :data:`EFFECTS`).
+
+    ``current`` as in :func:`effect_series` (None: the description's, else the default);
+    ``parameters`` are compiled in. Compiled once per description and values (cached), so
+    study tasks list these models for a sweep to ship (:mod:`robodyn.studies.shipping`).
+    """
+    c = _series_current(robot, parameters, current)
+    variant = effect_variant(robot, effect, current=c, lift=lift)
+    return compile_model(variant, backend=backend, parameters=dict(parameters))  # type: ignore[arg-type]
+
+
 def effect_series(robot: Robot, *, start: Sequence[float] | None = None,
                   end: Sequence[float] | None = None, move_time: float = 2.0,
                   hold_time: float = 1.0, free_time: float = 3.0, dt: float = 1e-3,
@@ -362,8 +375,8 @@ def effect_series(robot: Robot, *, start: Sequence[float] | None = None,
     bar = tqdm(chosen, desc=f"underwater {robot.name}", unit="variant", disable=not progress)
     for effect in bar:
         bar.set_postfix_str(LABELS[effect])
-        variant = effect_variant(robot, effect, current=c, lift=lift)
-        model = compile_model(variant, backend=backend, parameters=params)  # type: ignore[arg-type]
+        model = effect_model(robot, effect, params, backend=backend, current=c, lift=lift)
+        variant = model.robot
         if effect == "dry":
             kp, kd = _gains(model, q0, bandwidth)
         tracked = simulate(model, q0, None, duration, dt, controller=PD(kp, kd, reference))

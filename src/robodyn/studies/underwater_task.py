@@ -11,23 +11,41 @@ on). Results, per joint ``j`` (N m or N; rad or m), of that variant:
 * ``max_error.j``: largest tracking error.
 
 Compiled variants are cached by robodyn (description and values), so a worker compiles each
-variant of the robot once.
+variant of the robot once; a sweep builds them once and ships them to its workers
+(:meth:`UnderwaterEffects.compiled_models`, :mod:`robodyn.studies.shipping`), so workers need
+no compiler.
 """
 
 from __future__ import annotations
 
 import warnings
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 from robodyn.robot.errors import StudyError
 from robodyn.studies.models import RobotSource, robot_of
 
-__all__ = ["UNDERWATER_RESULTS", "UnderwaterEffects"]
+__all__ = ["UNDERWATER_RESULTS", "EffectModelSpec", "UnderwaterEffects"]
 
 #: Table columns of :func:`effect_series` reported per joint.
 UNDERWATER_RESULTS = ("peak_tau", "rms_tau", "free_amplitude", "max_error")
+
+
+class EffectModelSpec(NamedTuple):
+    """One compiled model of the effect series (:func:`robodyn.studies.underwater.effect_model`),
+    listed by :meth:`UnderwaterEffects.compiled_models` for a sweep to ship."""
+
+    source: RobotSource
+    effect: str
+    parameters: tuple[tuple[str, float], ...] = ()
+    backend: str = "c"
+
+    def model(self) -> Any:
+        """The compiled model (cached on disk by robodyn)."""
+        from robodyn.studies.underwater import effect_model
+
+        return effect_model(robot_of(self.source), self.effect, dict(self.parameters), backend=self.backend)
 
 
 @dataclass(frozen=True)
@@ -80,12 +98,29 @@ class UnderwaterEffects:
                 raise StudyError(f"{where}: unknown parameter {key!r} for the underwater effects of "
                                  f"{self.robot.name} (known: {', '.join(known)})")
 
+    def _values(self, case: Mapping[str, Any]) -> dict[str, float]:
+        values = {k: v for k, v in case.items() if k != "seed"}  # deterministic: no draws
+        self.check_case(values, "case")
+        return {k: float(v) for k, v in {**self.defaults, **values}.items()}
+
+    def compiled_models(self, cases: Sequence[Mapping[str, Any]]) -> list[EffectModelSpec]:
+        """The compiled models ``cases`` use (the dry arm, with its controller's gains, and the
+        reported variant, per distinct parameter values), for a sweep to build once and ship
+        to its workers (:mod:`robodyn.studies.shipping`). Cases this task would refuse are skipped."""
+        specs: dict[EffectModelSpec, None] = {}
+        for case in cases:
+            try:
+                params = tuple(sorted(self._values(case).items()))
+            except (StudyError, TypeError, ValueError):
+                continue  # the case itself reports it
+            for effect in ("dry", self.effect):
+                specs[EffectModelSpec(self.robot, effect, params, self.backend)] = None
+        return list(specs)
+
     def __call__(self, case: Mapping[str, Any]) -> dict[str, float]:
         from robodyn.studies.underwater import effect_series
 
-        values = {k: v for k, v in case.items() if k != "seed"}  # deterministic: no draws
-        self.check_case(values, "case")
-        params = {k: float(v) for k, v in {**self.defaults, **values}.items()}
+        params = self._values(case)
         robot = robot_of(self.robot)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # plausibility notes: the same for every case
