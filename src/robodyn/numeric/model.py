@@ -6,31 +6,20 @@ Array rules (DESIGN.md): one state is ``(n,)``, a batch is ``(N, n)``; results a
 
 from __future__ import annotations
 
-import contextlib
-import dataclasses
-import functools
 import hashlib
-import importlib.util
-import os
-import subprocess
-import sys
-import tempfile
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 from types import ModuleType
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 
 from robodyn.codegen.build import (
-    CFLAGS,
     CompiledLibrary,
-    CompilerNotFoundError,
     cache_dir,
     compile_library,
-    find_compiler,
 )
 from robodyn.codegen.c import CPrinter
 from robodyn.codegen.c_outputs import STREAM_MIN_BYTES
@@ -43,22 +32,30 @@ from robodyn.codegen.kernels import (
 )
 from robodyn.codegen.python import PythonPrinter
 from robodyn.numeric.checks import out_buffer, structural_singularity, without_infinities
-from robodyn.numeric.integrate_numpy import integrate_numpy as _integrate_numpy
 from robodyn.numeric.joint_corrections import link_positions
-from robodyn.numeric.runtime_parameters import check_physics, parameter_array, runtime_names
-from robodyn.robot.errors import InputError, SimulationError, SingularMassMatrixError
+from robodyn.numeric.model_cache import (
+    _code_hash,
+    _from_cache,
+    _generator_hash,
+    _import_file,
+    _kernels_cached,
+    _write_atomic,
+    openmp_flags,
+)
+from robodyn.numeric.rollout import rollout, thread_count
+from robodyn.numeric.runtime_parameters import (
+    ParameterValues,
+    check_physics,
+    parameter_array,
+    runtime_names,
+)
+from robodyn.robot.errors import InputError, SingularMassMatrixError
 from robodyn.robot.model import Robot
 from robodyn.robot.overrides import checked_parameter_values
 
 Backend = Literal["c", "numpy"]
-#: Runtime parameter values: a mapping (name -> value), a sequence of N mappings, or an array
-#: (P,) / (N, P) in the order of :attr:`Model.runtime_parameters`.
-ParameterValues = Mapping[str, float] | Sequence[Mapping[str, float]] | np.ndarray | None
 _PREFIX = "rd_"
 
-#: Largest output of one :meth:`Model.integrate` call (states and torques), bytes: longer runs
-#: are split into several calls (as :func:`robodyn.simulation.simulate` does).
-MAX_INTEGRATE_BYTES = 1 << 30
 
 
 @dataclass(frozen=True, eq=False)
@@ -380,176 +377,14 @@ class Model:
                   mode: str = "feedback", tau_limit: np.ndarray | None = None,
                   control: str = "sampled", threads: int = 1,
                   parameters: ParameterValues = None) -> tuple[np.ndarray, np.ndarray]:
-        """Fixed-step trajectory under a state-feedback law, in one call.
-
-        With ``e = reference[row] - x``::
-
-            "feedback":         tau = feedforward[row] + gain e + integral_gain * integral(e_q dt)
-            "gravity":          the same + g(q)
-            "computed_torque":  tau = M(q) (feedforward[row] + gain e) + C qd + g + friction
-
-        then clipped to ``+-tau_limit``. ``control="sampled"``: the law is evaluated at the start
-        of step k (row k) and held over the step, as a digital controller at the integration
-        rate; the integral is ``dt sum(e_q)`` including the current sample.
-        ``control="continuous"`` (RK4 only): the law is evaluated at every RK4 stage on the
-        stage's state, with rows sampled every ``dt / 2`` (row 2k at the start of step k), and
-        the integral is integrated by the same RK4: a continuous-time controller.
-
-        An ensemble: ``x0`` of shape (N, 2 n) integrates N trajectories under the same law and
-        inputs in one C call (sampled control only), a block of trajectories per vector loop
-        (SIMD across trajectories) and blocks on ``threads`` threads; each trajectory has the
-        same bits as its own run. Results gain a leading N.
-
-        Parameters
-        ----------
-        x0 : (2 n,) or (N, 2 n)
-            Initial ``[q, qd]``, or one per trajectory.
-        steps : int
-        dt : float
-            Step (s).
-        method : {"rk4", "semi_implicit"}
-            Classical RK4, or semi-implicit Euler (velocity first, then position with the new
-            velocity: symplectic only while M is constant, first order in general).
-        feedforward : (steps, n) or (2 steps + 1, n) when continuous, optional
-            Torques, or accelerations under "computed_torque".
-        reference : (steps, 2 n) or (2 steps + 1, 2 n) when continuous, optional
-            Desired ``[q, qd]`` per sample.
-        gain : (n, 2 n), optional
-            State-feedback gain (``[Kp, Kd]`` for PD, an LQR gain, ...).
-        integral_gain : (n,), optional
-        mode : {"feedback", "gravity", "computed_torque"}
-        tau_limit : (n,), optional
-            Actuator limits (N m or N), positive.
-        control : {"sampled", "continuous"}
-        threads : int
-            Threads of an ensemble (C backend with OpenMP; results do not depend on it).
-        parameters : mapping, sequence of N mappings, or (P,) / (N, P), optional
-            Values of the :attr:`runtime_parameters`: one set, or one per trajectory of an
-            ensemble (each integrated with its own dynamics and model-based law, in the same
-            one C call); checked like compile-time values (finite, physically possible).
-
-        Returns
-        -------
-        x : (steps + 1, 2 n) or (N, steps + 1, 2 n)
-            States, ``x[0] = x0``.
-        tau : (steps, n) or (N, steps, n)
-            Torques at the start of each step (those applied over it when sampled).
-
-        Raises
-        ------
-        FloatingPointError
-            When the state stops being finite (the step is named).
+        """Fixed-step trajectory under a state-feedback law, in one call: states
+        ``(steps + 1, 2 n)`` and torques ``(steps, n)`` (a leading N for an ensemble ``x0`` of
+        shape (N, 2 n)). The law, arguments and errors are those of
+        :func:`robodyn.numeric.rollout.rollout`, which this calls with the model.
         """
-        self._require_dynamics()
-        n, nx = self.dof, 2 * self.dof
-        methods = {"rk4": 0, "semi_implicit": 1}
-        modes = {"feedback": 0, "gravity": 1, "computed_torque": 2}
-        if method not in methods:
-            raise InputError(f"unknown fixed-step method {method!r}; choose {', '.join(methods)}")
-        if mode not in modes:
-            raise InputError(f"unknown controller mode {mode!r}; choose {', '.join(modes)}")
-        if control not in ("sampled", "continuous"):
-            raise InputError(f"unknown control {control!r}; choose 'sampled' or 'continuous'")
-        continuous = control == "continuous"
-        if continuous and method != "rk4":
-            raise InputError(f"control='continuous' needs method='rk4' ({method} evaluates the law "
-                             "once per step: use control='sampled')")
-        steps = int(steps)
-        if steps < 1:
-            raise InputError(f"integrate: steps must be a positive integer, got {steps}")
-        threads = _thread_count(threads)
-        ensemble = np.ndim(x0) == 2
-        if ensemble and continuous:
-            raise InputError("integrate: an ensemble (x0 of shape (N, 2 n)) runs control='sampled' "
-                             "only; integrate continuous-time control one trajectory at a time")
-        count = np.shape(x0)[0] if ensemble else 1
-        size = 8 * (steps + 1) * 3 * n * count
-        if size > MAX_INTEGRATE_BYTES:
-            raise InputError(f"integrate: {steps:,} steps of {n} joints need {size / 2**20:,.0f} MiB "
-                             f"of output, above {MAX_INTEGRATE_BYTES / 2**20:,.0f} MiB; split the "
-                             "run into several calls from the last state (simulate() does so)")
-        rows = 2 * steps + 1 if continuous else steps
-        arrays = {
-            "x0": (x0, (count, nx) if ensemble else (nx,)), "feedforward": (feedforward, (rows, n)),
-            "reference": (reference, (rows, nx)), "gain": (gain, (n, nx)),
-            "integral_gain": (integral_gain, (n,)), "tau_limit": (tau_limit, (n,)),
-        }
-        checked: dict[str, np.ndarray | None] = {}
-        for key, (val, shape) in arrays.items():
-            if val is None:
-                checked[key] = None
-                continue
-            arr = np.ascontiguousarray(val, dtype=np.float64)
-            if arr.shape != shape:
-                raise InputError(f"integrate: {key} must have shape {shape}, got {arr.shape}")
-            checked[key] = arr
-        checked["params"] = None
-        if self.runtime_parameters or parameters is not None:
-            checked["params"] = self.parameter_input(parameters, (count,) if ensemble else (), "integrate")
-            check_physics(self.robot, self.runtime_parameters, self.parameters, checked["params"],
-                          "integrate(parameters=...)")
-        if ensemble:
-            return self._integrate_ensemble(checked, steps, dt, methods[method], modes[mode], threads)
-        x_out = np.empty((steps + 1, nx))
-        tau_out = np.empty((steps, n))
-        if isinstance(self._impl, ModuleType):
-            status = _integrate_numpy(self, steps, dt, methods[method], modes[mode], checked, x_out,
-                                      tau_out, continuous)
-        else:
-            ffi = self._impl.ffi
-            ptr = {k: (ffi.NULL if v is None else ffi.from_buffer("double[]", v))
-                   for k, v in checked.items()}
-            params = (ptr["params"],) if self.runtime_parameters else ()
-            status = self._impl.lib.rd_simulate(
-                steps, float(dt), methods[method], ptr["x0"], ptr["feedforward"], ptr["reference"],
-                ptr["gain"], ptr["integral_gain"], modes[mode], ptr["tau_limit"], *params,
-                int(continuous), ffi.from_buffer("double[]", x_out),
-                ffi.from_buffer("double[]", tau_out))
-        if status:
-            # the last finite state: a singular mass matrix there is the explanation
-            self.check_mass_matrix(x_out[status - 1, :n], checked["params"])
-            exc = SimulationError(f"the simulated state stopped being finite at step {status - 1} "
-                                  f"(t = {(status - 1) * dt:g} s); reduce dt or check the inputs")
-            # the last finite state, for a caller's diagnosis
-            exc.state = x_out[status - 1].copy()
-            raise exc
-        return x_out, tau_out
-
-    def _integrate_ensemble(self, a: dict[str, np.ndarray | None], steps: int, dt: float,
-                            method: int, mode: int, threads: int) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`integrate` of ``a["x0"]`` (N, 2 n) checked: one C call, or N NumPy runs."""
-        n, nx = self.dof, 2 * self.dof
-        count = a["x0"].shape[0]
-        x_out = np.empty((count, steps + 1, nx))
-        tau_out = np.empty((count, steps, n))
-        status = np.zeros(count, dtype=np.int64)
-        params = a["params"]
-        if isinstance(self._impl, ModuleType):
-            for i in range(count):
-                row = {"x0": a["x0"][i], "params": None if params is None else params[i]}
-                status[i] = _integrate_numpy(self, steps, dt, method, mode, {**a, **row},
-                                             x_out[i], tau_out[i])
-        elif count:
-            ffi = self._impl.ffi
-            ptr = {k: (ffi.NULL if v is None else ffi.from_buffer("double[]", v)) for k, v in a.items()}
-            extra = (ptr["params"],) if self.runtime_parameters else ()
-            self._impl.lib.rd_simulate_ensemble(
-                count, steps, float(dt), method, ptr["x0"], ptr["feedforward"], ptr["reference"],
-                ptr["gain"], ptr["integral_gain"], mode, ptr["tau_limit"], *extra, threads,
-                ffi.from_buffer("double[]", x_out), ffi.from_buffer("double[]", tau_out),
-                ffi.from_buffer("long[]", status))
-        failed = np.flatnonzero(status)
-        if failed.size:
-            i, k = int(failed[0]), int(status[failed[0]])
-            self.check_mass_matrix(x_out[i, k - 1, :n], None if params is None else params[i])
-            exc = SimulationError(
-                f"{failed.size} of {count} trajectories stopped being finite; the first, "
-                f"trajectory {i}, at step {k - 1} (t = {(k - 1) * dt:g} s); reduce dt or check "
-                "the inputs")
-            exc.state = x_out[i, k - 1].copy()
-            exc.trajectory = i
-            raise exc
-        return x_out, tau_out
+        return rollout(self, x0, steps, dt, method, feedforward=feedforward, reference=reference,
+                       gain=gain, integral_gain=integral_gain, mode=mode, tau_limit=tau_limit,
+                       control=control, threads=threads, parameters=parameters)
 
     # --- plumbing ------------------------------------------------------------------------------
     def parameter_input(self, value: ParameterValues, batch: tuple[int, ...] = (),
@@ -577,7 +412,7 @@ class Model:
 
     def _call(self, name: str, *arrays: np.ndarray, threads: int = 1,
               parameters: ParameterValues = None, out: np.ndarray | None = None) -> np.ndarray:
-        threads = _thread_count(threads)
+        threads = thread_count(threads)
         inputs, result_shape = kernel_signature(name, self.dof)
         batch_shape: tuple[int, ...] | None = None
         args = []
@@ -701,30 +536,6 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
     return Model(robot, backend, tuple(sorted(values.items())), impl, runtime, singular, sources)
 
 
-def _code_hash(robot: Robot) -> str:
-    """The description's hash without what the generated code does not depend on (joint-reading
-    corrections, applied in NumPy before the kernels): a calibrated description shares its
-    compiled model with the same geometry without corrections."""
-    if robot.corrections is None:
-        return robot.description_hash
-    return dataclasses.replace(robot, corrections=None, description_hash="").description_hash
-
-
-def _from_cache(paths: Sequence[Path], write: Callable[[], None], load: Callable[[], Any]) -> Any:
-    """``load()`` of generated sources ``paths``, written by ``write()`` when missing. Sources
-    found in the cache that do not compile or import (a truncated or edited file) are generated
-    again once instead of failing every later run."""
-    if not all(p.exists() for p in paths):
-        write()
-        return load()
-    _touch(*paths)
-    try:
-        return load()
-    except Exception:  # noqa: BLE001 - any failure of cached sources: rebuilt, then raised if it recurs
-        write()
-        return load()
-
-
 def _kinematic_safe(robot: Robot, values: Mapping[str, float], runtime: tuple[str, ...],
                     marker: Path) -> KernelSet:
     """The kernels to print; for a mass matrix singular in every configuration (a kinematics-only
@@ -779,89 +590,6 @@ def _thread_count(threads: int) -> int:
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
         raise InputError(f"threads must be a positive integer, got {threads!r}")
     return int(threads)
-
-
-@functools.cache
-def openmp_flags() -> tuple[str, ...]:
-    """Compiler flags of the models: :data:`CFLAGS` plus ``-fopenmp`` when the compiler has it.
-
-    Without OpenMP the ``*_batch_threads`` functions run on one thread (same results).
-    """
-    flags = (*CFLAGS, "-fopenmp")
-    # a throwaway compilation outside the cache (which holds models only)
-    try:
-        compiler = find_compiler()
-    except CompilerNotFoundError:
-        return CFLAGS
-    with tempfile.TemporaryDirectory() as tmp:
-        src = Path(tmp) / "probe.c"
-        src.write_text("#ifndef _OPENMP\n#error no OpenMP\n#endif\nint rd_openmp_probe(void) { return 1; }\n")
-        proc = subprocess.run([compiler, *flags, str(src), "-o", str(Path(tmp) / "probe.so")],
-                              capture_output=True, check=False)
-    return flags if proc.returncode == 0 else CFLAGS
-
-
-def _touch(*paths: Path) -> None:
-    """Mark cached generated sources as recently used (the cache evicts least-recently used)."""
-    for p in paths:
-        with contextlib.suppress(OSError):
-            os.utime(p)
-
-
-@functools.cache
-def _generator_hash() -> str:
-    """Hash of the source files that decide what is generated (cache invalidation).
-
-    Taken once per process, when this module is imported (with the generator's modules): a
-    process that loaded the generator before its files were edited must not store what it
-    generates under the hash of the edited files.
-    """
-    import robodyn.codegen as codegen_pkg
-    import robodyn.symbolic as symbolic_pkg
-    import robodyn.symbolic.hydro as hydro_pkg
-
-    digest = hashlib.sha256()
-    # the hydrodynamic terms (robodyn.symbolic.hydro) are part of every underwater model's kernels
-    for pkg in (codegen_pkg, hydro_pkg, symbolic_pkg):
-        for path in sorted(Path(pkg.__file__).parent.glob("*.py")):
-            digest.update(path.read_bytes())
-    return digest.hexdigest()
-
-
-_generator_hash()
-
-
-def _write_atomic(path: Path, text: str) -> None:
-    """Write ``text`` so that readers see the old file or the whole new one."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
-    os.replace(tmp, path)
-
-
-_KERNEL_MEMO: dict[tuple[str, tuple], KernelSet] = {}
-
-
-def _kernels_cached(robot: Robot, parameters: Mapping[str, float] | None,
-                    runtime: tuple[str, ...] = ()) -> KernelSet:
-    """Kernels are deterministic in (description, parameters): derive them once per process."""
-    folded = tuple(sorted((k, v) for k, v in (parameters or {}).items() if k not in runtime))
-    key = (robot.description_hash, folded, runtime)
-    if key not in _KERNEL_MEMO:
-        _KERNEL_MEMO[key] = build_kernels(robot, parameters, runtime=runtime)
-    return _KERNEL_MEMO[key]
-
-
-def _import_file(path: Path, name: str) -> ModuleType:
-    """Import a generated NumPy module (once per process)."""
-    if name in sys.modules:
-        return sys.modules[name]
-    spec = importlib.util.spec_from_file_location(name, path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    sys.modules[name] = module
-    return module
 
 
 __all__ = ["Model", "compile_model"]

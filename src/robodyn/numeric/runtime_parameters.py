@@ -18,7 +18,11 @@ from robodyn.robot.expressions import parameter_symbol
 from robodyn.robot.model import Robot
 from robodyn.robot.overrides import checked_parameter_values
 
-__all__ = ["check_physics", "parameter_array", "runtime_names"]
+__all__ = ["ParameterValues", "check_physics", "parameter_array", "runtime_names"]
+
+#: Runtime parameter values: a mapping (name -> value), a sequence of N mappings, or an array
+#: (P,) / (N, P) in the order of :attr:`robodyn.numeric.model.Model.runtime_parameters`.
+ParameterValues = Mapping[str, float] | Sequence[Mapping[str, float]] | np.ndarray | None
 
 
 def runtime_names(robot: Robot, runtime: bool | Sequence[str]) -> tuple[str, ...]:

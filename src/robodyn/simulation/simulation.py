@@ -24,8 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from robodyn.numeric.model import MAX_INTEGRATE_BYTES, Model, ParameterValues
-from robodyn.numeric.runtime_parameters import check_physics
+from robodyn.numeric.model import Model
+from robodyn.numeric.rollout import MAX_INTEGRATE_BYTES
+from robodyn.numeric.runtime_parameters import ParameterValues, check_physics
 from robodyn.robot.errors import InputError, SimulationError
 from robodyn.simulation.controllers import Controller
 from robodyn.simulation.energy import potential_energy
