@@ -184,7 +184,7 @@ import robodyn.cli
 args = robodyn.cli._parser().parse_args(["calibrate", "puma560", "--data", sys.argv[1], "-o", "o"])
 import robodyn as rd
 from robodyn.calibration.io import read_calibration_csv
-from robodyn.calibration.pipeline import convert_units
+from robodyn.calibration.data_checks import convert_units
 robot = rd.load(args.robot)
 data = read_calibration_csv(args.data, robot)
 import scipy.optimize  # the solver's import, made on the first solve: overhead, not solving

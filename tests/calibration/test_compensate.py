@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from robodyn.calibration import build_model, calibrate, compensate, robot_geometry
-from robodyn.calibration.pipeline import inverse_kinematics
+from robodyn.calibration.compensation import inverse_kinematics
 from robodyn.studies.calibration_study import perturbed_robot, robot_positions
 from tests.calibration.helpers import TARGET, TRACKER, poses, robot
 

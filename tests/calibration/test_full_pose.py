@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from robodyn.calibration import calibrate
-from robodyn.calibration.pipeline import validate, validate_orientation
+from robodyn.calibration.held_out import validate, validate_orientation
 from robodyn.cli import main
 from robodyn.studies.calibration_study import perturbed_robot, robot_frames
 from tests.calibration.helpers import TRACKER, poses, robot

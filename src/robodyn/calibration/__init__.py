@@ -12,10 +12,12 @@ Modules: :mod:`~.models` (DH, Hayati, S-model, POE), :mod:`~.nominal` (geometry 
 """
 
 from robodyn.calibration.circle_point import CirclePointResult, circle_point
+from robodyn.calibration.compensation import compensate
+from robodyn.calibration.held_out import validate
 from robodyn.calibration.identifiability import Observability, Unidentifiable, observability, select_poses
 from robodyn.calibration.models import MODELS, ErrorModel, build_model
 from robodyn.calibration.nominal import robot_geometry
-from robodyn.calibration.pipeline import calibrate, compensate, random_configurations, validate
+from robodyn.calibration.pipeline import calibrate, random_configurations
 from robodyn.calibration.result import Calibration, ErrorStats, Parameter
 
 __all__ = [

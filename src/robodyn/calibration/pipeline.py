@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from robodyn.calibration.circle_point import CirclePointResult, circle_point
+from robodyn.calibration.data_checks import check_data, check_magnitude, convert_units
 from robodyn.calibration.identifiability import (
     Unidentifiable,
     compress_rows,
@@ -36,137 +37,15 @@ from robodyn.calibration.kinematics import hom, inv
 from robodyn.calibration.models import MODELS, ErrorModel, build_model, extend_model, model_frames
 from robodyn.calibration.nominal import RobotGeometry, default_frame0, robot_geometry
 from robodyn.calibration.result import Calibration, ErrorStats, Parameter
-from robodyn.calibration.solve import LOSSES, Fit, fit, rotation_vector
+from robodyn.calibration.solve import LOSSES, Fit, fit
 from robodyn.calibration.to_robot import calibrated_robot
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 
-__all__ = ["calibrate", "check_data", "compensate", "identifiable_parameters", "inverse_kinematics",
-           "nominal_placement", "random_configurations", "validate",
-           "validate_orientation"]
+__all__ = ["calibrate", "identifiable_parameters", "nominal_placement", "random_configurations"]
 
 #: Threshold of :func:`~robodyn.calibration.identifiability.independent_columns`.
 RANK_TOL = 1e-7
-
-
-def _array(name: str, value, shape_text: str) -> np.ndarray:
-    try:
-        a = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} must be a numeric array of shape {shape_text}: {exc}") from None
-    bad = np.argwhere(~np.isfinite(a))
-    if bad.size:
-        row = int(bad[0][0])
-        col = f", column {int(bad[0][1])}" if bad.shape[1] > 1 else ""
-        raise InputError(f"{name} has NaN or infinite values ({len(bad)} entries; first at row {row}{col})")
-    return a
-
-
-def check_data(robot: Robot, q, points, orientations=None, sigma=5e-5,
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray]:
-    """Validate calibration data; returns q (N, n), points, orientations and sigma (shape of points).
-
-    ``points`` is (N, 3), or (N, K, 3) for K targets measured at each pose.
-
-    Raises
-    ------
-    ValueError
-        On wrong shapes, mismatched lengths, NaN or infinite values, non-rotations, bad sigma.
-    """
-    n = robot.dof
-    q = _array("q", q, f"(N, {n})")
-    points = _array("points", points, "(N, 3) or (N, K, 3)")
-    if q.ndim != 2 or q.shape[1] != n:
-        raise InputError(f"q must have shape (N, {n}) for {robot.name}'s {n} joints "
-                         f"({', '.join(robot.joint_names)}); got {q.shape}")
-    if points.ndim not in (2, 3) or points.shape[-1] != 3 or (points.ndim == 3 and points.shape[1] < 1):
-        raise InputError(f"points must have shape (N, 3) or (N, K, 3) for K targets per pose; "
-                         f"got {points.shape}")
-    if len(q) != len(points):
-        raise InputError(f"mismatched lengths: q has {len(q)} poses but points has {len(points)}")
-    if orientations is not None:  # one per pose: the frame of the body that carries the targets
-        orientations = _array("orientations", orientations, "(N, 3, 3)")
-        if orientations.shape != (len(q), 3, 3):
-            raise InputError(f"orientations must have shape ({len(q)}, 3, 3); got {orientations.shape}")
-        err = np.abs(orientations @ np.swapaxes(orientations, 1, 2) - np.eye(3)).max(axis=(1, 2))
-        det = np.linalg.det(orientations)
-        bad = np.flatnonzero((err > 1e-6) | (det < 0))
-        if bad.size:
-            raise InputError(f"orientations[{bad[0]}] is not a rotation matrix ({bad.size} such rows)")
-    s = _array("sigma", sigma, "scalar, (N,), (N, 3) or the shape of points")
-    if s.ndim == 1:
-        s = s.reshape((-1,) + (1,) * (points.ndim - 1))
-    elif s.ndim == 2 and points.ndim == 3:
-        s = s[:, None, :]
-    try:
-        s = np.broadcast_to(s, points.shape).copy()
-    except ValueError:
-        raise InputError(f"sigma must be a scalar, (N,), (N, 3) or {points.shape} for N = {len(points)}; "
-                         f"got shape {np.shape(sigma)}") from None
-    if not np.all(s > 0):
-        raise InputError("sigma must be positive")
-    return q, points, orientations, s
-
-
-#: Length and angle units accepted by :func:`calibrate`, with their factor to SI.
-LENGTH_UNITS = {"m": 1.0, "mm": 1e-3}
-ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180}
-
-
-def convert_units(robot: Robot, q, points, sigma, sigma_rot, length_unit: str, angle_unit: str):
-    """Copies of q, points, sigma and sigma_rot in m and rad (revolute joints' readings only).
-
-    Raises
-    ------
-    ValueError
-        An unknown unit.
-    """
-    if length_unit not in LENGTH_UNITS:
-        raise InputError(f"length_unit must be one of {', '.join(LENGTH_UNITS)}, got {length_unit!r}")
-    if angle_unit not in ANGLE_UNITS:
-        raise InputError(f"angle_unit must be one of {', '.join(ANGLE_UNITS)}, got {angle_unit!r}")
-    if length_unit == "m" and angle_unit == "rad":
-        return q, points, sigma, sigma_rot
-    lf, af = LENGTH_UNITS[length_unit], ANGLE_UNITS[angle_unit]
-    q = _array("q", q, f"(N, {robot.dof})")
-    if q.ndim == 2 and q.shape[1] == robot.dof:
-        scale = np.array([af if j.type == "revolute" else 1.0 for j in robot.joints])
-        q = q * scale  # a new array: the caller's is not modified
-    return q, _array("points", points, "(N, 3)") * lf, _array("sigma", sigma, "") * lf, sigma_rot * af
-
-
-def check_magnitude(geometry: RobotGeometry, q: np.ndarray, points: np.ndarray, length_unit: str) -> None:
-    """Reject data whose spread contradicts the declared length unit.
-
-    The spread (RMS distance from the mean) of the measured points is compared with that of the
-    nominal model's target over the same readings; they differ by a rigid placement and small
-    errors only, so a ratio beyond 30 (or below 1/30) means the unit is wrong (millimetres given
-    as metres gives 1000).
-
-    Raises
-    ------
-    ValueError
-        Naming the declared unit, the two spreads and the likely unit.
-    """
-    if len(q) < 3:
-        return
-    nominal = build_model("dh", geometry)
-    p = nominal.evaluate(nominal.initial, q, derivatives=False).position
-    y = points.reshape(len(q), -1, 3)[:, 0]
-    spread_n = float(np.sqrt(((p - p.mean(axis=0)) ** 2).sum(axis=1).mean()))
-    spread_y = float(np.sqrt(((y - y.mean(axis=0)) ** 2).sum(axis=1).mean()))
-    if spread_n <= 0 or spread_y <= 0:
-        return
-    ratio = spread_y / spread_n
-    if ratio > 30 or ratio < 1 / 30:
-        hint = ("the data look like millimetres: give length_unit='mm' (CLI --length-unit mm)"
-                if 300 < ratio < 3000 else
-                "the data look like metres: give length_unit='m'" if 3e-4 < ratio < 3e-3 else
-                "check the units of the points and of the joint readings (deg vs rad)")
-        raise InputError(f"points contradict length_unit {length_unit!r}: the measured points spread "
-                         f"{spread_y:.4g} {'units' if length_unit != 'm' else 'm'} (as given, converted: "
-                         f"{spread_y:.4g} m) where the nominal model's target spreads {spread_n:.4g} m over "
-                         f"the same readings (ratio {ratio:.3g}); {hint}")
 
 
 def target_offsets(model: ErrorModel, params: np.ndarray, q: np.ndarray, points: np.ndarray,
@@ -668,117 +547,3 @@ def _warn_variance_factor(name: str, variance_factor: float) -> None:
                       RuntimeWarning, stacklevel=3)
 
 
-def validate(calibration: Calibration, q, points) -> ErrorStats:
-    """Error statistics of the calibrated model on other (held-out) poses.
-
-    Parameters
-    ----------
-    calibration : Calibration
-    q : array_like, shape (N, n)
-    points : array_like, shape (N, 3)
-        Measured target positions, instrument frame, m.
-    """
-    q, points, _, _ = check_data(calibration.robot, q, points)
-    return ErrorStats.from_residuals(points - calibration.predict(q))
-
-
-def validate_orientation(calibration: Calibration, q, orientations) -> ErrorStats:
-    """Orientation error statistics of the calibrated model on other (held-out) poses.
-
-    Parameters
-    ----------
-    calibration : Calibration
-        Fitted with measured orientations.
-    q : array_like, shape (N, n)
-    orientations : array_like, shape (N, 3, 3)
-        Measured orientations (one per pose, the targets' common frame), instrument frame.
-
-    Returns
-    -------
-    ErrorStats
-        Of the rotation vectors ``log(R_measured R_predicted^T)``: angles in rad.
-    """
-    if not calibration.model.orientation:
-        raise InputError("validate_orientation: the calibration was fitted without orientations")
-    q = np.atleast_2d(np.asarray(q, dtype=float))
-    dummy = np.zeros((len(q), 3))
-    q, _, orientations, _ = check_data(calibration.robot, q, dummy, orientations)
-    k = calibration.model.targets
-    predicted = calibration.predict_frames(q)[::k, :3, :3]
-    return ErrorStats.from_residuals(rotation_vector(orientations @ np.swapaxes(predicted, 1, 2)))
-
-
-def compensate(
-    calibration: Calibration,
-    points,
-    q_seed,
-    *,
-    frame: str = "instrument",
-    tol: float = 1e-10,
-    max_iter: int = 100,
-) -> np.ndarray:
-    """Corrected joint targets that put the target on desired points (calibrated inverse kinematics).
-
-    From ``q_seed`` (typically the nominal controller's joint solution), Newton steps with the
-    minimum-norm (pseudo-inverse) joint correction, so redundant degrees of freedom change as
-    little as possible.
-
-    Parameters
-    ----------
-    calibration : Calibration
-    points : array_like, shape (M, 3)
-        Desired target positions, m.
-    q_seed : array_like, shape (M, n)
-    frame : {"instrument", "base"}
-        Frame of ``points``: the instrument's, or the robot's chain base frame.
-    tol : float
-        Position tolerance, m.
-    max_iter : int
-
-    Returns
-    -------
-    numpy.ndarray, shape (M, n)
-
-    Raises
-    ------
-    ValueError
-        If a point is out of reach (no convergence from its seed).
-    """
-    q, pts, _, _ = check_data(calibration.robot, q_seed, points)
-    if pts.ndim != 2:
-        raise InputError(f"compensate: points must have shape (M, 3) (positions of the first target); "
-                         f"got {pts.shape}")
-    if frame == "base":
-        b = calibration.base()
-        pts = pts @ b[:3, :3].T + b[:3, 3]
-    elif frame != "instrument":
-        raise InputError(f"frame must be 'instrument' or 'base', got {frame!r}")
-    return inverse_kinematics(calibration.model, calibration.params, pts, q, tol=tol, max_iter=max_iter)
-
-
-def inverse_kinematics(model: ErrorModel, params: np.ndarray, points: np.ndarray, q_seed: np.ndarray,
-                       *, tol: float = 1e-10, max_iter: int = 100) -> np.ndarray:
-    """Readings (M, n) that put the model's target on ``points`` (M, 3), from ``q_seed`` (M, n).
-
-    Newton steps with the minimum-norm (pseudo-inverse) joint correction.
-
-    Raises
-    ------
-    ValueError
-        If a point is not reached within ``tol`` (m).
-    """
-    q = np.array(q_seed, dtype=float)
-    step = model.targets  # the first target of each pose
-    for _ in range(max_iter):
-        ev = model.evaluate(params, q)
-        err = points - ev.position[::step]
-        if np.all(np.linalg.norm(err, axis=1) < tol):
-            return q
-        # dq = J^+ e (minimum-norm step)
-        q += np.einsum("mij,mj->mi", np.linalg.pinv(ev.jac_joint[::step, :3], rcond=1e-10), err)
-    err = np.linalg.norm(points - model.evaluate(params, q, derivatives=False).position[::step], axis=1)
-    bad = np.flatnonzero(err >= tol)
-    if bad.size:
-        raise InputError(f"compensate: {bad.size} point(s) not reached (first: index {bad[0]}, "
-                         f"{err[bad[0]] * 1e3:.3g} mm away); out of reach or a poor seed")
-    return q

@@ -169,14 +169,9 @@ def _payload(values: np.ndarray | None) -> tuple[float, np.ndarray] | None:
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
+    from robodyn.calibration.data_checks import ANGLE_UNITS, LENGTH_UNITS, convert_units
+    from robodyn.calibration.held_out import validate, validate_orientation
     from robodyn.calibration.io import read_calibration_csv, read_joint_map, write_calibration
-    from robodyn.calibration.pipeline import (
-        ANGLE_UNITS,
-        LENGTH_UNITS,
-        convert_units,
-        validate,
-        validate_orientation,
-    )
 
     robot = rd.load(args.robot, tool=args.tool)
     stem = check_stem(args.stem) if args.stem is not None else \
