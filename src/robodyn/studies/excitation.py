@@ -63,101 +63,28 @@ from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 from robodyn.robot.sizes import time_grid_steps
 from robodyn.simulation.trajectory import JointTrajectory
+from robodyn.studies.excitation_limits import (
+    DEFAULT_ACCELERATION,
+    DEFAULT_VELOCITY,
+    ExcitationLimits,
+    _frozen,
+    excitation_limits,
+)
+from robodyn.studies.fourier_trajectory import (
+    FourierTrajectory,
+    _basis,
+    _fit_to_limits,
+    _Layout,
+    _null_bases,
+    random_fourier,
+)
 from robodyn.symbolic.regressor import JOINT_NAMES, PER_JOINT, parameter_names
 
 Criterion = Literal["cond", "logdet"]
 
-#: Default joint speed and acceleration limits where the description gives none (rad/s, rad/s^2;
-#: m/s, m/s^2 for prismatic joints): moderate values that an industrial arm reaches safely.
-DEFAULT_VELOCITY = 1.0
-DEFAULT_ACCELERATION = 3.0
-#: Range assumed for a revolute joint without position limits (rad), about the zero position.
-DEFAULT_RANGE = np.pi
 
 # Regressor columns with zero derivative almost everywhere (Coulomb +/- and offset friction).
 _STEP_COLUMNS = tuple(PER_JOINT - len(JOINT_NAMES) + k for k in (2, 3, 4))
-
-
-# ----------------------------------------------------------------------------------------------
-# limits
-# ----------------------------------------------------------------------------------------------
-@dataclass(frozen=True, eq=False)
-class ExcitationLimits:
-    """Box limits on joint position, speed and acceleration, (n,) arrays each.
-
-    Attributes
-    ----------
-    lower, upper : (n,) ndarray
-        Position limits, rad (m).
-    velocity, acceleration : (n,) ndarray
-        Symmetric limits ``|qd| <= velocity`` (rad/s, m/s), ``|qdd| <= acceleration`` (rad/s^2,
-        m/s^2); positive.
-    """
-
-    lower: np.ndarray
-    upper: np.ndarray
-    velocity: np.ndarray
-    acceleration: np.ndarray
-
-    @property
-    def dof(self) -> int:
-        """Number of joints n."""
-        return self.lower.size
-
-    def violation(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> float:
-        """Largest excess over any limit of the samples ``(N, n)`` (<= 0 when all are respected)."""
-        return float(max(np.max(q - self.upper), np.max(self.lower - q),
-                         np.max(np.abs(qd) - self.velocity), np.max(np.abs(qdd) - self.acceleration)))
-
-
-def excitation_limits(robot: Robot, *, lower: Sequence[float] | None = None,
-                      upper: Sequence[float] | None = None,
-                      velocity: float | Sequence[float] | None = None,
-                      acceleration: float | Sequence[float] | None = None,
-                      margin: float = 0.05) -> ExcitationLimits:
-    """Limits for :func:`excitation` from the robot's description, with overrides.
-
-    Parameters
-    ----------
-    robot : Robot
-    lower, upper : (n,) array_like, optional
-        Position limits, rad (m). Default: the joint limits shrunk by ``margin`` of their range
-        at each end; ``-+DEFAULT_RANGE`` where a joint has none.
-    velocity : float or (n,) array_like, optional
-        Default: each joint's ``velocity_limit`` times ``1 - margin``, ``DEFAULT_VELOCITY`` where
-        none is given.
-    acceleration : float or (n,) array_like, optional
-        Default ``DEFAULT_ACCELERATION`` (descriptions carry no acceleration limits).
-    margin : float
-        Fraction in [0, 0.5) kept free at each end of a description's limits.
-
-    Returns
-    -------
-    ExcitationLimits
-    """
-    n = robot.dof
-    if not 0.0 <= margin < 0.5:
-        raise InputError(f"excitation_limits: margin must be in [0, 0.5), got {margin!r}")
-    lo = np.array([-DEFAULT_RANGE if j.lower is None else float(j.lower) for j in robot.joints])
-    hi = np.array([DEFAULT_RANGE if j.upper is None else float(j.upper) for j in robot.joints])
-    span = hi - lo
-    lo, hi = lo + margin * span, hi - margin * span
-    if lower is not None:
-        lo = _finite_vector(lower, n, "lower")
-    if upper is not None:
-        hi = _finite_vector(upper, n, "upper")
-    if np.any(hi <= lo):
-        bad = int(np.argmax(hi <= lo))
-        raise InputError(f"excitation_limits: joint {robot.joint_names[bad]!r}: upper limit "
-                         f"{hi[bad]:g} is not above lower limit {lo[bad]:g}")
-    vel = np.array([DEFAULT_VELOCITY if j.velocity_limit is None
-                    else (1.0 - margin) * float(j.velocity_limit) for j in robot.joints])
-    if velocity is not None:
-        vel = _positive_vector(velocity, n, "velocity")
-    acc = np.full(n, DEFAULT_ACCELERATION)
-    if acceleration is not None:
-        acc = _positive_vector(acceleration, n, "acceleration")
-    return ExcitationLimits(*(_frozen(v) for v in (lo, hi, vel, acc)))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -228,134 +155,6 @@ def _singular_values(w: np.ndarray) -> np.ndarray:
     """
     lam = scipy.linalg.eigh(w.T @ w, eigvals_only=True, driver="evr")
     return np.sqrt(np.clip(lam[::-1], 0.0, None))
-
-
-# ----------------------------------------------------------------------------------------------
-# Fourier series
-# ----------------------------------------------------------------------------------------------
-@dataclass(frozen=True, eq=False)
-class FourierTrajectory:
-    """Finite Fourier series joint motion (module docstring), periodic with period ``1 / f``.
-
-    Attributes
-    ----------
-    a, b : (n, L) ndarray
-        Sine-side and cosine-side coefficients of the velocity, rad/s (m/s).
-    offset : (n,) ndarray
-        ``q0``, rad (m).
-    base_frequency : float
-        ``f``, Hz.
-    """
-
-    a: np.ndarray
-    b: np.ndarray
-    offset: np.ndarray
-    base_frequency: float
-
-    @property
-    def harmonics(self) -> int:
-        """Number of harmonics L."""
-        return self.a.shape[1]
-
-    @property
-    def period(self) -> float:
-        """``1 / f``, s."""
-        return 1.0 / self.base_frequency
-
-    def evaluate(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(q, qd, qdd)`` at times ``t`` (N,), each (N, n)."""
-        sq, sqd, sqdd = _basis(np.asarray(t, dtype=float), self.harmonics, self.base_frequency)
-        coef = np.concatenate([self.a, self.b], axis=1)  # (n, 2 L)
-        return self.offset + sq @ coef.T, sqd @ coef.T, sqdd @ coef.T
-
-    def scaled(self, s: float) -> FourierTrajectory:
-        """The same motion with its oscillation about the offset scaled by ``s``."""
-        return FourierTrajectory(_frozen(s * self.a), _frozen(s * self.b), self.offset, self.base_frequency)
-
-
-def _basis(t: np.ndarray, harmonics: int, f: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Matrices (N, 2 L) mapping ``[a; b]`` of one joint to q - q0, qd and qdd at ``t``."""
-    w = 2.0 * np.pi * f
-    wl = w * np.arange(1, harmonics + 1)
-    s, c = np.sin(np.outer(t, wl)), np.cos(np.outer(t, wl))
-    # q - q0 = a/(w l) sin - b/(w l) cos;  qd = a cos + b sin;  qdd = -a w l sin + b w l cos
-    return (np.hstack([s / wl, -c / wl]), np.hstack([c, s]), np.hstack([-s * wl, c * wl]))
-
-
-def _null_bases(harmonics: int, f: float) -> tuple[np.ndarray, np.ndarray]:
-    """Orthonormal bases (L, L-1) of ``sum a = 0`` and (L, L-2) of the two ``b`` constraints."""
-    wl = 2.0 * np.pi * f * np.arange(1, harmonics + 1)
-    na = scipy.linalg.null_space(np.ones((1, harmonics)))
-    # sum b/(w l) = 0 (q(0) = q0) and sum b w l = 0 (qdd(0) = 0)
-    nb = scipy.linalg.null_space(np.vstack([1.0 / wl, wl]))
-    return na, nb
-
-
-@dataclass(frozen=True)
-class _Layout:
-    """Map from the optimisation vector x to Fourier coefficients: x_i = [q0_i, z_a (L-1), z_b (L-2)]."""
-
-    n: int
-    harmonics: int
-    na: np.ndarray
-    nb: np.ndarray
-
-    @property
-    def per_joint(self) -> int:
-        return 1 + self.na.shape[1] + self.nb.shape[1]
-
-    def joint_map(self) -> np.ndarray:
-        """(2 L, per_joint - 1) matrix taking [z_a; z_b] to [a; b]."""
-        return scipy.linalg.block_diag(self.na, self.nb)
-
-    def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(offset (n,), coef (n, 2 L))`` of the vector x."""
-        xs = x.reshape(self.n, self.per_joint)
-        return xs[:, 0], xs[:, 1:] @ self.joint_map().T
-
-    def series(self, x: np.ndarray, f: float) -> FourierTrajectory:
-        off, coef = self.split(x)
-        L = self.harmonics
-        return FourierTrajectory(_frozen(coef[:, :L]), _frozen(coef[:, L:]), _frozen(off), f)
-
-    def pack(self, traj: FourierTrajectory) -> np.ndarray:
-        """Inverse of :meth:`series` for coefficients that satisfy the rest constraints."""
-        za = traj.a @ self.na
-        zb = traj.b @ self.nb
-        return np.hstack([traj.offset[:, None], za, zb]).ravel()
-
-
-def random_fourier(limits: ExcitationLimits, harmonics: int, base_frequency: float,
-                   rng: np.random.Generator, *, samples: int | None = None) -> FourierTrajectory:
-    """A random rest-to-rest Fourier trajectory scaled to touch its tightest limit.
-
-    Offsets are uniform in the middle half of each joint's range; coefficients standard normal in
-    the constraint null space, then the oscillation is scaled so that the largest ratio of
-    ``|q - q0|`` to the room left about the offset, ``|qd|`` to the speed limit and ``|qdd|`` to
-    the acceleration limit, over ``samples`` points of a period, is exactly 1.
-    """
-    na, nb = _null_bases(harmonics, base_frequency)
-    n = limits.dof
-    mid, half = 0.5 * (limits.lower + limits.upper), 0.5 * (limits.upper - limits.lower)
-    off = mid + 0.5 * half * rng.uniform(-1.0, 1.0, n)
-    a = rng.standard_normal((n, na.shape[1])) @ na.T
-    b = rng.standard_normal((n, nb.shape[1])) @ nb.T
-    traj = FourierTrajectory(_frozen(a), _frozen(b), _frozen(off), base_frequency)
-    return _fit_to_limits(traj, limits, samples or 40 * harmonics)
-
-
-def _fit_to_limits(traj: FourierTrajectory, limits: ExcitationLimits, samples: int,
-                   shrink_only: bool = False) -> FourierTrajectory:
-    """Scale the oscillation so the samples just meet the tightest limit (only shrink if asked)."""
-    t = np.arange(samples) * traj.period / samples
-    q, qd, qdd = traj.evaluate(t)
-    dq = q - traj.offset
-    room_up, room_down = limits.upper - traj.offset, traj.offset - limits.lower
-    ratio = max(np.max(np.where(dq > 0, dq / room_up, -dq / room_down)),
-                np.max(np.abs(qd) / limits.velocity), np.max(np.abs(qdd) / limits.acceleration))
-    if ratio <= 0 or (shrink_only and ratio <= 1.0):
-        return traj
-    return traj.scaled(1.0 / ratio)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -738,29 +537,6 @@ class _Problem:
                 out[which * n + i] = (dots[plus] - dots[plus + 1]) / (2 * h)
         out[2 * n:] = (dots[4 * n:] - dots0) / h
         return out
-
-
-# --- helpers -----------------------------------------------------------------------------------
-def _frozen(a: np.ndarray) -> np.ndarray:
-    a = np.array(a, dtype=float)
-    a.flags.writeable = False
-    return a
-
-
-def _finite_vector(v: Sequence[float], n: int, name: str) -> np.ndarray:
-    arr = np.asarray(v, dtype=float)
-    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-        raise InputError(f"excitation_limits: {name} must be a finite ({n},) array, got {v!r}")
-    return arr
-
-
-def _positive_vector(v: float | Sequence[float], n: int, name: str) -> np.ndarray:
-    arr = np.asarray(v, dtype=float)
-    if arr.ndim == 0:
-        arr = np.full(n, float(arr))
-    if arr.shape != (n,) or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-        raise InputError(f"excitation_limits: {name} must be positive: a scalar or a ({n},) array, got {v!r}")
-    return arr
 
 
 __all__ = [
