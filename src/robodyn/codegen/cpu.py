@@ -31,7 +31,7 @@ from pathlib import Path
 
 from robodyn.robot.errors import InputError
 
-__all__ = ["WIDTHS", "block_width", "cpu_flags"]
+__all__ = ["BLOCK", "WIDTHS", "block_width", "cpu_flags"]
 
 #: Block widths the generator accepts.
 WIDTHS = (1, 2, 4, 8, 16, 32)
@@ -63,3 +63,8 @@ def block_width() -> int:
                              f"must be one of {', '.join(map(str, WIDTHS))} (1: scalar code)")
         return int(text)
     return 16 if "avx512f" in cpu_flags() else 8
+
+
+#: States per block of the generated batch functions in this process (:func:`block_width` at
+#: import): one vector loop evaluates a block's sines and cosines.
+BLOCK = block_width()
