@@ -403,19 +403,7 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
         An unknown term, a negative payload mass, ``identify_payload`` without compliance, an
         unknown ``deflection``, ``"exact"`` with ``identify_payload`` or without link masses.
     """
-    terms = tuple(dict.fromkeys(terms))
-    if deflection not in DEFLECTIONS:
-        raise InputError(f"deflection must be one of {', '.join(DEFLECTIONS)}, got {deflection!r}")
-    if deflection == "exact" and identify_payload:
-        raise InputError("deflection='exact' cannot be combined with identify_payload: the exact "
-                         "Jacobian of the identified payload's terms is not implemented; identify the "
-                         "payload with deflection='linear', then give it as a known payload")
-    unknown = [t for t in terms if t not in NONGEOMETRIC]
-    if unknown:
-        raise InputError(f"unknown non-geometric term {unknown[0]!r}; choose from {', '.join(NONGEOMETRIC)}")
-    if identify_payload and "compliance" not in terms:
-        raise InputError("identify_payload needs the 'compliance' term: the payload is seen only "
-                         "through the joints' deflection under its weight")
+    terms = _checked_terms(terms, deflection, identify_payload)
     subs = robot.defaults()
     n = robot.dof
     gear = np.full(n, np.nan)
@@ -424,45 +412,13 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
         if g != 1.0:
             gear[j] = g
     names, units, joints, kinds = [], [], [], []
-    torque = exact_torque = torque_jacobian = None
+    torque = exact_torque = torque_jacobian = holding = tool0 = None
     source = ""
+    gravity = np.array(robot.gravity.xreplace(subs), dtype=float).ravel()
+    load = _payload_load(payload)
     if "compliance" in terms:
-        gravity = np.array(robot.gravity.xreplace(subs), dtype=float).ravel()
-        masses = [float(link.mass.xreplace(subs)) for link in robot.links]
-        load = None
-        if payload is not None:
-            mass, com = float(payload[0]), np.asarray(payload[1], dtype=float).reshape(3)
-            if not mass >= 0:
-                raise InputError(f"payload mass must be >= 0 kg, got {mass}")
-            load = (mass, com)
-        known = None if identify_payload else load
-        types = [j.type for j in robot.joints]
-        origins0, axes0, tool0 = (a[0] for a in frames(np.zeros((1, n))))
-        payload_point = [] if known is None else [tool0[:3, :3] @ known[1] + tool0[:3, 3]]
-        if any(m > 0 for m in masses):
-            holding = robot_holding(robot)  # numerically: no model to derive or compile
-            if known:
-                holding = _with_points(holding, [known[0]], payload_point, [n], "gravity model + payload")
-            if deflection == "exact":
-                extra = None
-                if known:
-                    alone = _with_points(replace(holding, masses=(), moments=(), moved_by=()),
-                                         [known[0]], payload_point, [n], "payload")
-                    extra = lambda x, alone=alone: holding_torque(alone, x)  # noqa: E731
-                exact_torque, torque_jacobian = _compiled_gravity(robot, extra)
-        else:
-            if deflection == "exact":
-                raise InputError(f"deflection='exact' needs the link masses of {robot.name}: its "
-                                 "description has none, so the compliance torques are a gravity-shaped "
-                                 "basis of unknown scale; use deflection='linear'")
-            # a 1 kg point mass on the axis of every joint after the first (riding on the link
-            # before it) and at the tool
-            empty = HoldingTorque(_rows(origins0), _rows(axes0), tuple(types), (), (), (),
-                                  tuple(float(g) for g in gravity))
-            holding = _with_points(empty, [1.0] * n + ([known[0]] if known else []),
-                                   np.vstack([origins0[1:], tool0[None, :3, 3], *payload_point]),
-                                   list(range(1, n + 1)) + ([n] if known else []),
-                                   "gravity-shaped basis" + (" + payload" if known else ""))
+        holding, tool0, exact_torque, torque_jacobian = _compliance_holding(
+            robot, frames, None if identify_payload else load, deflection)
         torque = lambda q, holding=holding: holding_torque(holding, q)  # noqa: E731
         source = holding.source
         for j, joint in enumerate(robot.joints):
@@ -483,9 +439,7 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
                 joints.append(j)
                 kinds.append(kind)
     initial = [0.0] * len(names)
-    payload_torque = holding_block = tool_zero = None
-    if "compliance" in terms:
-        holding_block, tool_zero = holding, tool0
+    payload_torque = None
     if identify_payload:
         payload_torque = _payload_unit_torque(frames, [j.type for j in robot.joints], gravity)
         source += " + identified payload"
@@ -502,4 +456,71 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
         deflection = "linear"  # nothing deflects: the option changes nothing
     return NonGeometric(terms, tuple(names), tuple(units), tuple(joints), tuple(kinds), gear, torque,
                         source, np.array(initial), payload_torque, deflection, torque_jacobian,
-                        exact_torque, holding_block, tool_zero)
+                        exact_torque, holding, tool0)
+
+
+def _checked_terms(terms: Sequence[str], deflection: str, identify_payload: bool) -> tuple[str, ...]:
+    """The terms without repeats; refuses unknown terms and options that do not go together."""
+    terms = tuple(dict.fromkeys(terms))
+    if deflection not in DEFLECTIONS:
+        raise InputError(f"deflection must be one of {', '.join(DEFLECTIONS)}, got {deflection!r}")
+    if deflection == "exact" and identify_payload:
+        raise InputError("deflection='exact' cannot be combined with identify_payload: the exact "
+                         "Jacobian of the identified payload's terms is not implemented; identify the "
+                         "payload with deflection='linear', then give it as a known payload")
+    unknown = [t for t in terms if t not in NONGEOMETRIC]
+    if unknown:
+        raise InputError(f"unknown non-geometric term {unknown[0]!r}; choose from {', '.join(NONGEOMETRIC)}")
+    if identify_payload and "compliance" not in terms:
+        raise InputError("identify_payload needs the 'compliance' term: the payload is seen only "
+                         "through the joints' deflection under its weight")
+    return terms
+
+
+def _payload_load(payload: tuple[float, Sequence[float]] | None) -> tuple[float, np.ndarray] | None:
+    """``payload`` as (kg, centre of mass (3,) in the tool frame, m), checked."""
+    if payload is None:
+        return None
+    mass, com = float(payload[0]), np.asarray(payload[1], dtype=float).reshape(3)
+    if not mass >= 0:
+        raise InputError(f"payload mass must be >= 0 kg, got {mass}")
+    return mass, com
+
+
+def _compliance_holding(robot: Robot, frames, known: tuple[float, np.ndarray] | None, deflection: str,
+                        ) -> tuple[HoldingTorque, np.ndarray, Callable | None, Callable | None]:
+    """The point masses whose holding torque loads the joints (the links' own, or a unit-mass
+    basis without masses; plus a known payload), the nominal tool frame at zero readings
+    (4, 4), and for ``"exact"`` the compiled torque and its Jacobian."""
+    n = robot.dof
+    subs = robot.defaults()
+    gravity = np.array(robot.gravity.xreplace(subs), dtype=float).ravel()
+    masses = [float(link.mass.xreplace(subs)) for link in robot.links]
+    origins0, axes0, tool0 = (a[0] for a in frames(np.zeros((1, n))))
+    payload_point = [] if known is None else [tool0[:3, :3] @ known[1] + tool0[:3, 3]]
+    exact_torque = torque_jacobian = None
+    if any(m > 0 for m in masses):
+        holding = robot_holding(robot)  # numerically: no model to derive or compile
+        if known:
+            holding = _with_points(holding, [known[0]], payload_point, [n], "gravity model + payload")
+        if deflection == "exact":
+            extra = None
+            if known:
+                alone = _with_points(replace(holding, masses=(), moments=(), moved_by=()),
+                                     [known[0]], payload_point, [n], "payload")
+                extra = lambda x, alone=alone: holding_torque(alone, x)  # noqa: E731
+            exact_torque, torque_jacobian = _compiled_gravity(robot, extra)
+        return holding, tool0, exact_torque, torque_jacobian
+    if deflection == "exact":
+        raise InputError(f"deflection='exact' needs the link masses of {robot.name}: its "
+                         "description has none, so the compliance torques are a gravity-shaped "
+                         "basis of unknown scale; use deflection='linear'")
+    # a 1 kg point mass on the axis of every joint after the first (riding on the link before
+    # it) and at the tool
+    empty = HoldingTorque(_rows(origins0), _rows(axes0), tuple(j.type for j in robot.joints), (), (), (),
+                          tuple(float(g) for g in gravity))
+    holding = _with_points(empty, [1.0] * n + ([known[0]] if known else []),
+                           np.vstack([origins0[1:], tool0[None, :3, 3], *payload_point]),
+                           list(range(1, n + 1)) + ([n] if known else []),
+                           "gravity-shaped basis" + (" + payload" if known else ""))
+    return holding, tool0, None, None

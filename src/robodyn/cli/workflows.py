@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import csv
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -170,7 +171,6 @@ def _payload(values: np.ndarray | None) -> tuple[float, np.ndarray] | None:
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
     from robodyn.calibration.data_checks import ANGLE_UNITS, LENGTH_UNITS, convert_units
-    from robodyn.calibration.held_out import validate, validate_orientation
     from robodyn.calibration.io import read_calibration_csv, read_joint_map, write_calibration
 
     robot = rd.load(args.robot, tool=args.tool)
@@ -201,47 +201,26 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
                            nongeometric=tuple(args.nongeometric or ()),
                            payload=_payload(args.payload), identify_payload=args.identify_payload,
                            deflection=args.deflection, **units)
-    validation = None
-    if args.validate:
-        from robodyn.calibration.frames import robot_positions
-        from robodyn.calibration.result import ErrorStats
-
-        held = read_calibration_csv(args.validate, robot, targets=args.targets, joint_map=jmap)
-        held_q, held_pts = si(held)
-        stats = validate(cal, held_q, held_pts)
-        rot_stats = None
-        if held.orientations is not None and cal.model.orientation:
-            rot_stats = validate_orientation(cal, held_q, held.orientations)
-        first = held_pts if held_pts.ndim == 2 else held_pts[:, 0]
-        # before: the nominal kinematics placed in the instrument frame, first target
-        stats_before = ErrorStats.from_residuals(first - robot_positions(cal.before_robot, held_q))
-        validation = (Path(args.validate).name, (held_pts - cal.predict(held_q)).reshape(-1, 3))
+    held = _held_out(args, robot, cal, jmap, si) if args.validate else None
     paths = write_calibration(cal, args.output, stem=stem)
     check = alone = None
     if args.nongeometric:
-        poses = (Path(args.validate).name, held_q, held_pts) if args.validate else \
+        poses = (Path(args.validate).name, held["q"], held["points"]) if held else \
             (Path(args.data).name, *si(data))
         check, alone = _terms_check(args, robot, cal, data, sigma, units, poses, paths, stem)
-    if validation is not None:
-        entry = {"file": str(args.validate), "before_m": stats_before.__dict__,
-                 "before_targets": "first", "after_m": stats.__dict__}
-        if rot_stats is not None:
-            entry["orientation_after_rad"] = rot_stats.__dict__
-        _add_to_report(paths["json"], {"validation": entry})
+    if held is not None:
+        _add_to_report(paths["json"], {"validation": held["entry"]})
     if not args.no_report:
         from robodyn.report.calibration_report import calibration_html  # matplotlib: after the solve
 
         paths["html"] = calibration_html(cal, output_path(args.output, stem, "_report.html"),
-                                         source=str(args.data), validation=validation)
+                                         source=str(args.data),
+                                         validation=held["residuals"] if held else None)
     print(cal.summary())
     if check is not None and alone is not None:
         _print_terms(check, alone, paths["yaml"].name, stem)
-    if validation is not None:
-        print(f"\nheld-out ({args.validate}), after calibration: {stats.text()}")
-        print(f"held-out ({args.validate}), before (nominal, placed): {stats_before.text()}"
-              + (" (first target)" if cal.targets_axis else ""))
-        if rot_stats is not None:
-            print(f"held-out ({args.validate}), orientation after calibration: {rot_stats.angle_text()}")
+    for line in held["lines"] if held else ():
+        print(line)
     print()
     for kind, path in paths.items():
         if path is not None:
@@ -250,6 +229,37 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         err("robodyn: warning: the least-squares solver did not converge")
         return 1
     return 0
+
+
+def _held_out(args: argparse.Namespace, robot: rd.Robot, cal: Any, jmap: Any,
+              si: Callable[[Any], tuple[np.ndarray, np.ndarray]]) -> dict[str, Any]:
+    """``--validate``: the held-out poses (q, points in rad and m), their statistics after and
+    before (the nominal kinematics placed, first target), the JSON entry, the report's residuals
+    and the lines to print."""
+    from robodyn.calibration.frames import robot_positions
+    from robodyn.calibration.held_out import validate, validate_orientation
+    from robodyn.calibration.io import read_calibration_csv
+    from robodyn.calibration.result import ErrorStats
+
+    data = read_calibration_csv(args.validate, robot, targets=args.targets, joint_map=jmap)
+    q, pts = si(data)
+    stats = validate(cal, q, pts)
+    rot_stats = None
+    if data.orientations is not None and cal.model.orientation:
+        rot_stats = validate_orientation(cal, q, data.orientations)
+    first = pts if pts.ndim == 2 else pts[:, 0]
+    before = ErrorStats.from_residuals(first - robot_positions(cal.before_robot, q))
+    entry = {"file": str(args.validate), "before_m": before.__dict__, "before_targets": "first",
+             "after_m": stats.__dict__}
+    lines = [f"\nheld-out ({args.validate}), after calibration: {stats.text()}",
+             f"held-out ({args.validate}), before (nominal, placed): {before.text()}"
+             + (" (first target)" if cal.targets_axis else "")]
+    if rot_stats is not None:
+        entry["orientation_after_rad"] = rot_stats.__dict__
+        lines.append(f"held-out ({args.validate}), orientation after calibration: "
+                     f"{rot_stats.angle_text()}")
+    residuals = (Path(args.validate).name, (pts - cal.predict(q)).reshape(-1, 3))
+    return {"q": q, "points": pts, "entry": entry, "residuals": residuals, "lines": lines}
 
 
 def _terms_check(args: argparse.Namespace, robot: rd.Robot, cal: Any, data: Any, sigma: Any,
