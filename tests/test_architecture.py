@@ -144,3 +144,30 @@ def test_the_checks_can_fail() -> None:
     # a cycle and an upward import, made up, are found
     assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
     assert LAYERS["robot"] < LAYERS["studies"]
+
+
+#: Size limits of issue 21 (shared/DESIGN.md's style): lines per file, lines per function body
+#: (docstring excluded).
+MAX_FILE_LINES, MAX_FUNCTION_LINES = 600, 80
+
+
+def test_every_file_under_the_size_limit() -> None:
+    long = {str(p.relative_to(SRC)): n for p in SRC.rglob("*.py")
+            if (n := len(p.read_text(encoding="utf-8").splitlines())) > MAX_FILE_LINES}
+    assert long == {}
+
+
+def test_every_function_body_under_the_size_limit() -> None:
+    long = []
+    for path in SRC.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                continue
+            first = node.body[0]
+            start = first.lineno
+            if (isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant)
+                    and isinstance(first.value.value, str) and len(node.body) > 1):
+                start = node.body[1].lineno  # the docstring does not count
+            if node.end_lineno - start + 1 > MAX_FUNCTION_LINES:
+                long.append(f"{path.relative_to(SRC)}:{node.lineno} {node.name}")
+    assert long == []

@@ -121,6 +121,14 @@ def ensemble_source(n: int, prefix: str, runtime: int = 0) -> str:
         "    }",
         "}",
         "",
+        *_ensemble_driver(n, prefix, runtime, args),
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _ensemble_driver(n: int, prefix: str, runtime: int, args: str) -> list[str]:
+    """C lines of ``PREFIXsimulate_ensemble``: the blocks of trajectories on OpenMP threads."""
+    return [
         f"/* count trajectories of {n}-joint dynamics, {BLOCK} per block, blocks on `threads` threads. */",
         ensemble_signature(prefix, runtime) + " {",
         f"    const long blocks = (count + {BLOCK - 1}) / {BLOCK};",
@@ -138,7 +146,6 @@ def ensemble_source(n: int, prefix: str, runtime: int = 0) -> str:
         "    return (int)(failed < 2147483647L ? failed : 2147483647L);",
         "}",
     ]
-    return "\n".join(lines) + "\n"
 
 
 def _law_source(n: int, prefix: str, has_gravity: bool, has_mass: bool,

@@ -39,6 +39,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, fields
+from typing import Any
 
 import sympy as sp
 
@@ -220,12 +221,30 @@ def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
     reserved |= set(REGRESSOR_DERIVATIVE_KERNEL_NAMES)
 
     hyd = _pi_as_number(hydro_terms(robot, q, qd, qdd))
+    builders = _builders(robot, q, qd, qdd, u, inputs, hyd)
+    kernels = []
+    for name in names:
+        if name not in builders:
+            raise InputError(f"unknown kernel {name!r}; choose from "
+                             f"{', '.join(KERNEL_NAMES + DERIVATIVE_KERNEL_NAMES)}, "
+                             "regressor_derivatives")
+        kernels.append(_kernel(name, builders[name], reserved, prm, rename_prm, values))
+    params = tuple((k, float(v)) for k, v in sorted(merged.items()) if k not in runtime)
+    return KernelSet(robot.name, robot.description_hash, n, params, tuple(kernels), runtime)
+
+
+_Builder = tuple[str, tuple[Argument, ...], str, tuple[int, ...], Callable[[Recorder], Sequence[sp.Expr]]]
+
+
+def _builders(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol], qdd: Sequence[sp.Symbol],
+              u: Sequence[sp.Symbol], inputs: dict[str, Argument], hyd: Any) -> dict[str, _Builder]:
+    """Per kernel: summary, inputs, output name and shape, and the recorder of its outputs."""
+    n = len(q)
 
     def fd_outputs(rec: Recorder) -> list[sp.Expr]:
         return _forward_dynamics(robot, q, qd, u, rec, hyd)
 
-    builders: dict[str, tuple[str, tuple[Argument, ...], str, tuple[int, ...],
-                              Callable[[Recorder], Sequence[sp.Expr]]]] = {
+    return {
         "inverse_dynamics": (
             "Inverse dynamics tau = M(q) qdd + C(q, qd) qd + g(q) + friction(qd), N m or N",
             (inputs["q"], inputs["qd"], inputs["qdd"]), "tau", (n,),
@@ -275,30 +294,26 @@ def build_kernels(robot: Robot, parameters: Mapping[str, float] | None = None,
             (inputs["q"], inputs["qd"], inputs["qdd"]), "dY", (15 * n * n, 3 * n),
             lambda rec: _regressor_derivatives(robot, q, qd, qdd, rec)),
     }
-    kernels = []
-    for name in names:
-        if name not in builders:
-            raise InputError(f"unknown kernel {name!r}; choose from "
-                             f"{', '.join(KERNEL_NAMES + DERIVATIVE_KERNEL_NAMES)}, "
-                             "regressor_derivatives")
-        summary, ins, out_name, shape, build = builders[name]
-        rec = Recorder(reserved)
-        outs = build(rec)
-        assignments = rec.assignments
-        if prm:
-            ins = (*ins, _arg("p", prm))
-            assignments = [(s, e.xreplace(rename_prm)) for s, e in assignments]
-            outs = [sp.sympify(o).xreplace(rename_prm) for o in outs]
-        body, outs = opt.fold_parameters(assignments, outs, values)
-        body, outs = opt.eliminate_common_subexpressions(body, outs)
-        rename = opt.safe_names(body, reserved)
-        if rename:
-            body = [(rename.get(s, s), e.xreplace(rename)) for s, e in body]
-            outs = [sp.sympify(o).xreplace(rename) for o in outs]
-        kernels.append(Kernel(name, summary, ins, (Argument(out_name, shape, tuple(outs)),),
-                              tuple(body)))
-    params = tuple((k, float(v)) for k, v in sorted(merged.items()) if k not in runtime)
-    return KernelSet(robot.name, robot.description_hash, n, params, tuple(kernels), runtime)
+
+
+def _kernel(name: str, builder: _Builder, reserved: set[str], prm: Sequence[sp.Symbol],
+            rename_prm: dict[sp.Symbol, sp.Symbol], values: dict[sp.Symbol, float]) -> Kernel:
+    """One kernel: its outputs recorded, runtime parameters renamed, folded, CSE, safe names."""
+    summary, ins, out_name, shape, build = builder
+    rec = Recorder(reserved)
+    outs = build(rec)
+    assignments = rec.assignments
+    if prm:
+        ins = (*ins, _arg("p", prm))
+        assignments = [(s, e.xreplace(rename_prm)) for s, e in assignments]
+        outs = [sp.sympify(o).xreplace(rename_prm) for o in outs]
+    body, outs = opt.fold_parameters(assignments, outs, values)
+    body, outs = opt.eliminate_common_subexpressions(body, outs)
+    rename = opt.safe_names(body, reserved)
+    if rename:
+        body = [(rename.get(s, s), e.xreplace(rename)) for s, e in body]
+        outs = [sp.sympify(o).xreplace(rename) for o in outs]
+    return Kernel(name, summary, ins, (Argument(out_name, shape, tuple(outs)),), tuple(body))
 
 
 def _arg(name: str, symbols: Sequence[sp.Symbol]) -> Argument:
