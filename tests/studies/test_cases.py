@@ -94,3 +94,15 @@ def test_serial_table_records_a_failing_case_and_keeps_case_order():
     with pytest.raises(ValueError, match="not allowed") as info:
         run_serial(noisy_square, {"x": [0, 3]}, on_error="raise")
     assert "case 1" in " ".join(getattr(info.value, "__notes__", []))
+
+
+def test_case_count_bounded_before_anything_is_built(monkeypatch):
+    big = {f"p{k}": list(range(1000)) for k in range(3)}  # 10^9 combinations
+    with pytest.raises(StudyError, match=r"grid over p0, p1, p2: 1e\+09 cases, more than 1,000,000"):
+        expand_cases(big)
+    with pytest.raises(StudyError, match=r"LatinHypercube of n = 10000000 crossed with a grid of 2"):
+        LatinHypercube({"x": (0.0, 1.0)}, n=10_000_000, grid={"g": [1, 2]}).cases()
+    monkeypatch.setenv("ROBODYN_MAX_CASES", "10")
+    with pytest.raises(StudyError, match="11 cases, more than 10"):
+        RandomSampler({"x": (0.0, 1.0)}, n=11).cases()
+    assert len(RandomSampler({"x": (0.0, 1.0)}, n=10).cases()) == 10

@@ -48,6 +48,10 @@ def test_study_file_expands_grid_times_samples(tmp_path):
     (("seed: 4", "seeds: 4"), r"study.yaml: unknown key 'seeds'"),
     (("task: actuator_sizing", "task: sizing"), r"study.yaml: task: expected one of"),
     (("settings: {dt: 0.005}", "settings: {step: 0.005}"), r"study.yaml: settings: .*'step'"),
+    # case-count bombs, refused before any case is built (issue 23: 15-23 GB before)
+    (("sampler: {kind: random, n: 2}", "sampler: {kind: random, n: 1000000000}"),
+     r"study.yaml: sampler.n = 1000000000 times a grid of 6: 6e\+09 cases, more than 1,000,000"),
+    (("seed: 4", "seed: 4\nrepeat: 1000000000"), r"study.yaml: repeat: 1e\+09 cases, more than"),
 ])
 def test_bad_study_file_is_named(tmp_path, change, message):
     path = _write(tmp_path, GOOD.replace(*change))
@@ -121,3 +125,15 @@ def test_cli_sweep_where_every_case_failed_exits_1_with_the_table(tmp_path, caps
     assert len(table) == 2 and table["error"].notna().all()
     failures = pd.read_csv(tmp_path / "out" / "failures.csv", index_col="case")
     assert list(failures.index) == [0, 1] and failures["error"].str.contains("payload mass").all()
+
+
+def test_grid_bomb_refused_before_expansion(tmp_path, monkeypatch):
+    values = "[" + ", ".join(str(k) for k in range(1000)) + "]"
+    text = GOOD.replace("  payload: [0, 50]", f"  payload: {values}").replace(
+        "  bandwidth_hz: {min: 2, max: 8}\n", f"  bandwidth_hz: {values}\n").replace(
+        "sampler: {kind: random, n: 2}\n", "")
+    with pytest.raises(StudyError, match=r"study.yaml: parameters: a grid over payload, bandwidth_hz, "
+                                         r"zeta: 3e\+06 cases, more than 1,000,000 .*ROBODYN_MAX_CASES"):
+        read_study(_write(tmp_path, text))
+    monkeypatch.setenv("ROBODYN_MAX_CASES", "5000000")  # the limit a deliberate study raises
+    assert read_study(_write(tmp_path, text)).varying == ("payload", "bandwidth_hz", "zeta")

@@ -26,6 +26,7 @@ import numpy as np
 from scipy.stats import qmc
 
 from robodyn.robot.errors import StudyError
+from robodyn.robot.sizes import env_limit
 
 __all__ = ["SEED_COLUMN", "Grid", "LatinHypercube", "RandomSampler", "Range", "case_seed",
            "expand_cases"]
@@ -85,6 +86,20 @@ def _as_range(value: Range | Sequence[float], where: str) -> Range:
     return r
 
 
+#: Default largest number of cases a study expands to (``$ROBODYN_MAX_CASES`` raises it): checked
+#: before the cases are built, so that a grid of 10^9 combinations is refused in a millisecond
+#: instead of filling the memory (a case dict costs about 1 kB; each case is also a task result).
+MAX_CASES = 1_000_000
+
+
+def check_case_count(count: int, where: str) -> None:
+    """Refuse ``count`` cases above ``$ROBODYN_MAX_CASES`` (default :data:`MAX_CASES`)."""
+    limit = env_limit("ROBODYN_MAX_CASES", MAX_CASES)
+    if count > limit:
+        raise StudyError(f"{where}: {count:.3g} cases, more than {limit:,} (fewer values or "
+                         "sample points; or set ROBODYN_MAX_CASES)")
+
+
 @dataclass(frozen=True)
 class Grid:
     """The product of value lists, the last key varying fastest.
@@ -106,6 +121,8 @@ class Grid:
                 raise StudyError(f"grid parameter {name!r}: expected a list of values, got {vals!r}")
             if len(vals) == 0:
                 raise StudyError(f"grid parameter {name!r}: empty list of values")
+        check_case_count(math.prod(len(self.values[n]) for n in names),
+                         f"grid over {', '.join(names)}")
         return [dict(zip(names, combo, strict=True))
                 for combo in itertools.product(*(self.values[n] for n in names))]
 
@@ -125,6 +142,10 @@ class _Sampler:
         """``n`` sample points (crossed with the grid, if any), each with the fixed values."""
         if isinstance(self.n, bool) or not isinstance(self.n, int | np.integer) or self.n < 1:
             raise StudyError(f"{type(self).__name__}: n must be a positive integer, got {self.n!r}")
+        grid = math.prod(len(v) for v in self.grid.values()
+                         if isinstance(v, Sequence) and not isinstance(v, str | bytes))
+        check_case_count(int(self.n) * grid, f"{type(self).__name__} of n = {self.n}"
+                         + (f" crossed with a grid of {grid}" if self.grid else ""))
         names = list(self.ranges)
         if not names:
             raise StudyError(f"{type(self).__name__}: no ranges to sample")

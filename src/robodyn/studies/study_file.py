@@ -23,6 +23,7 @@ the field and the reason.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,7 +34,7 @@ import numpy as np
 from robodyn.robot.errors import StudyError
 from robodyn.robot.safe_yaml import safe_yaml
 from robodyn.studies.calibration_mc import CalibrationMonteCarlo
-from robodyn.studies.cases import Grid, LatinHypercube, RandomSampler, Range
+from robodyn.studies.cases import Grid, LatinHypercube, RandomSampler, Range, check_case_count
 from robodyn.studies.identification_mc import IdentificationMonteCarlo
 from robodyn.studies.models import RobotSource
 from robodyn.studies.sizing import ActuatorSizing
@@ -119,6 +120,7 @@ def read_study(path: str | Path) -> Study:
     grid, ranges, fixed = _split_parameters(params, task, name)
     seed = _int(data.get("seed", 0), f"{name}: seed")
     repeat = _int(data.get("repeat", 1), f"{name}: repeat", 1)
+    check_case_count(repeat, f"{name}: repeat")  # before its list of counters is built
     if repeat > 1:
         grid["repeat"] = list(range(repeat))
     cases = _cases(data.get("sampler"), grid, ranges, fixed, seed, name)
@@ -207,9 +209,11 @@ def _split_parameters(params: Mapping[str, Any], task: Any, name: str
 def _cases(sampler: Any, grid: dict[str, list[Any]], ranges: dict[str, Range],
            fixed: dict[str, Any], seed: int, name: str) -> Any:
     """The case set: a sampler over the ranges (crossed with the grid), or the plain grid."""
+    combos = math.prod(len(v) for v in grid.values())
     if not ranges:
         if sampler is not None:
             raise StudyError(f"{name}: sampler: given but no parameter is a range to sample")
+        check_case_count(combos, f"{name}: parameters: a grid over {', '.join(grid) or 'nothing'}")
         return Grid({**{k: [v] for k, v in fixed.items()}, **grid})
     if not isinstance(sampler, dict) or "n" not in sampler:
         raise StudyError(f"{name}: sampler: ranges {sorted(ranges)} need a sampler "
@@ -218,6 +222,7 @@ def _cases(sampler: Any, grid: dict[str, list[Any]], ranges: dict[str, Range],
     if skind not in _SAMPLERS:
         raise StudyError(f"{name}: sampler.kind: expected latin_hypercube or random, got {skind!r}")
     n = _int(sampler["n"], f"{name}: sampler.n", 1)
+    check_case_count(n * combos, f"{name}: sampler.n = {n}" + (f" times a grid of {combos}" if grid else ""))
     return _SAMPLERS[skind](ranges, n=n, seed=seed, fixed=fixed, grid=grid)
 
 
