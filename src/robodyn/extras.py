@@ -27,7 +27,7 @@ __all__ = ["EXTRAS", "MissingExtraError", "require"]
 EXTRAS: dict[str, str] = {
     "dask": "study", "distributed": "study", "cloudpickle": "study", "pyarrow": "study",
     "cvxpy": "sdp", "clarabel": "sdp",
-    "mcap": "ros", "mcap_ros2": "ros",
+    "mcap": "ros", "mcap_ros2": "ros", "zstandard": "ros",
 }
 
 

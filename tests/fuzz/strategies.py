@@ -8,6 +8,9 @@ has a deadline, so a loader that hangs or explodes on a small input fails the te
 from __future__ import annotations
 
 import os
+import tracemalloc
+from collections.abc import Iterator
+from contextlib import contextmanager
 from datetime import timedelta
 
 from hypothesis import HealthCheck, settings
@@ -15,6 +18,23 @@ from hypothesis import strategies as st
 
 #: Largest generated or mutated file, bytes.
 MAX_BYTES = 64 * 1024
+
+#: Largest peak of memory one reader or command may allocate on a generated input, bytes
+#: (``tracemalloc`` sees NumPy's arrays too): a small input that expands into gigabytes fails.
+MEMORY_CAP = 256 * 2**20
+
+
+@contextmanager
+def memory_capped() -> Iterator[None]:
+    """Assert that the block allocates at most :data:`MEMORY_CAP` at its peak."""
+    tracemalloc.start()
+    try:
+        yield
+    finally:
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        assert peak < MEMORY_CAP, f"{peak / 2**20:.0f} MiB allocated"
+
 
 #: Examples per fuzz test (``ROBODYN_FUZZ_EXAMPLES`` raises it for a longer local run).
 FUZZ_EXAMPLES = int(os.environ.get("ROBODYN_FUZZ_EXAMPLES", "40"))

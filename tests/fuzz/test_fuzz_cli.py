@@ -2,8 +2,10 @@
 
 For every generated input the only outcomes allowed are exit 0 or exit 2 with one line on
 stderr (bad input). Exit 1 here would be an internal error (a bug, see robodyn.cli), a traceback
-escaping ``main`` fails the test, the input files are unchanged, and nothing is written outside
-the output folder given.
+escaping ``main`` fails the test, the input files are unchanged, nothing is written outside
+the output folder given, and the memory the command allocates stays under ``MEMORY_CAP``
+(``tests.fuzz.strategies``: measured by ``tracemalloc``, which sees NumPy's arrays too, so a
+small input that expands into gigabytes fails here rather than on a user's machine).
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import hashlib
 import io
 import os
 import tempfile
+import tracemalloc
 import warnings
 from contextlib import redirect_stderr, redirect_stdout
 from pathlib import Path
@@ -23,7 +26,7 @@ from hypothesis import strategies as st
 from robodyn.cli import main
 from robodyn.errors import StudyError
 from robodyn.studies.study_file import read_study
-from tests.fuzz.strategies import TOKENS, fuzz_settings, mutated
+from tests.fuzz.strategies import MEMORY_CAP, TOKENS, fuzz_settings, memory_capped, mutated
 
 SPEC = """\
 description: two joints
@@ -62,6 +65,7 @@ def _run(argv: list[str], folder: Path) -> None:
     cwd = os.getcwd()
     os.chdir(folder)
     out, errors = io.StringIO(), io.StringIO()
+    tracemalloc.start()
     try:
         with warnings.catch_warnings(), redirect_stdout(out), redirect_stderr(errors):
             warnings.simplefilter("ignore")
@@ -70,9 +74,12 @@ def _run(argv: list[str], folder: Path) -> None:
             except SystemExit as exc:  # argparse: usage errors exit 2, --help exits 0
                 code = exc.code
     finally:
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
         os.chdir(cwd)
     err = errors.getvalue().strip()
     assert code in (0, 2), (argv, code, err)
+    assert peak < MEMORY_CAP, (argv, f"{peak / 2**20:.0f} MiB allocated")
     if code == 2 and err.startswith("robodyn: error:"):
         assert len(err.splitlines()) == 1, err
     after = {k: v for k, v in _digest(folder).items() if not k.startswith("out")}
@@ -97,10 +104,11 @@ def test_mutated_study_file_reads_or_is_refused(text: str) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "study.yaml"
         path.write_text(text, encoding="utf-8", errors="surrogatepass")
-        try:
-            read_study(path)
-        except StudyError as exc:
-            assert "study.yaml" in str(exc), str(exc)
+        with memory_capped():
+            try:
+                read_study(path)
+            except StudyError as exc:
+                assert "study.yaml" in str(exc), str(exc)
 
 
 _ARG = st.one_of(st.sampled_from(TOKENS), st.sampled_from(

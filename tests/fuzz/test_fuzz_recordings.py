@@ -17,7 +17,7 @@ import robodyn as rd
 from robodyn.measure.csv_io import write_csv
 from robodyn.measure.mcap_io import write_mcap
 from robodyn.robot.errors import RecordingError, RecordingWarning
-from tests.fuzz.strategies import MAX_BYTES, fuzz_settings, mutated
+from tests.fuzz.strategies import MAX_BYTES, fuzz_settings, memory_capped, mutated
 
 
 def _recording() -> rd.Recording:
@@ -41,7 +41,7 @@ def outcome(data: bytes, suffix: str) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / f"run{suffix}"
         path.write_bytes(data)
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), memory_capped():
             warnings.simplefilter("error")  # a stray RuntimeWarning is a defect too
             warnings.simplefilter("ignore", RecordingWarning)
             try:

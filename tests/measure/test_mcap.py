@@ -105,3 +105,37 @@ def test_not_an_mcap_file(tmp_path):
 
 def test_point_stamped_schema_is_what_we_write(tmp_path):
     assert MSGDEFS[POINT_STAMPED].startswith("std_msgs/Header header\ngeometry_msgs/Point point")
+
+
+def _chunk_size_offsets(data: bytes) -> list[int]:
+    """Byte offsets of every Chunk record's uncompressed_size field (MCAP: opcode 0x06, then
+    length u64, start time u64, end time u64, uncompressed_size u64)."""
+    out, i = [], 8  # after the magic
+    while i + 9 <= len(data):
+        op, length = data[i], int.from_bytes(data[i + 1:i + 9], "little")
+        if op == 0x06:
+            out.append(i + 9 + 16)
+        i += 9 + length
+    return out
+
+
+def test_chunk_sizes_are_checked_before_decompression(tmp_path, monkeypatch):
+    # issue 23: a damaged size field sized the decompression buffer (a 4 kB fuzzed bag allocated
+    # 329 MiB); now the stated size must match the zstd frame, and the total the read limit
+    rec = rd.Recording(t=np.arange(200) * 0.01, q=np.ones((200, 2)), joint_names=("a", "b"),
+                       tau=np.zeros((200, 2)))
+    good = write_mcap(rec, tmp_path / "good.mcap").read_bytes()
+    offsets = _chunk_size_offsets(good)
+    assert offsets
+    bad = bytearray(good)
+    bad[offsets[0]:offsets[0] + 8] = (300 * 2**20).to_bytes(8, "little")
+    (tmp_path / "bad.mcap").write_bytes(bytes(bad))
+    with pytest.raises(RecordingError, match=r"bad.mcap: a zstd chunk states 314572800 bytes but its "
+                                             r"frame holds \d+: the bag is damaged"):
+        rd.read_recording(tmp_path / "bad.mcap")
+    stated = sum(int.from_bytes(good[o:o + 8], "little") for o in offsets)
+    assert stated > 2 * len(good)  # zstd: the chunks expand past the file's size
+    limit_mb = 1.5 * len(good) / 2**20  # reads the file, not what it expands to
+    monkeypatch.setenv("ROBODYN_MAX_FILE_MB", repr(limit_mb))
+    with pytest.raises(RecordingError, match=r"good.mcap: expands to more than .* MB when decompressed"):
+        rd.read_recording(tmp_path / "good.mcap")

@@ -8,6 +8,7 @@ Each JointState message may list its joints in any order; they are matched by na
 
 from __future__ import annotations
 
+import io
 from os import PathLike
 from pathlib import Path
 from typing import Any
@@ -15,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from robodyn.extras import require
+from robodyn.measure.csv_io import max_file_bytes
 from robodyn.measure.recording import Recording
 from robodyn.robot.errors import RecordingError
 
@@ -42,6 +44,32 @@ MSGDEFS = {
 def _stamp(msg: Any) -> int:
     """Header stamp in integer nanoseconds."""
     return int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec)
+
+
+def _check_chunks(data: bytes, limit: int, name: str) -> None:
+    """Refuse a bag whose chunks would decompress beyond ``limit`` bytes in all, or whose chunk
+    states a size its data contradicts (a damaged or hostile length field would otherwise size
+    the decompression buffer): before any chunk is decompressed."""
+    Chunk = require("mcap.records", f"reading the ROS 2 bag {name}").Chunk  # noqa: N806
+    StreamReader = require("mcap.stream_reader", f"reading the ROS 2 bag {name}").StreamReader  # noqa: N806
+
+    total = 0
+    for record in StreamReader(io.BytesIO(data), emit_chunks=True, record_size_limit=len(data)).records:
+        if not isinstance(record, Chunk):
+            continue
+        stated = record.uncompressed_size
+        if record.compression == "" and stated != len(record.data):
+            raise RecordingError(f"{name}: a chunk states {stated} bytes but holds {len(record.data)}")
+        if record.compression == "zstd":
+            zstandard = require("zstandard", f"reading the ROS 2 bag {name}")
+            real = zstandard.frame_content_size(record.data)
+            if real >= 0 and real != stated:
+                raise RecordingError(f"{name}: a zstd chunk states {stated} bytes but its frame "
+                                     f"holds {real}: the bag is damaged")
+        total += stated
+        if total > limit:
+            raise RecordingError(f"{name}: expands to more than {limit / 2**20:g} MB when "
+                                 "decompressed (set ROBODYN_MAX_FILE_MB to read it)")
 
 
 def read_mcap(path: str | PathLike[str], robot: Any = None, joint_topic: str | None = None,
@@ -72,8 +100,15 @@ def read_mcap(path: str | PathLike[str], robot: Any = None, joint_topic: str | N
     joints: list[tuple[int, list[str], Any, Any, Any, str]] = []
     tool: dict[str, list[tuple[int, tuple[float, float, float]]]] = {}
     topics: dict[str, str] = {}
+    limit = max_file_bytes()
+    if p.stat().st_size > limit:
+        raise RecordingError(f"{p.name}: {p.stat().st_size / 2**20:.1f} MB, more than the "
+                             f"{limit / 2**20:g} MB read (set ROBODYN_MAX_FILE_MB to read it)")
+    # in memory: a damaged length field then reads what is there instead of allocating what it says
+    data = p.read_bytes()
     try:
-        with p.open("rb") as fh:
+        _check_chunks(data, limit, p.name)
+        with io.BytesIO(data) as fh:
             reader = make_reader(fh, validate_crcs=True, decoder_factories=[DecoderFactory()])
             for schema, channel, _, msg in reader.iter_decoded_messages(log_time_order=True):
                 kind, topic = schema.name, channel.topic
@@ -84,6 +119,8 @@ def read_mcap(path: str | PathLike[str], robot: Any = None, joint_topic: str | N
                 elif kind in (POINT_STAMPED, POSE_STAMPED) and (tool_topic is None or topic == tool_topic):
                     pt = msg.point if kind == POINT_STAMPED else msg.pose.position
                     tool.setdefault(topic, []).append((_stamp(msg), (pt.x, pt.y, pt.z)))
+    except RecordingError:
+        raise
     except Exception as exc:  # noqa: BLE001 - McapError, and any failure of the third-party
         # decoders on a damaged file (zstd/lz4 chunk errors, struct.error, an overflowing length
         # field, mcap_ros2's schema-parser errors), is a property of the file, reported as such
