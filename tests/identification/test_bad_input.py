@@ -98,3 +98,20 @@ def test_infeasible_consistent_problem_is_reported(arm):
                     bounds={"M1": (-2.0, -1.0)}, model=model)
     with pytest.raises(IdentificationError, match=r"bounds: unknown standard parameter 'mass'"):
         rd.identify(robot, rec, method="consistent", cutoff=None, bounds={"mass": (0, 1)}, model=model)
+
+
+def test_positions_in_degrees_named_as_such():
+    # issue 23: a recording in degrees ran to an overflow warning and exit 1; positions a whole
+    # turn beyond a joint's limits cannot be radians of that joint
+    robot = load_quiet("puma560")  # limits from the description, e.g. q1 in [-2.79, 2.79] rad
+    t = np.arange(500) * 0.01
+    q_rad = 0.8 * np.sin(np.outer(t, np.arange(1, 7)))  # inside every limit
+    rec = rd.Recording(t=t, q=np.degrees(q_rad), tau=np.zeros_like(q_rad), source="deg.csv")
+    with pytest.raises(IdentificationError, match=r"deg.csv: q: joint q1 reaches 45.8\d* rad at row "
+                                                  r"\d+, .* beyond its limits .* positions in degrees\?"):
+        rd.identify(robot, rec)
+    # a trajectory that only leaves the limits (a simulated one may) is not refused by this check
+    ok = rd.Recording(t=t, q=q_rad * 4, tau=np.zeros_like(q_rad), source="wide.csv")
+    from robodyn.identification.inputs import check_within_limits
+
+    check_within_limits(robot, ok.q, "wide.csv")

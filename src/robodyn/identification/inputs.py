@@ -69,6 +69,29 @@ def check_recording(robot: Robot, rec: Any, index: int, target: str | None) -> N
             column = "" if name == "t" else f", column {col} ({robot.joint_names[col]})"
             raise IdentificationError(f"{src}: {name}: value {a[row, col]} is not finite at row "
                                       f"{row}{column}")
+    check_within_limits(robot, q, src)
+
+
+def check_within_limits(robot: Robot, q: np.ndarray, src: str) -> None:
+    """Refuse positions a whole turn (2 pi) or more beyond a revolute joint's limits: no reading
+    of that joint in radians can be there, while degrees read as radians are (a joint at 60 deg
+    reads 60 "rad"), and so can be a recording of another robot or in another joint order.
+    (Trajectories that merely leave the limits, as simulated ones may, are left alone.)"""
+    subs = robot.defaults()
+    for j, joint in enumerate(robot.joints):
+        if joint.type != "revolute" or joint.lower is None or joint.upper is None:
+            continue
+        lo, hi = float(joint.lower.xreplace(subs)), float(joint.upper.xreplace(subs))
+        if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
+            continue
+        beyond = np.maximum(lo - q[:, j], q[:, j] - hi)
+        k = int(np.argmax(beyond))
+        if beyond[k] > 2 * np.pi:
+            raise IdentificationError(
+                f"{src}: q: joint {joint.name} reaches {q[k, j]:.4g} rad at row {k}, "
+                f"{beyond[k]:.3g} rad beyond its limits [{lo:.4g}, {hi:.4g}] in {robot.name!r}: "
+                "positions in degrees? (a recording spec declares position: {unit: deg}); or a "
+                "recording of another robot or joint order")
 
 
 def checked_inputs(robot: Robot, recordings: Any, target: str | None, method: str, friction: str,
