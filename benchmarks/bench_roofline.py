@@ -120,6 +120,7 @@ def main() -> None:
     results.add_options(parser)
     args = parser.parse_args()
     repeat = 3 if args.quick else 7
+    load_at_start = results.load_average()
     lib, width = _library()
     peak = peak_gflops(lib, width, repeat)
     bw = triad_gbs(lib, repeat)
@@ -149,7 +150,8 @@ def main() -> None:
           f"rate): {memory_ns:.2f} ns/state: the kernel is compute-bound")
     path = results.target(args)
     if path is not None:
-        results.merge(path, "roofline", {"command": " ".join(sys.argv[1:]) or "(defaults)",
+        command = " ".join(["python", "benchmarks/bench_roofline.py", *sys.argv[1:]])
+        results.merge(path, "roofline", {"command": command, "load_average_at_start": load_at_start,
                                           "peak": peak, "triad": bw, "inverse_dynamics": idyn,
                                           "roofline": roofline})
         print(f"results: {path}")

@@ -319,9 +319,32 @@ def render_hydro(data: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def render_roofline(data: dict[str, Any]) -> str:
+    """Markdown of the ``roofline`` entry: peak, bandwidth, inverse dynamics against its floors."""
+    e = data["benchmarks"]["roofline"]
+    p, b, i, r = e["peak"], e["triad"], e["inverse_dynamics"], e["roofline"]
+    met = "met" if r["times_compute_floor"] <= r["target_times_floor"] else "not met"
+    text = (
+        f"{_run(data, e, 'The roofline of one core')} Peak FP64 rate measured by "
+        f"{p['chains']} fused multiply-add chains on {p['vector_doubles']}-double vectors with "
+        f"robodyn's compiler flags: {_sig(p['gflops'])} GFLOP/s (median {_sig(p['median_gflops'])}); "
+        f"STREAM triad over 3 x {b['array_mib']} MiB: {_sig(b['gbs'])} GB/s (median "
+        f"{_sig(b['median_gbs'])}). PUMA 560 inverse dynamics with its friction, "
+        f"{i['states']:,} states on one thread: {_sig(i['ns_per_state']['min'])} ns per state "
+        f"(median {_sig(i['ns_per_state']['median'])}) for {i['multiplications']} multiplications "
+        f"and {i['additions']} additions of the generated program ({i['functions']} sines and "
+        f"cosines not counted), {_sig(r['achieved_gflops'])} GFLOP/s = "
+        f"{100 * r['fraction_of_peak']:.0f} % of the peak: {r['times_compute_floor']:.2f}x the "
+        f"floor of {_sig(r['compute_floor_ns'])} ns that its op count sets at the peak rate "
+        f"(target at most {r['target_times_floor']:g}x: {met}). A streaming batch moves "
+        f"{i['bytes_per_state']} bytes per state, {_sig(r['memory_floor_ns'])} ns at the triad "
+        "rate: the kernel is compute-bound.")
+    return "\n".join(_wrap(text)) + "\n"
+
+
 RENDERERS: dict[str, Callable[[dict[str, Any]], str]] = {
     "kernels": render_kernels, "casadi": render_casadi, "ensemble": render_ensemble,
-    "simulation": render_simulation, "hydro": render_hydro}
+    "simulation": render_simulation, "hydro": render_hydro, "roofline": render_roofline}
 
 
 def render(text: str, root: Path = ROOT, results: str | None = None) -> str:
