@@ -146,8 +146,11 @@ def main() -> None:
     print(f"  achieved {roofline['achieved_gflops']:.2f} GFLOP/s = "
           f"{100 * roofline['fraction_of_peak']:.1f} % of peak; compute floor {floor_ns:.1f} "
           f"ns/state -> {times:.2f}x the floor (target <= 3x: {'met' if times <= 3 else 'NOT met'})")
+    bound = "compute" if floor_ns >= memory_ns else "memory"
     print(f"  memory floor of a streaming batch ({idyn['bytes_per_state']} B/state at the triad "
-          f"rate): {memory_ns:.2f} ns/state: the kernel is compute-bound")
+          f"rate): {memory_ns:.2f} ns/state: by its floors the kernel is {bound}-bound "
+          f"({flops / idyn['bytes_per_state']:.2f} flop/B against the ridge at "
+          f"{peak['gflops'] / bw['gbs']:.2f})")
     path = results.target(args)
     if path is not None:
         command = " ".join(["python", "benchmarks/bench_roofline.py", *sys.argv[1:]])

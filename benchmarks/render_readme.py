@@ -338,7 +338,8 @@ def render_roofline(data: dict[str, Any]) -> str:
         f"floor of {_sig(r['compute_floor_ns'])} ns that its op count sets at the peak rate "
         f"(target at most {r['target_times_floor']:g}x: {met}). A streaming batch moves "
         f"{i['bytes_per_state']} bytes per state, {_sig(r['memory_floor_ns'])} ns at the triad "
-        "rate: the kernel is compute-bound.")
+        f"rate: by its two floors the kernel is "
+        f"{'compute' if r['compute_floor_ns'] >= r['memory_floor_ns'] else 'memory'}-bound.")
     return "\n".join(_wrap(text)) + "\n"
 
 

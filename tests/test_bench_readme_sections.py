@@ -1,4 +1,4 @@
-"""The README's CasADi, ensemble, simulation and hydro figures are those of its results file.
+"""The README's CasADi, ensemble, simulation, hydro and roofline figures are those of its results file.
 
 Issue 22, items 1c-1e and 2: each benchmark merges its figures into
 ``benchmarks/results/<machine>.json`` and ``benchmarks/render_readme.py`` renders one marked
@@ -19,7 +19,7 @@ from typing import Any
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-SECTIONS = ("casadi", "ensemble", "simulation", "hydro")
+SECTIONS = ("casadi", "ensemble", "simulation", "hydro", "roofline")
 
 
 @pytest.fixture(scope="module")
@@ -152,3 +152,16 @@ def test_hydro_rows_have_scipy_at_its_best(sections):
     s = entry["simulation"]
     assert {"SciPy RK45 + lambdify", "SciPy DOP853 + compiled RHS"} <= {r["label"] for r in s["rows"]}
     _check_routes(s["rows"], s["sweeps"], "vs_simulate", "robodyn rd.simulate")
+
+
+def test_roofline_figures_follow_from_the_measurements(sections):
+    e = _data(sections, "roofline")["benchmarks"]["roofline"]
+    i, r = e["inverse_dynamics"], e["roofline"]
+    flops = i["additions"] + i["multiplications"]
+    ns = i["ns_per_state"]["min"]
+    assert r["flops_per_state"] == flops > 0
+    assert r["achieved_gflops"] == pytest.approx(flops / ns, rel=0.01)  # flop per ns = GFLOP/s
+    assert r["compute_floor_ns"] == pytest.approx(flops / e["peak"]["gflops"], rel=0.01)
+    assert r["times_compute_floor"] == pytest.approx(ns / r["compute_floor_ns"], rel=0.01)
+    assert r["memory_floor_ns"] == pytest.approx(i["bytes_per_state"] / e["triad"]["gbs"], rel=0.01)
+    assert 0 < r["fraction_of_peak"] <= 1 and e["peak"]["median_gflops"] <= e["peak"]["gflops"]
