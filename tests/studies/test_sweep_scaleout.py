@@ -79,7 +79,8 @@ def test_workers_that_join_after_submission_get_batches(grow):
 @pytest.mark.tool("gcc|cc")  # here, to build the models shipped
 def test_workers_without_compiler_or_cache_get_the_compiled_models(tmp_path):
     # issue 24: compiled models were never shipped, so every worker needed the toolchain.
-    # Two `dask worker` processes, each with its own empty cache and no compiler on PATH or in $CC.
+    # Two `dask worker` processes, each with its own empty cache and no compiler on PATH or in $CC,
+    # that join the cluster after the sweep was submitted (the plugin reaches late joiners too).
     from distributed import Client, LocalCluster
 
     task = _planar_sizing()
@@ -87,9 +88,17 @@ def test_workers_without_compiler_or_cache_get_the_compiled_models(tmp_path):
     empty = tmp_path / "bin"
     empty.mkdir()
     caches = [tmp_path / f"cache{k}" for k in range(2)]
+    found: dict = {}
     with LocalCluster(n_workers=0, processes=False, protocol="tcp://", host="127.0.0.1",
                       dashboard_address=None, silence_logs=logging.ERROR) as cluster, \
             Client(cluster, set_as_default=False) as client:
+        run = threading.Thread(target=lambda: found.update(
+            table=sweep(task, grid, client=client, seed=None, batch=1)))
+        run.start()
+        deadline = time.monotonic() + 60
+        while client.run_on_scheduler(_scheduler_tasks) < 6 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert client.nthreads() == {}  # submitted before any worker exists
         workers = [subprocess.Popen(
             [sys.executable, "-m", "distributed.cli.dask_worker", cluster.scheduler_address,
              "--nthreads", "1", "--no-nanny", "--no-dashboard", "--name", f"bare-{k}"],
@@ -99,12 +108,13 @@ def test_workers_without_compiler_or_cache_get_the_compiled_models(tmp_path):
         try:
             client.wait_for_workers(2, timeout=60)
             assert list(client.run(has_compiler).values()) == [False, False]
-            table = sweep(task, grid, client=client, seed=None, batch=1)
+            run.join(timeout=240)
         finally:
             for proc in workers:
                 proc.terminate()
             for proc in workers:
                 proc.wait(timeout=30)
+    table = found["table"]
     assert table["error"].isna().all() and len(table) == 6  # without the models: "no C compiler"
     assert table.equals(run_serial(task, grid, seed=None))  # bit for bit
     used = [c for c in caches if c.is_dir()]
