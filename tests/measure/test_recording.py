@@ -103,3 +103,23 @@ def test_slice_select_resample():
         rec.select(["c"])
     with pytest.raises(RecordingError, match="keeps 0 sample"):
         rec.slice(5.0, 6.0)
+
+
+def test_rows_keeps_measured_fields_and_re_estimates_the_estimated():
+    t = np.arange(200) * 0.01
+    q = np.column_stack([np.sin(t), np.cos(t)])
+    q_bad = q.copy()
+    q_bad[100, 0] += 0.5  # a glitch
+    rec = rd.Recording(t=t, q=q_bad, tau=np.ones_like(q))
+    assert {"qd", "qdd"} <= rec.estimated
+    keep = np.ones(t.size, bool)
+    keep[100] = False
+    clean = rec.rows(keep)
+    assert clean.n_samples == 199 and np.array_equal(clean.tau, np.ones((199, 2)))
+    # the velocities are estimated again from the kept rows: the glitch leaves no bump
+    again = rd.Recording(t=t[keep], q=q[keep], tau=np.ones((199, 2)))
+    np.testing.assert_allclose(clean.qd, again.qd, rtol=0, atol=1e-12)
+    measured = rd.Recording(t=t, q=q, qd=np.zeros_like(q), tau=np.ones_like(q))
+    assert np.array_equal(measured.rows(keep).qd, np.zeros((199, 2)))  # measured: kept as given
+    with pytest.raises(RecordingError, match="rows\\(\\) keeps 1 of 200 samples"):
+        rec.rows(np.arange(200) == 3)

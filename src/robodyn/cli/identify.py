@@ -130,7 +130,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
         ident = rd.identify(robot, recs + loaded, target=args.target, method=args.method,
                             model=model,
                             friction=args.friction, velocity=args.velocity,
-                            dead_band=args.dead_band, cutoff=args.cutoff,
+                            dead_band=args.dead_band, spikes=args.spikes, cutoff=args.cutoff,
                             regularization=args.regularization, decimate=args.decimate,
                             sensor=args.sensor, **extra)
     paths = {"yaml": out / f"{stem}.yaml", "urdf": out / f"{stem}.urdf",
@@ -415,6 +415,10 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
                    help="Coulomb dead band in rad/s, in the fit and the prediction alike (below "
                         "it a joint carries only its friction offset), or auto: 0 or 1e-3 chosen "
                         "by held-out time blocks (default: %(default)s)")
+    p.add_argument("--spikes", choices=("keep", "drop"), default="keep",
+                   help="one-sample glitches (a position or target sample far off the line "
+                        "through its neighbours) in the identification recordings: keep them, or "
+                        "drop those rows before the fit (default: %(default)s)")
     p.add_argument("--cutoff", type=_auto_or(float, none=True), default="auto", metavar="HZ",
                    help="zero-phase low-pass cut-off in Hz, none (the recording's own "
                         "velocities and accelerations), or auto: the motion's bandwidth within "

@@ -272,6 +272,24 @@ class Recording:
                 tool = {"tool_t": self.tool_t[tk], "tool_points": self.tool_points[tk]}
         return replace(self, t=self.t[keep], **arrays, **tool)
 
+    def rows(self, keep: np.ndarray) -> Recording:
+        """The joint samples where ``keep`` (N,) is true (tool samples unchanged). Fields that were
+        estimated rather than measured (``estimated``: velocities, accelerations from ``q``) are
+        estimated again from the kept samples, so a dropped glitch leaves no trace in them.
+
+        Raises
+        ------
+        RecordingError
+            ``keep`` of another length, or fewer than 2 samples kept.
+        """
+        keep = np.asarray(keep, dtype=bool)
+        if keep.shape != self.t.shape or keep.sum() < 2:
+            raise RecordingError(f"{self._where('t')}: rows() keeps {int(keep.sum())} of "
+                                 f"{self.t.size} samples (a mask of {keep.size}); at least 2 needed")
+        arrays = {k: (None if v is None or k in self.estimated else v[keep])
+                  for k, v in self._joint_arrays().items()}
+        return replace(self, t=self.t[keep], **arrays, estimated=frozenset())
+
     def select(self, joints: Sequence[str | int]) -> Recording:
         """A recording of some joints, in the order given (names or 0-based indices)."""
         idx = []

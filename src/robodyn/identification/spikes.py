@@ -1,0 +1,93 @@
+"""Isolated corrupt rows in a recording: one-sample spikes found before identification.
+
+A logger's glitch (an encoder reading off by a fraction of a turn for one sample, a torque or
+current spike, a row of zeros) is a sample far from the line through its two neighbours while
+the neighbours agree with each other. Differentiated and filtered, one such sample becomes a
+bump of velocity and acceleration a filter's length wide, which the least squares then fit
+(on a simulated PUMA log, five corrupt rows of 6000 made the held-out error 15 times the clean
+fit's). For every column of the positions and of the target, with stamps ``t``::
+
+    d_k = x_k - (x_{k-1} + (x_{k+1} - x_{k-1}) (t_k - t_{k-1}) / (t_{k+1} - t_{k-1}))
+
+is the sample's distance from its neighbours' line. Sample ``k`` is a spike when ``|d_k|`` exceeds
+``THRESHOLD`` robust standard deviations of ``d`` (1.4826 times its median absolute deviation, at
+least ``QUANTA`` steps of the column's resolution, so that printed values are not spikes) and is
+more than ``SHAPE`` times both neighbours' ``|d|`` (a spike gives -s/2, s, -s/2; a step, such as
+Coulomb friction reversing, gives h/2, -h/2 and is kept). Spikes are removed (their rows
+dropped, the stamps kept irregular) and counted; a second pass finds one of two adjacent ones.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from robodyn.robot.errors import RecordingWarning
+
+__all__ = ["QUANTA", "SHAPE", "THRESHOLD", "drop_spikes", "spike_rows"]
+
+#: Robust standard deviations beyond which a sample's distance from its neighbours' line is a spike.
+THRESHOLD = 12.0
+#: A spike's distance is more than this many times each neighbour's.
+SHAPE = 1.5
+#: The scale is at least this many steps of the column's resolution (its smallest nonzero change).
+QUANTA = 4.0
+#: Passes (each can drop one of two adjacent corrupt rows).
+PASSES = 2
+
+
+def _distances(t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``d`` of every interior sample (rows 1 .. N-2), shape (N - 2, columns)."""
+    w = ((t[1:-1] - t[:-2]) / (t[2:] - t[:-2]))[:, None]
+    return x[1:-1] - (x[:-2] + (x[2:] - x[:-2]) * w)
+
+
+def _scale(d: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Per column: the robust standard deviation of ``d``, at least ``QUANTA`` resolution steps."""
+    mad = 1.4826 * np.median(np.abs(d - np.median(d, axis=0)), axis=0)
+    steps = np.abs(np.diff(x, axis=0))
+    steps = np.where(steps > 0, steps, np.inf)
+    quantum = np.min(steps, axis=0)
+    quantum = np.where(np.isfinite(quantum), quantum, 0.0)
+    return np.maximum(mad, QUANTA * quantum)
+
+
+def spike_rows(t: np.ndarray, *signals: np.ndarray) -> np.ndarray:
+    """Rows (N,) that are a one-sample spike in some column of ``signals`` (each (N, n)); NaN
+    columns (no sensor) are skipped."""
+    t = np.asarray(t, dtype=float)
+    out = np.zeros(t.size, dtype=bool)
+    if t.size < 5:
+        return out
+    for x in signals:
+        x = np.asarray(x, dtype=float)
+        x = x[:, np.all(np.isfinite(x), axis=0)]
+        if x.shape[1] == 0:
+            continue
+        d = np.abs(_distances(t, x))
+        scale = _scale(d, x)
+        big = d > THRESHOLD * np.where(scale > 0, scale, np.inf)
+        padded = np.pad(d, ((1, 1), (0, 0)))
+        shaped = (d > SHAPE * padded[:-2]) & (d > SHAPE * padded[2:])
+        out[1:-1] |= np.any(big & shaped, axis=1)
+    return out
+
+
+def drop_spikes(rec: Any, target: str) -> tuple[Any, int]:
+    """``rec`` without the rows that are spikes in ``q`` or in ``target``, and how many were
+    dropped (``rec`` itself when none)."""
+    dropped = 0
+    if not callable(getattr(rec, "rows", None)):
+        return rec, 0  # not a Recording: left as given
+    for _ in range(PASSES):
+        y = getattr(rec, target, None)
+        rows = spike_rows(rec.t, rec.q, *([] if y is None else [y]))
+        if not rows.any():
+            break
+        with warnings.catch_warnings():  # the dropped rows are the only 'gaps' this adds
+            warnings.simplefilter("ignore", RecordingWarning)
+            rec = rec.rows(~rows)
+        dropped += int(rows.sum())
+    return rec, dropped
