@@ -15,6 +15,7 @@ from robodyn.identification.consistent import EPS, _project_link, pseudo_inertia
 from robodyn.identification.pipeline import nominal_standard
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.validation import inertia_problems
+from robodyn.robot.yaml_writer import dump_yaml
 from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
 from tests.identification.helpers import fourier, load_quiet
 
@@ -404,3 +405,30 @@ def test_a_few_corrupt_rows_are_dropped_as_spikes(puma):
     assert set(np.flatnonzero(found)) == set(rows)  # the five rows, and only they
     assert not spike_rows(t, fit.q, noisy_tau).any()  # clean data: nothing
     assert held_out(q, tau) < 1.02 * clean
+
+
+def test_least_squares_writes_a_physical_completion_when_one_exists(puma, tmp_path):
+    # issue 25 item 6 (the other half): the PUMA 560's own description gives its first link
+    # principal moments 0, 0, 0.35 (triangle inequality broken); only Izz of that link reaches the
+    # base parameters, so the plain completion with the description's values wrote an impossible
+    # link although a physical one with the same base parameters (the same predictions) exists
+    from robodyn.identification.completion import physical
+    from robodyn.identification.pipeline import _complete
+
+    robot, model = puma
+    t = np.arange(0.0, 20.0, 0.01)
+    q, qd, qdd = fourier(t, robot.dof, np.random.default_rng(4))
+    rec = rd.Recording(t=t, q=q, qd=qd, qdd=qdd, tau=model.inverse_dynamics(q, qd, qdd),
+                       joint_names=robot.joint_names)
+    ident = rd.identify(robot, rec, model=model, cutoff=None, regularization=None, method="ols")
+    theta = ident.relations.to_base(ident.standard)
+    plain = _complete(ident.relations, theta, nominal_standard(robot))
+    assert not physical(plain, robot.dof)  # what was written before
+    assert physical(ident.standard, robot.dof)
+    np.testing.assert_allclose(theta, ident.relations.to_base(plain), rtol=1e-7, atol=1e-9)
+    # the written description loads strictly and predicts what the identification predicts
+    path = tmp_path / "puma_identified.yaml"
+    path.write_text(dump_yaml(ident.robot))
+    again = rd.load(str(path), strict=True)
+    np.testing.assert_allclose(rd.compile_model(again).inverse_dynamics(q[:200], qd[:200], qdd[:200]),
+                               ident.predict(rec)[:200], rtol=1e-6, atol=1e-6)

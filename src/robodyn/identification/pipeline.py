@@ -28,6 +28,7 @@ import sympy as sp
 
 from robodyn.identification.base import BaseRelations, base_relations
 from robodyn.identification.choices import Candidate, Choices, Problem, candidates, choose
+from robodyn.identification.completion import consistent_completion
 from robodyn.identification.drive_gains import estimate_drive_gains
 from robodyn.identification.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identification.friction import NONLINEAR, fit_friction_samples, without_friction
@@ -500,7 +501,9 @@ def _estimate_standard(robot: Robot, relations: BaseRelations, step: _LinearStep
     """Base parameters (b,) and the full standard set (15 n,) of the estimate (steps 6 and 7).
 
     ``method="consistent"``: the physically consistent standard set; otherwise the linear fit
-    completed with ``prior`` (15 n,) for the dependent parameters.
+    completed with ``prior`` (15 n,) for the dependent parameters, or, when that is not
+    physical, with the physical completion closest to it that has the same base parameters
+    (:mod:`robodyn.identification.completion`).
     """
     if method == "consistent":
         from robodyn.identification.consistent import consistent_standard
@@ -509,7 +512,8 @@ def _estimate_standard(robot: Robot, relations: BaseRelations, step: _LinearStep
                                        bounds)
         return relations.to_base(standard), standard
     theta = step.fit.theta
-    return theta, _complete(relations, theta, prior)
+    # the same base parameters, with a physical standard set when one exists
+    return theta, consistent_completion(relations, _complete(relations, theta, prior), robot.dof)
 
 
 def _identification(robot: Robot, data: _Prepared, step: _LinearStep, theta: np.ndarray,
