@@ -115,3 +115,26 @@ def test_positions_in_degrees_named_as_such():
     from robodyn.identification.inputs import check_within_limits
 
     check_within_limits(robot, ok.q, "wide.csv")
+
+
+def test_options_object_checks_once_and_runs_like_the_keywords(arm):
+    # issue 21 item 6: the choices in one checked object; the keywords build the same object
+    robot, model = arm
+    rec, _ = simulated(model, seconds=4.0, noise=0.01)
+    by_keywords = rd.identify(robot, rec, cutoff=None, regularization=None, method="ols", model=model)
+    opts = rd.IdentifyOptions(cutoff=None, regularization=None, method="ols")
+    by_options = rd.identify(robot, rec, options=opts, model=model)
+    np.testing.assert_array_equal(by_options.standard, by_keywords.standard)
+    assert by_options.options is opts and by_keywords.options.method == "ols"
+    assert by_keywords.options.cutoff is None and by_keywords.options.spikes == "keep"
+    for bad, message in [({"method": "lasso"}, r"method: expected one of \('ols', 'wls', 'consistent'\)"),
+                         ({"spikes": "clip"}, r"spikes: expected one of \('keep', 'drop'\)"),
+                         ({"weights": "state-noise"}, r"state_noise: weights='state-noise' needs"),
+                         ({"thermal": 1}, r"thermal: expected False, True or 'auto', got 1")]:
+        with pytest.raises(IdentificationError, match=message):
+            rd.IdentifyOptions(**bad)
+    with pytest.raises(IdentificationError, match=r"options: given together with the keyword\(s\) "
+                                                  r"method, spikes"):
+        rd.identify(robot, rec, options=opts, method="consistent", spikes="drop", model=model)
+    with pytest.raises(IdentificationError, match="options: expected an IdentifyOptions, got dict"):
+        rd.identify(robot, rec, options={"method": "ols"}, model=model)

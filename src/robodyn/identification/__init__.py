@@ -7,6 +7,7 @@ from robodyn.identification.base import BaseRelations, base_relations
 from robodyn.identification.friction import FrictionFit, fit_friction
 from robodyn.identification.friction_table import friction_table
 from robodyn.identification.jointwise import JointIdentification, identify_joint
+from robodyn.identification.options import IdentifyOptions
 from robodyn.identification.payload import Payload
 from robodyn.identification.pipeline import identify
 from robodyn.identification.preprocess import Preprocess
@@ -17,6 +18,7 @@ __all__ = [
     "BaseRelations",
     "FrictionFit",
     "Identification",
+    "IdentifyOptions",
     "JointIdentification",
     "Payload",
     "Preprocess",

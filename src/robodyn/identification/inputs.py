@@ -11,16 +11,13 @@ from typing import Any
 
 import numpy as np
 
-from robodyn.identification.friction import FRICTION_MODELS
 from robodyn.identification.payload import Payload
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
 
-__all__ = ["METHODS", "TARGETS", "WEIGHTS", "check_payloads", "check_recording", "checked_inputs"]
+__all__ = ["TARGETS", "check_payloads", "check_recording", "checked_inputs"]
 
 TARGETS = ("tau", "current")
-METHODS = ("ols", "wls", "consistent")
-WEIGHTS = ("residual", "state-noise")
 
 
 def _src(rec: Any, index: int) -> str:
@@ -94,15 +91,14 @@ def check_within_limits(robot: Robot, q: np.ndarray, src: str) -> None:
                 "recording of another robot or joint order")
 
 
-def checked_inputs(robot: Robot, recordings: Any, target: str | None, method: str, friction: str,
-                    weights: str, state_noise: Any, gains: str, velocity: str, dead_band: Any,
-                    thermal: Any, sensor: str,
-                    payloads: Sequence[Payload | None] | None
-                    ) -> tuple[list[Any], str, list[Payload | None]]:
-    """The recordings as a list, the resolved target and one payload per recording (step 1).
+def checked_inputs(robot: Robot, recordings: Any, target: str | None, sensor: str,
+                   payloads: Sequence[Payload | None] | None
+                   ) -> tuple[list[Any], str, list[Payload | None]]:
+    """The recordings as a list, the resolved target and one payload per recording (step 1;
+    the options are checked by :class:`~robodyn.identification.options.IdentifyOptions`).
 
-    Raises :class:`IdentificationError` on no recordings, an unknown option, missing state
-    noise for ``weights="state-noise"``, a recording that does not fit ``robot``
+    Raises :class:`IdentificationError` on no recordings, an unknown target, a link-side
+    ``sensor`` without torques, a recording that does not fit ``robot``
     (:func:`check_recording`) or malformed payloads.
     """
     recs = [recordings] if hasattr(recordings, "q") else list(recordings)
@@ -112,29 +108,9 @@ def checked_inputs(robot: Robot, recordings: Any, target: str | None, method: st
         target = "tau" if all(getattr(r, "tau", None) is not None for r in recs) else "current"
     if target not in TARGETS:
         raise IdentificationError(f"target: expected one of {TARGETS}, got {target!r}")
-    if method not in METHODS:
-        raise IdentificationError(f"method: expected one of {METHODS}, got {method!r}")
-    if friction not in (*FRICTION_MODELS, "auto"):
-        raise IdentificationError(f"friction: expected one of {(*FRICTION_MODELS, 'auto')}, got "
-                                  f"{friction!r}")
-    if weights not in WEIGHTS:
-        raise IdentificationError(f"weights: expected one of {WEIGHTS}, got {weights!r}")
-    if weights == "state-noise" and state_noise is None:
-        raise IdentificationError("state_noise: weights='state-noise' needs the state noise "
-                                  "(s_q, s_qd, s_qdd) in rad, rad/s, rad/s^2")
-    if velocity not in ("auto", "position", "measured"):
-        raise IdentificationError(f"velocity: expected 'auto', 'position' or 'measured', got {velocity!r}")
-    if sensor not in ("motor", "link"):
-        raise IdentificationError(f"sensor: expected 'motor' or 'link', got {sensor!r}")
     if sensor == "link" and target != "tau":
         raise IdentificationError("sensor: 'link' (a joint torque sensor after the gear) needs "
                                   f"target='tau', got target={target!r}")
-    if thermal not in (False, True, "auto"):
-        raise IdentificationError(f"thermal: expected False, True or 'auto', got {thermal!r}")
-    if isinstance(dead_band, str) and dead_band != "auto":
-        raise IdentificationError(f"dead_band: expected a velocity in rad/s or 'auto', got {dead_band!r}")
-    if gains not in ("auto", "description", "absorbed"):
-        raise IdentificationError(f"gains: expected 'auto', 'description' or 'absorbed', got {gains!r}")
     for i, rec in enumerate(recs):
         check_recording(robot, rec, i, target)
     return recs, target, check_payloads(payloads, len(recs))

@@ -34,6 +34,7 @@ from robodyn.identification.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identification.friction import NONLINEAR, fit_friction_samples, without_friction
 from robodyn.identification.friction_choice import choose_friction_law
 from robodyn.identification.inputs import check_recording, checked_inputs
+from robodyn.identification.options import IdentifyOptions, keywords_given
 from robodyn.identification.payload import Payload, payload_standard, payload_torque
 from robodyn.identification.preprocess import (
     DEAD_BAND,
@@ -107,7 +108,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
              bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None,
              payloads: Sequence[Payload | None] | None = None, weights: str = "residual",
              state_noise: Any = None, thermal: bool | str = False, sensor: str = "motor",
-             spikes: str = "keep") -> Identification:
+             spikes: str = "keep", options: IdentifyOptions | None = None) -> Identification:
     """Identify the base inertial, drive and friction parameters of a robot from recordings.
 
     Parameters
@@ -120,34 +121,12 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         ``tau`` or ``current`` (N, n).
     target : {"tau", "current"}, optional
         Default: ``"tau"`` when every recording has torques, else ``"current"``.
-    method : {"ols", "wls", "consistent"}
-        Ordinary or weighted least squares, or physically consistent (pseudo-inertia LMIs).
-    friction : {"linear", "none", "stribeck", "load", "polynomial", "auto"}
-        "linear": viscous, Coulomb (+/-) and offset per joint in the linear fit; "none": no
-        friction; the others: a nonlinear law fitted after the linear step
-        (:mod:`robodyn.identification.friction`); "auto": linear or Stribeck, chosen by time-block
-        cross-validation (:mod:`robodyn.identification.friction_choice`).
-    regularization : "auto", float or None
-        Tikhonov weight toward the description's values (dimensionless, see
-        :mod:`robodyn.identification.estimate`); "auto": chosen by time-block cross-validation on these
-        data; None: plain least squares (not-excited directions stay at the prior).
-    cutoff : "auto", float or None
-        Zero-phase low-pass cut-off, Hz (:mod:`robodyn.identification.preprocess`); None: none.
-    decimate : "auto" or int
-    velocity : {"auto", "position", "measured"}
-        Joint velocities from the filtered positions or the filtered measured ones; "auto":
-        chosen by time-block cross-validation (:mod:`robodyn.identification.choices`) between the two
-        when every recording has a measured velocity, else "position".
-    dead_band : "auto" or float
-        Coulomb dead band, rad/s (m/s): where a joint's processed velocity is below it, its
-        Coulomb columns are zero and only the friction offset acts, in the fit and in
-        :meth:`Identification.predict` alike (:mod:`robodyn.identification.preprocess`); 0: none;
-        "auto": 0 or ``DEAD_BAND`` (1e-3), chosen by time-block cross-validation.
-    gains : {"auto", "description", "absorbed"}
-        Drive gains for ``target="current"`` (:func:`robodyn.identification.prior.joint_prior`).
-    bounds : dict of str to (float, float), optional
-        Box constraints on named standard parameters for ``method="consistent"``
-        (e.g. ``{"M7": (0.3, 2.0)}`` for a known payload range).
+    method, friction, regularization, cutoff, decimate, velocity, dead_band, gains, bounds
+        The choices: the attributes of the same names of
+        :class:`~robodyn.identification.options.IdentifyOptions` (what each does, its values
+        and default). ``method``: "ols", "wls" (default) or "consistent".
+    weights, state_noise, thermal, sensor, spikes
+        Likewise.
     model : Model, optional
         A compiled model of ``robot`` to reuse (default ``rd.compile_model(robot)``).
     payloads : sequence of Payload or None, optional
@@ -156,30 +135,9 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         together with a run without it (or with another payload) identifies the drive gains
         (:mod:`robodyn.identification.drive_gains`; ``gains_source="payload"``, ``gains_std``).
         ``ident.robot`` is the robot without payloads.
-    weights : {"residual", "state-noise"}
-        Row weights of ``method="wls"``/``"consistent"``: per joint from the residuals of a first
-        fit, or per sample and joint ``1 / sigma_tau`` with ``sigma_tau^2`` the measurement
-        variance plus the state noise propagated through the analytic derivatives of the first
-        fit's model (errors in variables, :mod:`robodyn.identification.state_noise`).
-    state_noise : (s_q, s_qd, s_qdd), optional
-        Standard deviations of the processed states' noise (rad, rad/s, rad/s^2; scalars or
-        (n,)), required by ``weights="state-noise"``.
-    sensor : {"motor", "link"}
-        Where the effort is measured: "motor" (motor current, or a torque that includes the
-        drive: the reflected rotor inertia ``Ia`` is identified), or "link" (a joint torque
-        sensor after the gear, which does not see the rotor: the ``Ia`` columns are dropped and
-        ``Ia = 0`` in the prior and the result; ``target="tau"`` only).
-    spikes : {"keep", "drop"}
-        One-sample glitches of the identification recordings (a sample of ``q`` or of the target
-        far off the line through its neighbours, :mod:`robodyn.identification.spikes`): kept, or
-        their rows dropped before anything else (estimated velocities then re-estimated). Off
-        by default: on the real logs here the test also flags 0.5-3 % of ordinary samples, and
-        dropping them changed the quality table's held-out errors by -0.4 % to +5.5 %
-        (benchmarks/bench_identification_quality.py cases, one run).
-    thermal : bool or "auto"
-        Temperature-dependent viscous and Coulomb friction (:mod:`robodyn.identification.thermal`;
-        needs the recordings' ``temperature``); "auto": with and without, chosen by time-block
-        cross-validation when every recording has temperatures.
+    options : IdentifyOptions, optional
+        All the choices at once, instead of the keywords (a keyword other than its default
+        given as well is refused); ``ident.options`` is the set a run used.
 
     Returns
     -------
@@ -191,21 +149,22 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         Joints not matching the robot, NaN, a missing target, too few samples for the
         parameters, an unknown option, an infeasible or failed semidefinite program.
     """
-    recs, target, pays = checked_inputs(robot, recordings, target, method, friction, weights,
-                                         state_noise, gains, velocity, dead_band, thermal,
-                                         sensor, payloads)
-    if spikes not in ("keep", "drop"):
-        raise IdentificationError(f"spikes: expected 'keep' or 'drop', got {spikes!r}")
-    if spikes == "drop":  # one-sample glitches removed from the fit's recordings
+    opts = _options(options, dict(
+        method=method, friction=friction, regularization=regularization, cutoff=cutoff,
+        decimate=decimate, velocity=velocity, dead_band=dead_band, gains=gains, bounds=bounds,
+        weights=weights, state_noise=state_noise, thermal=thermal, sensor=sensor, spikes=spikes))
+    recs, target, pays = checked_inputs(robot, recordings, target, opts.sensor, payloads)
+    if opts.spikes == "drop":  # one-sample glitches removed from the fit's recordings
         recs = [drop_spikes(r, target)[0] for r in recs]
     model = model if model is not None else compile_model(robot)
     measured = all(r.qd is not None and "qd" not in getattr(r, "estimated", frozenset()) for r in recs)
     temps = all(getattr(r, "temperature", None) is not None for r in recs)
 
     def stacked(c: Candidate) -> Problem:
-        data = _prepared(robot, recs, target, friction, c.cutoff, decimate, c.velocity, c.dead_band,
-                         model, c.thermal, sensor)
-        drive, prior, loads = _gains_and_prior(robot, data, pays, target, gains, friction, sensor)
+        data = _prepared(robot, recs, target, opts.friction, c.cutoff, opts.decimate, c.velocity,
+                         c.dead_band, model, c.thermal, opts.sensor)
+        drive, prior, loads = _gains_and_prior(robot, data, pays, target, opts.gains, opts.friction,
+                                               opts.sensor)
         cols = data.relations.independent
         th = data.thermal
         phi, y, joint, blocks = _stack(data.samples, data.y_full, cols, drive.k, loads,
@@ -222,30 +181,30 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
                        np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), held,
                        (data, drive, prior, loads))
 
-    cutoffs = _cutoff_candidates(recs, cutoff)
+    cutoffs = _cutoff_candidates(recs, opts.cutoff)
     reference = _reference_targets(recs, target, cutoffs[0])
-    cands = candidates(velocity, dead_band, thermal, measured, temps, DEAD_BAND, cutoffs)
+    cands = candidates(opts.velocity, opts.dead_band, opts.thermal, measured, temps, DEAD_BAND, cutoffs)
     best, problem, scored = choose(cands, stacked)
     data, drive, prior, loads = problem.payload
-    step, thermal_fit = _linear_step(robot, data, drive.k, loads, prior, method, regularization,
-                                     weights, state_noise)
-    theta, standard = _estimate_standard(robot, data.relations, step, prior, method, bounds)
-    result = _identification(robot, data, step, theta, standard, drive, target, method)
+    step, thermal_fit = _linear_step(robot, data, drive.k, loads, prior, opts.method,
+                                     opts.regularization, opts.weights, opts.state_noise)
+    theta, standard = _estimate_standard(robot, data.relations, step, prior, opts.method, opts.bounds)
+    result = _identification(robot, data, step, theta, standard, drive, target, opts.method)
     reason = (f"held-out time blocks ({FOLDS} per recording), {len(scored)} candidates: the plain "
               "processing unless another is better by more than one standard error"
               if len(scored) > 1 else "as given")
     result = replace(result, choices=Choices(best.velocity, best.dead_band, data.settings.cutoff,
                                              step.fit.lam, tuple(scored), reason, best.thermal, best),
                      thermal_fit=thermal_fit)
-    law = friction
-    if friction == "auto":
+    law = opts.friction
+    if opts.friction == "auto":
         law, scores = choose_friction_law(result, data.samples, data.y_full)
         result = replace(result, choices=replace(result.choices, friction=law,
                                                  friction_scores=tuple(scores.items())))
     if law in NONLINEAR:
         result = replace(result, friction_fit=fit_friction_samples(result, data.samples, data.y_full,
                                                                     law))
-    return result
+    return replace(result, options=opts)
 
 
 @dataclass(frozen=True, eq=False)
@@ -493,6 +452,19 @@ def _state_noise_fit(robot: Robot, data: _Prepared, step: _LinearStep, prior: np
     meas = np.maximum(step.fit.sigma**2 - prop, MEAS_FLOOR * step.fit.sigma**2)
     return fit_linear(step.phi, step.y, step.theta0, step.joint, step.blocks,
                       regularization=regularization, row_sigma=np.sqrt(meas[step.joint] + var))
+
+
+def _options(options: IdentifyOptions | None, keywords: dict[str, Any]) -> IdentifyOptions:
+    """``options``, or the keywords as :class:`IdentifyOptions` (both: refused)."""
+    if options is None:
+        return IdentifyOptions(**keywords)
+    if not isinstance(options, IdentifyOptions):
+        raise IdentificationError(f"options: expected an IdentifyOptions, got {type(options).__name__}")
+    given = keywords_given(keywords)
+    if given:
+        raise IdentificationError(f"options: given together with the keyword(s) {', '.join(given)}; "
+                                  "give the choices either way, not both")
+    return options
 
 
 def _estimate_standard(robot: Robot, relations: BaseRelations, step: _LinearStep, prior: np.ndarray,

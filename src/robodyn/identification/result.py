@@ -12,6 +12,7 @@ import sympy as sp
 from robodyn.identification.base import BaseRelations
 from robodyn.identification.choices import Choices
 from robodyn.identification.friction import FrictionFit, without_friction
+from robodyn.identification.options import IdentifyOptions
 from robodyn.identification.preprocess import Preprocess, prediction_rows, preprocess
 from robodyn.identification.thermal import ThermalFit, temperatures
 from robodyn.numeric.model import Model
@@ -133,6 +134,8 @@ class Identification:
         Temperature coefficients of the friction (``thermal=True``,
         :mod:`robodyn.identification.thermal`): :meth:`predict` adds their torque (the recording then
         needs temperatures); ``robot`` carries the friction at the reference temperature.
+    options : IdentifyOptions or None
+        The choices the run was made with (:mod:`robodyn.identification.options`).
     """
 
     robot: Robot
@@ -155,6 +158,7 @@ class Identification:
     gains_std: np.ndarray | None = None
     choices: Choices | None = None
     thermal_fit: ThermalFit | None = None
+    options: IdentifyOptions | None = None
 
     @property
     def gains_identified(self) -> bool:

@@ -72,31 +72,13 @@ def _check_chunks(data: bytes, limit: int, name: str) -> None:
                                  "decompressed (set ROBODYN_MAX_FILE_MB to read it)")
 
 
-def read_mcap(path: str | PathLike[str], robot: Any = None, joint_topic: str | None = None,
-              tool_topic: str | None = None) -> Recording:
-    """Read a ROS 2 bag: joints from ``sensor_msgs/msg/JointState``, a tracker from points/poses.
-
-    Parameters
-    ----------
-    path : str or path
-        ``.mcap`` file (only read).
-    robot : Robot, optional
-        Every robot joint must appear in the messages (others, e.g. gripper fingers, are left
-        out); the recording's joints are in the robot's chain order. Without a robot, the order
-        of the first message.
-    joint_topic, tool_topic : str, optional
-        Topics to use when a bag has several of a kind.
-
-    Returns
-    -------
-    Recording
-        ``q`` from ``position``; ``qd`` from ``velocity`` and ``tau`` from ``effort`` when the
-        messages carry them; ``tool_t``/``tool_points`` from the tracker topic.
-    """
-    make_reader = require("mcap.reader", f"reading the ROS 2 bag {path}").make_reader
-    DecoderFactory = require("mcap_ros2.decoder", f"reading the ROS 2 bag {path}").DecoderFactory  # noqa: N806
-
-    p = Path(path)
+def _messages(p: Path, joint_topic: str | None, tool_topic: str | None,
+              ) -> tuple[list[tuple[int, list[str], Any, Any, Any, str]],
+                         dict[str, list[tuple[int, tuple[float, float, float]]]], dict[str, str]]:
+    """The bag's JointState messages (stamp, names, position, velocity, effort, topic), tracker
+    points by topic and every topic's message type; a damaged or oversized bag is refused."""
+    make_reader = require("mcap.reader", f"reading the ROS 2 bag {p}").make_reader
+    DecoderFactory = require("mcap_ros2.decoder", f"reading the ROS 2 bag {p}").DecoderFactory  # noqa: N806
     joints: list[tuple[int, list[str], Any, Any, Any, str]] = []
     tool: dict[str, list[tuple[int, tuple[float, float, float]]]] = {}
     topics: dict[str, str] = {}
@@ -126,6 +108,32 @@ def read_mcap(path: str | PathLike[str], robot: Any = None, joint_topic: str | N
         # field, mcap_ros2's schema-parser errors), is a property of the file, reported as such
         raise RecordingError(f"{p.name}: not a readable ROS 2 MCAP bag ({type(exc).__name__}: "
                              f"{' '.join(str(exc).split())})") from None
+    return joints, tool, topics
+
+
+def read_mcap(path: str | PathLike[str], robot: Any = None, joint_topic: str | None = None,
+              tool_topic: str | None = None) -> Recording:
+    """Read a ROS 2 bag: joints from ``sensor_msgs/msg/JointState``, a tracker from points/poses.
+
+    Parameters
+    ----------
+    path : str or path
+        ``.mcap`` file (only read).
+    robot : Robot, optional
+        Every robot joint must appear in the messages (others, e.g. gripper fingers, are left
+        out); the recording's joints are in the robot's chain order. Without a robot, the order
+        of the first message.
+    joint_topic, tool_topic : str, optional
+        Topics to use when a bag has several of a kind.
+
+    Returns
+    -------
+    Recording
+        ``q`` from ``position``; ``qd`` from ``velocity`` and ``tau`` from ``effort`` when the
+        messages carry them; ``tool_t``/``tool_points`` from the tracker topic.
+    """
+    p = Path(path)
+    joints, tool, topics = _messages(p, joint_topic, tool_topic)
     if not joints:
         listed = ", ".join(f"{t} ({k})" for t, k in topics.items()) or "no messages"
         which = f" on topic {joint_topic!r}" if joint_topic else ""

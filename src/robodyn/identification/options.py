@@ -1,0 +1,143 @@
+"""Every choice of an identification other than its data, in one checked object.
+
+:func:`robodyn.identify` takes the same choices as keywords (and builds an
+:class:`IdentifyOptions` from them) or as ``options=IdentifyOptions(...)``; the result keeps the
+one it ran with (``ident.options``), so a run can be repeated with one choice changed
+(``dataclasses.replace(ident.options, method="consistent")``). The checks live here, once: a bad
+value is refused when the options are made, naming the field.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from robodyn.identification.friction import FRICTION_MODELS
+from robodyn.robot.errors import IdentificationError
+
+__all__ = ["METHODS", "WEIGHTS", "IdentifyOptions", "keywords_given"]
+
+METHODS = ("ols", "wls", "consistent")
+WEIGHTS = ("residual", "state-noise")
+
+
+@dataclass(frozen=True, eq=False)
+class IdentifyOptions:
+    """The choices of :func:`robodyn.identify` (keywords of the same names).
+
+    Attributes
+    ----------
+    method : {"ols", "wls", "consistent"}
+        Ordinary or weighted least squares, or physically consistent (pseudo-inertia LMIs).
+    friction : {"linear", "none", "stribeck", "load", "polynomial", "auto"}
+        "linear": viscous, Coulomb (+/-) and offset per joint in the linear fit; "none": no
+        friction; the others: a nonlinear law fitted after the linear step
+        (:mod:`robodyn.identification.friction`); "auto": linear or Stribeck, chosen by time-block
+        cross-validation (:mod:`robodyn.identification.friction_choice`).
+    regularization : "auto", float or None
+        Tikhonov weight toward the description's values (dimensionless, see
+        :mod:`robodyn.identification.estimate`); "auto": chosen by time-block cross-validation;
+        None: plain least squares (not-excited directions stay at the prior).
+    cutoff : "auto", float or None
+        Zero-phase low-pass cut-off, Hz (:mod:`robodyn.identification.preprocess`); None: none
+        (the recordings' own velocities and accelerations).
+    decimate : "auto" or int
+        Keep every ``decimate``-th filtered sample.
+    velocity : {"auto", "position", "measured"}
+        Joint velocities from the filtered positions or the filtered measured ones; "auto":
+        chosen by time-block cross-validation (:mod:`robodyn.identification.choices`) when every
+        recording has a measured velocity, else "position".
+    dead_band : "auto" or float
+        Coulomb dead band, rad/s (m/s): below it a joint's Coulomb columns are zero and only the
+        friction offset acts, in the fit and in :meth:`Identification.predict` alike; 0: none;
+        "auto": 0 or ``DEAD_BAND`` (1e-3), chosen by time-block cross-validation.
+    gains : {"auto", "description", "absorbed"}
+        Drive gains for ``target="current"`` (:func:`robodyn.identification.prior.joint_prior`).
+    bounds : mapping of str to (float, float), optional
+        Box constraints on named standard parameters for ``method="consistent"``
+        (e.g. ``{"M7": (0.3, 2.0)}`` for a known payload range).
+    weights : {"residual", "state-noise"}
+        Row weights of ``"wls"``/``"consistent"``: per joint from the residuals of a first fit,
+        or per sample and joint ``1 / sigma_tau`` with the state noise propagated through the
+        first fit's model (errors in variables, :mod:`robodyn.identification.state_noise`).
+    state_noise : (s_q, s_qd, s_qdd), optional
+        Standard deviations of the processed states' noise (rad, rad/s, rad/s^2; scalars or
+        (n,)), required by ``weights="state-noise"``.
+    thermal : bool or "auto"
+        Temperature-dependent viscous and Coulomb friction (:mod:`robodyn.identification.thermal`;
+        needs the recordings' ``temperature``); "auto": with and without, chosen by time-block
+        cross-validation when every recording has temperatures.
+    sensor : {"motor", "link"}
+        Where the effort is measured: "motor" (motor current, or a torque that includes the
+        drive: the reflected rotor inertia ``Ia`` is identified), or "link" (a joint torque
+        sensor after the gear, which does not see the rotor: the ``Ia`` columns are dropped and
+        ``Ia = 0`` in the prior and the result; ``target="tau"`` only).
+    spikes : {"keep", "drop"}
+        One-sample glitches of the identification recordings (a sample of ``q`` or of the target
+        far off the line through its neighbours, :mod:`robodyn.identification.spikes`): kept, or
+        their rows dropped before anything else (estimated velocities then re-estimated). Off
+        by default: on the real logs here the test also flags 0.5-3 % of ordinary samples, and
+        dropping them changed the quality table's held-out errors by -0.4 % to +5.5 %
+        (benchmarks/bench_identification_quality.py cases, one run).
+
+    Raises
+    ------
+    IdentificationError
+        On construction: a value outside its choices, naming the field.
+    """
+
+    method: str = "wls"
+    friction: str = "auto"
+    regularization: float | str | None = "auto"
+    cutoff: float | str | None = "auto"
+    decimate: int | str = "auto"
+    velocity: str = "auto"
+    dead_band: float | str = 0.0
+    gains: str = "auto"
+    bounds: Mapping[str, tuple[float, float]] | None = None
+    weights: str = "residual"
+    state_noise: Any = None
+    thermal: bool | str = False
+    sensor: str = "motor"
+    spikes: str = "keep"
+
+    def __post_init__(self) -> None:
+        _choice("method", self.method, METHODS)
+        _choice("friction", self.friction, (*FRICTION_MODELS, "auto"))
+        _choice("weights", self.weights, WEIGHTS)
+        if self.weights == "state-noise" and self.state_noise is None:
+            raise IdentificationError("state_noise: weights='state-noise' needs the state noise "
+                                      "(s_q, s_qd, s_qdd) in rad, rad/s, rad/s^2")
+        _choice("velocity", self.velocity, ("auto", "position", "measured"))
+        _choice("sensor", self.sensor, ("motor", "link"))
+        if not any(self.thermal is v for v in (False, True)) and self.thermal != "auto":
+            raise IdentificationError(f"thermal: expected False, True or 'auto', got {self.thermal!r}")
+        if isinstance(self.dead_band, str) and self.dead_band != "auto":
+            raise IdentificationError(f"dead_band: expected a velocity in rad/s or 'auto', got "
+                                      f"{self.dead_band!r}")
+        _choice("gains", self.gains, ("auto", "description", "absorbed"))
+        _choice("spikes", self.spikes, ("keep", "drop"))
+
+
+def _choice(name: str, value: Any, choices: tuple[str, ...]) -> None:
+    if not isinstance(value, str) or value not in choices:
+        raise IdentificationError(f"{name}: expected one of {choices}, got {value!r}")
+
+
+def _default(name: str) -> Any:
+    return IdentifyOptions.__dataclass_fields__[name].default
+
+
+def keywords_given(values: Mapping[str, Any]) -> list[str]:
+    """The option names among ``values`` whose value is not the default (arrays count as given)."""
+    out = []
+    for f in fields(IdentifyOptions):
+        v, d = values[f.name], _default(f.name)
+        same = v is d or (not isinstance(v, np.ndarray | list | tuple | Mapping) and type(v) is type(d)
+                          and v == d)
+        if not same:
+            out.append(f.name)
+    return out
