@@ -136,5 +136,5 @@ def test_options_object_checks_once_and_runs_like_the_keywords(arm):
     with pytest.raises(IdentificationError, match=r"options: given together with the keyword\(s\) "
                                                   r"method, spikes"):
         rd.identify(robot, rec, options=opts, method="consistent", spikes="drop", model=model)
-    with pytest.raises(IdentificationError, match="options: expected an IdentifyOptions, got dict"):
+    with pytest.raises(IdentificationError, match="options: expected IdentifyOptions, got dict"):
         rd.identify(robot, rec, options={"method": "ols"}, model=model)

@@ -10,15 +10,13 @@ value is refused when the options are made, naming the field.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Any
-
-import numpy as np
 
 from robodyn.identification.friction import FRICTION_MODELS
 from robodyn.robot.errors import IdentificationError
 
-__all__ = ["METHODS", "WEIGHTS", "IdentifyOptions", "keywords_given"]
+__all__ = ["METHODS", "WEIGHTS", "IdentifyOptions"]
 
 METHODS = ("ols", "wls", "consistent")
 WEIGHTS = ("residual", "state-noise")
@@ -125,19 +123,3 @@ class IdentifyOptions:
 def _choice(name: str, value: Any, choices: tuple[str, ...]) -> None:
     if not isinstance(value, str) or value not in choices:
         raise IdentificationError(f"{name}: expected one of {choices}, got {value!r}")
-
-
-def _default(name: str) -> Any:
-    return IdentifyOptions.__dataclass_fields__[name].default
-
-
-def keywords_given(values: Mapping[str, Any]) -> list[str]:
-    """The option names among ``values`` whose value is not the default (arrays count as given)."""
-    out = []
-    for f in fields(IdentifyOptions):
-        v, d = values[f.name], _default(f.name)
-        same = v is d or (not isinstance(v, np.ndarray | list | tuple | Mapping) and type(v) is type(d)
-                          and v == d)
-        if not same:
-            out.append(f.name)
-    return out

@@ -34,7 +34,7 @@ from robodyn.identification.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identification.friction import NONLINEAR, fit_friction_samples, without_friction
 from robodyn.identification.friction_choice import choose_friction_law
 from robodyn.identification.inputs import check_recording, checked_inputs
-from robodyn.identification.options import IdentifyOptions, keywords_given
+from robodyn.identification.options import IdentifyOptions
 from robodyn.identification.payload import Payload, payload_standard, payload_torque
 from robodyn.identification.preprocess import (
     DEAD_BAND,
@@ -51,6 +51,7 @@ from robodyn.identification.spikes import drop_spikes
 from robodyn.identification.state_noise import state_noise_std, torque_variance
 from robodyn.identification.thermal import ThermalData, ThermalFit, thermal_data
 from robodyn.identification.to_robot import robot_with_parameters
+from robodyn.keywords import resolve
 from robodyn.measure.filtering import lowpass
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import IdentificationError
@@ -149,10 +150,11 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         Joints not matching the robot, NaN, a missing target, too few samples for the
         parameters, an unknown option, an infeasible or failed semidefinite program.
     """
-    opts = _options(options, dict(
+    opts = resolve(IdentifyOptions, options, dict(
         method=method, friction=friction, regularization=regularization, cutoff=cutoff,
         decimate=decimate, velocity=velocity, dead_band=dead_band, gains=gains, bounds=bounds,
-        weights=weights, state_noise=state_noise, thermal=thermal, sensor=sensor, spikes=spikes))
+        weights=weights, state_noise=state_noise, thermal=thermal, sensor=sensor, spikes=spikes),
+        IdentificationError)
     recs, target, pays = checked_inputs(robot, recordings, target, opts.sensor, payloads)
     if opts.spikes == "drop":  # one-sample glitches removed from the fit's recordings
         recs = [drop_spikes(r, target)[0] for r in recs]
@@ -452,19 +454,6 @@ def _state_noise_fit(robot: Robot, data: _Prepared, step: _LinearStep, prior: np
     meas = np.maximum(step.fit.sigma**2 - prop, MEAS_FLOOR * step.fit.sigma**2)
     return fit_linear(step.phi, step.y, step.theta0, step.joint, step.blocks,
                       regularization=regularization, row_sigma=np.sqrt(meas[step.joint] + var))
-
-
-def _options(options: IdentifyOptions | None, keywords: dict[str, Any]) -> IdentifyOptions:
-    """``options``, or the keywords as :class:`IdentifyOptions` (both: refused)."""
-    if options is None:
-        return IdentifyOptions(**keywords)
-    if not isinstance(options, IdentifyOptions):
-        raise IdentificationError(f"options: expected an IdentifyOptions, got {type(options).__name__}")
-    given = keywords_given(keywords)
-    if given:
-        raise IdentificationError(f"options: given together with the keyword(s) {', '.join(given)}; "
-                                  "give the choices either way, not both")
-    return options
 
 
 def _estimate_standard(robot: Robot, relations: BaseRelations, step: _LinearStep, prior: np.ndarray,
