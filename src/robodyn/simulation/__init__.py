@@ -14,6 +14,7 @@ from robodyn.simulation.controllers import LQR, PD, PID, ComputedTorque, Control
 from robodyn.simulation.energy import frame_origins, potential_energy
 from robodyn.simulation.ik import IKResult, UnreachableError, inverse_kinematics
 from robodyn.simulation.linearize import Linearization, linearize
+from robodyn.simulation.options import SimulateOptions
 from robodyn.simulation.simulation import ADAPTIVE, FIXED_STEP, Trajectory, simulate
 from robodyn.simulation.trajectory import (
     JointTrajectory,
@@ -28,6 +29,7 @@ __all__ = [
     "ADAPTIVE",
     "FIXED_STEP",
     "IKResult",
+    "SimulateOptions",
     "JointTrajectory",
     "LQR",
     "PD",

@@ -19,15 +19,17 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from robodyn.keywords import resolve
 from robodyn.numeric.model import Model
 from robodyn.numeric.runtime_parameters import ParameterValues, check_physics
 from robodyn.robot.errors import InputError, SimulationError
 from robodyn.simulation.controllers import Controller
 from robodyn.simulation.energy import potential_energy
+from robodyn.simulation.options import ADAPTIVE, FIXED_STEP, MAX_SAMPLES, SimulateOptions
 from robodyn.simulation.steppers import (
     CHUNK_STEPS,
     ControllerLike,
@@ -39,13 +41,6 @@ from robodyn.simulation.steppers import (
     _fixed_step_python,
     _member_model,
 )
-
-FIXED_STEP = ("rk4", "semi_implicit")
-ADAPTIVE = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
-
-#: Default largest number of output samples (rows of a :class:`Trajectory`): 1000 s at 1 ms,
-#: about 250 MB of arrays for six joints. Longer runs need ``decimate`` or ``max_samples``.
-MAX_SAMPLES = 1_000_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -79,6 +74,8 @@ class Trajectory:
         Right-hand-side evaluations (``state_derivative`` calls), per trajectory.
     decimate : int
         Every ``decimate``-th step was kept.
+    options : SimulateOptions or None
+        The choices the run was made with (:mod:`robodyn.simulation.options`).
     """
 
     t: np.ndarray
@@ -96,6 +93,7 @@ class Trajectory:
     backend: str
     evaluations: int
     decimate: int = 1
+    options: SimulateOptions | None = None
 
     @property
     def x(self) -> np.ndarray:
@@ -132,7 +130,8 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
              tau_limit: float | np.ndarray | None = None, rtol: float = 1e-9,
              atol: float = 1e-12, control: str = "sampled", decimate: int = 1,
              max_samples: int | None = MAX_SAMPLES, substeps: int = 1,
-             threads: int = 1, parameters: ParameterValues = None) -> Trajectory:
+             threads: int = 1, parameters: ParameterValues = None,
+             options: SimulateOptions | None = None) -> Trajectory:
     """Simulate ``model`` from ``(q0, qd0)`` for ``duration`` seconds.
 
     A batch of ``N`` initial states (``q0`` of shape (N, n)) is integrated in one call into the
@@ -190,6 +189,10 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         set for the run, or for a batch one set per trajectory, every trajectory integrated
         with its own parameters (plant and built-in model-based law) in the same C call.
         Checked like compile-time values. None: the model's defaults.
+    options : SimulateOptions, optional
+        ``method``, ``tau_limit``, ``rtol``, ``atol``, ``control``, ``decimate``,
+        ``max_samples``, ``substeps`` and ``threads`` at once, instead of the keywords (a keyword
+        other than its default given as well is refused); ``traj.options`` is the set a run used.
 
     Returns
     -------
@@ -209,6 +212,11 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         (a ``FloatingPointError`` and a ``ValueError``) When the state stops being finite; a
         :class:`~robodyn.robot.errors.SingularMassMatrixError` when the mass matrix is singular.
     """
+    opts = resolve(SimulateOptions, options, dict(
+        method=method, tau_limit=tau_limit, rtol=rtol, atol=atol, control=control,
+        decimate=decimate, max_samples=max_samples, substeps=substeps, threads=threads), InputError)
+    method, tau_limit, rtol, atol, control = opts.method, opts.tau_limit, opts.rtol, opts.atol, opts.control
+    decimate, max_samples, substeps, threads = opts.decimate, opts.max_samples, opts.substeps, opts.threads
     n = model.dof
     q0, qd0, batch = _initial_states(q0, qd0, n)
     count = len(q0) if batch else 1
@@ -228,11 +236,12 @@ def simulate(model: Model, q0: np.ndarray, qd0: np.ndarray | None, duration: flo
         x0 = np.concatenate([q0, qd0], axis=1)
         x, tau, evals = _run_batch(model, x0, steps, dt, decimate, method, controller, limit,
                                    threads, rows, control)
-        return _result(model, t, x, tau, method, dt, controller, evals, decimate, rows)
+        return replace(_result(model, t, x, tau, method, dt, controller, evals, decimate, rows),
+                       options=opts)
     x0 = np.concatenate([q0, qd0])
     x, tau, evals = _run_single(model, x0, t, steps, dt, decimate, method, controller, limit,
                                 control, substeps, max_samples, rtol, atol)
-    return _result(model, t, x, tau, method, dt, controller, evals, decimate)
+    return replace(_result(model, t, x, tau, method, dt, controller, evals, decimate), options=opts)
 
 
 def _initial_states(q0: np.ndarray, qd0: np.ndarray | None,
@@ -303,20 +312,8 @@ def _check_samples(steps: int, decimate: int, count: int, n: int, duration: floa
 
 
 def _check_options(method: str, control: str, substeps: int, controller: ControllerLike) -> None:
-    """Refuse an unknown or inconsistent ``substeps``, ``method``, ``control`` or controller."""
-    if isinstance(substeps, bool) or not isinstance(substeps, int | np.integer) or substeps < 1:
-        raise InputError(f"simulate: substeps must be a positive integer, got {substeps!r}")
-    if substeps > 1 and (control != "sampled" or method not in FIXED_STEP):
-        raise InputError("simulate: substeps needs a fixed-step method and control='sampled' (a "
-                         "continuous law or a SciPy method already evaluates the law wherever it "
-                         "evaluates the dynamics)")
-    if method not in FIXED_STEP + ADAPTIVE:
-        raise InputError(f"unknown method {method!r}; choose one of {', '.join(FIXED_STEP + ADAPTIVE)}")
-    if control not in ("sampled", "continuous"):
-        raise InputError(f"unknown control {control!r}; choose 'sampled' or 'continuous'")
-    if control == "continuous" and method == "semi_implicit":
-        raise InputError("control='continuous' needs method='rk4' or a SciPy method (semi-implicit "
-                         "Euler evaluates the law once per step: use control='sampled')")
+    """Refuse a controller that is not callable (the options are checked by
+    :class:`~robodyn.simulation.options.SimulateOptions`)."""
     if controller is not None and not callable(controller):
         raise TypeError(f"controller must be a built-in controller, a callable (t, q, qd) -> tau or "
                         f"None, got {type(controller).__name__}")
