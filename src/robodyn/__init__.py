@@ -24,6 +24,7 @@ from robodyn._version import __version__ as __version__
 # module and ``rd.simulate`` is always the function.
 _EXPORTS = {
     "Calibration": "robodyn.calibration",
+    "CalibrateOptions": "robodyn.calibration",
     "calibrate": "robodyn.calibration",
     "Identification": "robodyn.identification",
     "IdentifyOptions": "robodyn.identification",
@@ -79,6 +80,7 @@ def __dir__() -> list[str]:
 
 
 __all__ = [
+    "CalibrateOptions",
     "Calibration",
     "Drive",
     "EquationsOfMotion",

@@ -93,3 +93,27 @@ def test_unreachable_compensation_target():
         compensate(cal, y[:2] + np.array([5.0, 0, 0]), q[:2])
     with pytest.raises(ValueError, match="frame must be"):
         compensate(cal, y[:2], q[:2], frame="world")
+
+
+def test_options_object_runs_like_the_keywords_and_checks_when_made():
+    # issue 21 item 6: the choices of rd.calibrate in one checked object
+    import robodyn as rd
+    from robodyn.robot.errors import InputError
+
+    r = robot("puma560")
+    true = perturbed_robot(r, 3, base=TRACKER, target=(0.0, 0.0, 0.0))
+    q = poses("puma560", 40, 1)
+    y = robot_positions(true, q)
+    by_keywords = rd.calibrate(r, q, y, "hayati", loss="huber")
+    opts = rd.CalibrateOptions(model="hayati", loss="huber")
+    by_options = rd.calibrate(r, q, y, options=opts)
+    np.testing.assert_array_equal(by_options.params, by_keywords.params)
+    assert by_options.options is opts and by_keywords.options.loss == "huber"
+    for bad, message in [({"model": "mdh"}, "unknown error model 'mdh'"),
+                         ({"nongeometric": "compliance"}, "expected a sequence of terms"),
+                         ({"payload": (1.0, (0, 0, 0))}, "payload needs the 'compliance' term"),
+                         ({"sigma_rot": 0.0}, "sigma_rot must be a positive number")]:
+        with pytest.raises(InputError, match=message):
+            rd.CalibrateOptions(**bad)
+    with pytest.raises(InputError, match=r"options: given together with the keyword\(s\) loss"):
+        rd.calibrate(r, q, y, loss="cauchy", options=opts)

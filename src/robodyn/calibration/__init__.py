@@ -17,11 +17,13 @@ from robodyn.calibration.held_out import validate
 from robodyn.calibration.identifiability import Observability, Unidentifiable, observability, select_poses
 from robodyn.calibration.models import MODELS, ErrorModel, build_model
 from robodyn.calibration.nominal import robot_geometry
+from robodyn.calibration.options import CalibrateOptions
 from robodyn.calibration.pipeline import calibrate, random_configurations
 from robodyn.calibration.result import Calibration, ErrorStats, Parameter
 
 __all__ = [
     "MODELS",
+    "CalibrateOptions",
     "Calibration",
     "CirclePointResult",
     "ErrorModel",

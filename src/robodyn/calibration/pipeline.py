@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -34,11 +35,13 @@ from robodyn.calibration.identifiability import (
     observability,
 )
 from robodyn.calibration.kinematics import hom, inv
-from robodyn.calibration.models import MODELS, ErrorModel, build_model, extend_model, model_frames
+from robodyn.calibration.models import ErrorModel, build_model, extend_model, model_frames
 from robodyn.calibration.nominal import RobotGeometry, default_frame0, robot_geometry
+from robodyn.calibration.options import CalibrateOptions
 from robodyn.calibration.result import Calibration, ErrorStats, Parameter
-from robodyn.calibration.solve import LOSSES, Fit, fit
+from robodyn.calibration.solve import Fit, fit
 from robodyn.calibration.to_robot import calibrated_robot
+from robodyn.keywords import resolve
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
 
@@ -227,6 +230,7 @@ def calibrate(
     length_unit: str = "m",
     angle_unit: str = "rad",
     deflection: str = "linear",
+    options: CalibrateOptions | None = None,
 ) -> Calibration:
     """Identify a robot's kinematics from measured target positions.
 
@@ -285,6 +289,10 @@ def calibrate(
         Newton with the compiled model's analytic gravity derivatives and an exact Jacobian
         (``"exact"``, :mod:`robodyn.numeric.deflection`; compiles the model on first use). Needs
         ``"compliance"`` and link masses; not with ``identify_payload``.
+    options : CalibrateOptions, optional
+        The choices above (all but the data ``q``, ``points``, ``circle_data`` and
+        ``orientations``) at once, instead of the keywords (a keyword other than its default
+        given as well is refused); ``cal.options`` is the set a run used.
 
     Returns
     -------
@@ -296,8 +304,18 @@ def calibrate(
         On bad input: shapes, lengths, NaN, unknown options, too few poses for the identifiable
         parameters, a circle-point set in which its joint never moved.
     """
-    _check_options(model, loss, initial, nongeometric, payload, identify_payload, deflection,
-                   circle_data)
+    opts = resolve(CalibrateOptions, options, dict(
+        model=model, sigma=sigma, loss=loss, initial=initial, sigma_rot=sigma_rot,
+        loss_scale=loss_scale, parallel_tol=parallel_tol, max_nfev=max_nfev,
+        nongeometric=nongeometric, payload=payload, identify_payload=identify_payload,
+        length_unit=length_unit, angle_unit=angle_unit, deflection=deflection), InputError)
+    (model, sigma, loss, initial, sigma_rot, loss_scale, parallel_tol, max_nfev, nongeometric, payload,
+     identify_payload, length_unit, angle_unit, deflection) = (
+        opts.model, opts.sigma, opts.loss, opts.initial, opts.sigma_rot, opts.loss_scale,
+        opts.parallel_tol, opts.max_nfev, opts.nongeometric, opts.payload, opts.identify_payload,
+        opts.length_unit, opts.angle_unit, opts.deflection)
+    if initial == "circle-point" and circle_data is None:
+        raise InputError("initial='circle-point' needs circle_data: one (q, points) set per joint")
     q, points, orientations, sig, sigma_rot, geometry = _prepared_data(
         robot, q, points, orientations, sigma, sigma_rot, length_unit, angle_unit)
     oriented = orientations is not None
@@ -315,8 +333,8 @@ def calibrate(
         warnings.warn(f"calibration of {robot.name} did not converge: {res.message}", RuntimeWarning,
                       stacklevel=2)
     _warn_variance_factor(robot.name, res.variance_factor)
-    return _calibration(robot, geometry, em, res, unid, q, sig, before_res, placed, placed_params, loss,
-                        initial, cp)
+    return replace(_calibration(robot, geometry, em, res, unid, q, sig, before_res, placed,
+                                placed_params, loss, initial, cp), options=opts)
 
 
 def _prepared_data(robot: Robot, q, points, orientations, sigma, sigma_rot: float, length_unit: str,
@@ -484,28 +502,6 @@ def _calibration(robot: Robot, geometry: RobotGeometry, em: ErrorModel, res: Fit
         before_robot=calibrated_robot(robot, geometry, placed, placed_params, name=f"{robot.name}_placed"),
         targets_axis=before_res.ndim == 3,
     )
-
-
-def _check_options(model: str, loss: str, initial: str, nongeometric: Sequence[str],
-                   payload: Any, identify_payload: bool, deflection: str, circle_data: Any) -> None:
-    """Refuse option values and combinations :func:`calibrate` cannot honour (ValueError)."""
-    if model not in MODELS:
-        raise InputError(f"unknown error model {model!r}; choose one of {', '.join(MODELS)}")
-    if loss not in LOSSES:
-        raise InputError(f"unknown loss {loss!r}; choose one of {', '.join(LOSSES)}")
-    if initial not in ("nominal", "circle-point"):
-        raise InputError(f"initial must be 'nominal' or 'circle-point', got {initial!r}")
-    if (identify_payload or payload is not None) and "compliance" not in tuple(nongeometric):
-        raise InputError(f"{'identify_payload' if identify_payload else 'payload'} needs the "
-                         "'compliance' term (nongeometric=('compliance', ...)): the payload is seen "
-                         "only through the joints' deflection under its weight")
-    if deflection not in ("linear", "exact"):
-        raise InputError(f"deflection must be 'linear' or 'exact', got {deflection!r}")
-    if deflection == "exact" and "compliance" not in tuple(nongeometric):
-        raise InputError("deflection='exact' needs the 'compliance' term (nongeometric=('compliance', "
-                         "...)): it changes how the joints deflect under their load")
-    if initial == "circle-point" and circle_data is None:
-        raise InputError("initial='circle-point' needs circle_data: one (q, points) set per joint")
 
 
 def _error_model(robot: Robot, geometry: RobotGeometry, model: str, initial: str, circle_data: Any,

@@ -9,6 +9,7 @@ import numpy as np
 from robodyn.calibration.circle_point import CirclePointResult
 from robodyn.calibration.identifiability import Observability, Unidentifiable
 from robodyn.calibration.models import ErrorModel, model_frames
+from robodyn.calibration.options import CalibrateOptions
 from robodyn.robot.model import Robot
 
 __all__ = ["Calibration", "ErrorStats", "Parameter"]
@@ -140,6 +141,8 @@ class Calibration:
         model behind ``before_residuals``.
     targets_axis : bool
         The points were given as (N, K, 3): residuals and predictions keep that shape.
+    options : CalibrateOptions or None
+        The choices the run was made with (:mod:`robodyn.calibration.options`).
     """
 
     robot: Robot
@@ -165,6 +168,7 @@ class Calibration:
     circle_point: CirclePointResult | None = None
     before_robot: Robot | None = None
     targets_axis: bool = False
+    options: CalibrateOptions | None = None
 
     def __post_init__(self) -> None:
         for name in ("params", "covariance", "residuals", "rotation_residuals", "before_residuals"):
