@@ -69,6 +69,7 @@ def test_newton_solves_the_fixed_point_and_g_is_the_gravity_derivative(puma):
     np.testing.assert_allclose(big_g, fd, rtol=0, atol=1e-7 * scale)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("payload", [None, (3.0, (0.02, -0.03, 0.11))])
 def test_jacobian_of_the_predicted_points_matches_finite_differences(payload):
     r = robot("puma560")

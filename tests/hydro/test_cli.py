@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import csv
 
+import pytest
+
 from robodyn.cli import main
 
 
+@pytest.mark.slow
 def test_underwater_writes_table_figures_and_report(tmp_path, capsys) -> None:
     out = tmp_path / "uw"
     code = main(["underwater", "underwater_2r", "-o", str(out), "--move-time", "0.5",

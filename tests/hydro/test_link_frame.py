@@ -5,6 +5,7 @@ current by Lagrange's equations of the relative kinetic energy, differentiated n
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import sympy as sp
 
 import robodyn as rd
@@ -164,6 +165,7 @@ def _current_added_mass(functions: list, qv: np.ndarray, qdv: np.ndarray) -> np.
     return out
 
 
+@pytest.mark.slow
 def test_spatial_hydro_terms_equal_world_frame_strip_formulas() -> None:
     robot = load_yaml_text(SPATIAL, source="spatial.yaml")
     q, qd = sp.symbols("q1:4", real=True), sp.symbols("qd1:4", real=True)

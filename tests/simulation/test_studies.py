@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from PIL import Image
 
 import robodyn as rd
@@ -22,6 +23,7 @@ def test_payload_is_merged_into_the_last_link(aa300):
                                rtol=1e-9)
 
 
+@pytest.mark.slow
 def test_aa300_study_sizes_the_motors(tmp_path):
     study = run_study(tmp_path, payload=50.0, fps=2)
     names = [m.name for m in study.manoeuvres]

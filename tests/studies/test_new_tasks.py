@@ -55,6 +55,7 @@ def test_higher_drag_damps_the_free_swing_and_costs_torque():
         UnderwaterEffects(effect="sonar")
 
 
+@pytest.mark.slow
 def test_dask_sweep_equals_the_serial_table():
     from distributed import Client, LocalCluster
 

@@ -83,6 +83,7 @@ settings: {trajectory: trapezoid, q_start: [0, 0.6, 1], q_goal: [0.5, 0.9, 1],
 """
 
 
+@pytest.mark.slow
 def test_cli_sweep_writes_table_figures_and_report(tmp_path, capsys):
     path = _write(tmp_path, SIZING + "parameters:\n  payload: [0, 50]\n  bandwidth_hz: [3, 5]\n")
     assert main(["sweep", str(path), "--workers", "1", "-o", str(tmp_path / "out")]) == 0

@@ -132,6 +132,7 @@ def test_killing_a_worker_mid_study_still_completes(client):
     assert table.drop(columns="pid").equals(serial)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("threads, batch", [(1, 4), (2, 1)])
 def test_case_that_kills_its_worker_is_recorded_and_the_sweep_goes_on(threads, batch):
     # issue 24: a case crashing its worker every time aborted the whole sweep (KilledWorker) and

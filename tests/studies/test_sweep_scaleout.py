@@ -166,6 +166,7 @@ print(json.dumps([task(c) for c in json.loads(sys.argv[2])]))
 """
 
 
+@pytest.mark.slow
 @pytest.mark.tool("gcc|cc")
 def test_underwater_task_ships_the_models_it_uses(tmp_path):
     # issue 24: UnderwaterEffects listed no models, so its workers needed a compiler. A process

@@ -36,6 +36,7 @@ def test_sizing_refuses_unknown_parameters_and_the_wrong_robot():
         ActuatorSizing(RobotSource.of("planar_2r"), trajectory="trapezoid", q_start=(0.0, 0.0))
 
 
+@pytest.mark.slow
 def test_calibration_monte_carlo_recovers_the_true_robot_without_noise():
     task = CalibrationMonteCarlo(n_test=40)
     clean = task({"seed": 5, "sigma": 1e-9, "n_poses": 30, "model": "s-model"})

@@ -81,6 +81,7 @@ def puma():
     return robot, rd.compile_model(robot)
 
 
+@pytest.mark.slow
 def test_the_three_formulations_agree_with_each_other_and_the_compiled_puma(puma):
     """Rotor inertia and friction included: the full tau of each formulation."""
     robot, model = puma

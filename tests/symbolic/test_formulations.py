@@ -86,9 +86,11 @@ def test_formulations_agree_symbolically_on_small_robots(name):
 # test_kinova_formulations.py: its expanded equations are too large for lambdify.
 ALL = ("trolley_pendulum", "trolley_double_pendulum", "planar_2r", "aa300", "puma560",
        "puma560_akb")
+#: The same, the six-joint arms marked slow (13-16 s each: make quick leaves them to the full suite)
+ALL_MARKED = tuple(pytest.param(n, marks=pytest.mark.slow) if n.startswith("puma560") else n for n in ALL)
 
 
-@pytest.mark.parametrize("name", ALL)
+@pytest.mark.parametrize("name", ALL_MARKED)
 def test_formulations_agree_numerically(name):
     eoms = [eom_of(name, m) for m in METHODS]
     fns = [(evaluator(e, e.M), evaluator(e, e.g), evaluator(e, e.tau), evaluator(e, e.C))

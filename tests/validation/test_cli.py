@@ -31,6 +31,7 @@ def _rows(path):
         return list(csv.DictReader(fh))
 
 
+@pytest.mark.slow
 def test_validate_command_writes_metrics_report_and_figures(files, tmp_path, capsys):
     train, _ = files
     rc = main(["validate", "puma560", "--data", str(train), "-o", str(tmp_path)])
@@ -211,6 +212,7 @@ def test_validate_with_a_joint_without_sensor(tmp_path, capsys):
     assert all(np.isfinite(float(x)) for x in row[3:6]) and float(row[3]) < 1e-3
 
 
+@pytest.mark.slow
 def test_validate_and_underwater_without_a_c_compiler(files, tmp_path, monkeypatch, capsys):
     # issue 23: tracebacks when no compiler is on PATH
     train, _ = files
