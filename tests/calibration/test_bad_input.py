@@ -117,3 +117,21 @@ def test_options_object_runs_like_the_keywords_and_checks_when_made():
             rd.CalibrateOptions(**bad)
     with pytest.raises(InputError, match=r"options: given together with the keyword\(s\) loss"):
         rd.calibrate(r, q, y, loss="cauchy", options=opts)
+
+
+def test_too_many_parameters_for_the_poses_is_warned_about():
+    # issue 25 item 2: fewer than 3 equations per identifiable parameter draws a warning (and
+    # more poses silence it); fewer equations than parameters stay refused
+    r = robot("puma560")
+    true = perturbed_robot(r, 3, base=TRACKER, target=(0.0, 0.0, 0.0))
+    q = poses("puma560", 40, 1)
+    y = robot_positions(true, q)
+    with pytest.warns(RuntimeWarning, match=r"40 poses give 120 equations for \d+ identifiable "
+                                             r"parameters of the s-model model \(fewer than 3 per"):
+        calibrate(r, q, y, nongeometric=("compliance", "harmonics"))
+    import warnings
+
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        calibrate(r, q, y)  # the geometry alone: about 30 parameters for 120 equations
+    assert not [w for w in seen if "equations for" in str(w.message)]
