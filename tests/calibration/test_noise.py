@@ -49,6 +49,7 @@ def test_standard_dh_stays_above_the_noise_on_the_puma():
     assert validate(cal, q_test, y_test).rms > 2 * SIGMA * math.sqrt(3)
 
 
+@pytest.mark.slow
 def test_before_and_after_statistics_match_an_independent_recomputation():
     _, q, _, y, _, _, _ = data()
     cal = calibrate(robot("puma560"), q, y, "hayati", sigma=SIGMA)

@@ -99,6 +99,7 @@ def test_identify_payload_needs_compliance():
         calibrate(r, q, y, "s-model", payload=(2.0, (0.0, 0.0, 0.1)))
 
 
+@pytest.mark.slow
 @pytest.mark.filterwarnings("ignore:calibration of puma560. the variance factor")
 def test_cli_payload_options(loaded, tmp_path, capsys):
     import json

@@ -159,6 +159,7 @@ def test_non_contiguous_and_odd_stride_inputs(models, name):
             np.testing.assert_array_equal(v, b)  # inputs untouched
 
 
+@pytest.mark.slow
 @pytest.mark.tool("gcc")  # needs gcc's -fopt-info-vec
 def test_kernel_block_loops_are_vectorised(tmp_path):
     import robodyn as rd

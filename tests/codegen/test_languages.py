@@ -205,6 +205,7 @@ def _call_library(ffi, lib, b: Bundle, prefix: str) -> tuple[dict, dict]:
     return single, batch
 
 
+@pytest.mark.slow
 @pytest.mark.tool("gcc|cc")
 def test_c_library_matches_numpy(bundle):
     bundle.wait("c_lib")

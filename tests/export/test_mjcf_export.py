@@ -108,7 +108,8 @@ def test_bodies_are_robodyn_link_frames(name):
         np.testing.assert_allclose(site.xmat.reshape(3, 3), ref.tool[:3, :3], atol=1e-12)
 
 
-@pytest.mark.parametrize("name", ["aa300", "planar_2r", "trolley_double_pendulum", "kinova_gen3"])
+@pytest.mark.parametrize("name", ["aa300", "planar_2r", "trolley_double_pendulum",
+                                  pytest.param("kinova_gen3", marks=pytest.mark.slow)])
 def test_inertia_repairs_keep_the_dynamics(name):
     """Massless links, thin rods, point masses, Kinova's shoulder: repaired without a change."""
     original, (robot, _, messages) = builtin(name), written(name)

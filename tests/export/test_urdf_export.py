@@ -76,7 +76,8 @@ def assert_same_frames(original: Robot, loaded: Robot, rng: np.random.Generator)
     return worst
 
 
-@pytest.mark.parametrize("name", BUILTINS)
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n == "kinova_gen3" else n
+                                  for n in BUILTINS])
 def test_round_trip_keeps_frames_and_dynamics(name, tmp_path):
     original = builtin(name)
     loaded, messages, _ = export_and_load(original, tmp_path)

@@ -20,6 +20,7 @@ from contextlib import redirect_stderr, redirect_stdout
 from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -86,6 +87,7 @@ def _run(argv: list[str], folder: Path) -> None:
     assert after == before, argv
 
 
+@pytest.mark.slow
 @fuzz_settings(deadline_s=20)
 @given(spec=mutated([SPEC]))
 def test_record_info_and_convert_with_a_mutated_spec(spec: str) -> None:

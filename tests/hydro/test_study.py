@@ -68,6 +68,7 @@ def test_lift_row_is_dropped_with_the_reason_where_lift_cannot_act(series) -> No
     assert wet.notes == (LIFT_DROPPED + LIFT_IN_CURRENT,)
 
 
+@pytest.mark.slow
 def test_lift_reaches_joints_is_physics_not_a_blanket_rule() -> None:
     planar = rd.load("underwater_2r")
     assert not lift_reaches_joints(planar, (0.0, 0.0, 0.0))

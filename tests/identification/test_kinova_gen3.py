@@ -54,6 +54,7 @@ def _errors(ident, recs, joint=None):
     return fig.raw, fig.filtered, fig.noise_floor
 
 
+@pytest.mark.slow
 @data
 def test_held_out_current_error_beats_the_readme_baseline(gen3):
     robot, model, train, test = gen3
@@ -105,6 +106,7 @@ def test_each_jointwise_run_for_its_moving_joint(default_fit):
         assert filtered < BASELINE_FILTERED, path.name
 
 
+@pytest.mark.slow
 @data
 def test_cross_run_fit_on_the_short_runs_predicts_the_long_run(gen3):
     """Fit on the whole of RunTrajectory1 and Trajectory1, predict the whole of

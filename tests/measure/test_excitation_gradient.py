@@ -111,6 +111,7 @@ def test_excitation_gradient_analytic_equals_finite_differences(puma, criterion)
         assert slope == pytest.approx(g_a[i], rel=1e-4, abs=1e-6 * scale)
 
 
+@pytest.mark.slow
 def test_design_with_analytic_gradient_improves_on_its_starts(puma):
     # No optimiser guarantees that one gradient ends at least as low as another from the same
     # starts (that depends on the path, and so on the CPU's rounding). What holds on any CPU: the

@@ -229,6 +229,7 @@ def test_missing_compiler_names_the_numpy_fallback(tmp_path, monkeypatch):
     assert model.mass_matrix(np.zeros(2)).shape == (2, 2)
 
 
+@pytest.mark.slow
 def test_cache_is_reused_and_safe_across_processes(tmp_path):
     env = {**os.environ, "ROBODYN_CACHE": str(tmp_path)}
     script = ("import warnings, numpy as np, robodyn as rd; warnings.simplefilter('ignore');"

@@ -33,7 +33,7 @@ def test_pd_settles_where_the_spring_holds_gravity(planar, method):
     assert np.abs(run.qd[-1]).max() < 1e-8
 
 
-@pytest.mark.parametrize("method", ["rk4", "RK45"])
+@pytest.mark.parametrize("method", ["rk4", pytest.param("RK45", marks=pytest.mark.slow)])
 def test_pid_and_gravity_compensation_reach_the_set_point(planar, method):
     for ctrl in (PID(200.0, 300.0, 40.0, Q_REF), GravityCompensation(200.0, 40.0, Q_REF)):
         run = simulate(planar, Q_START, None, 10.0, 1e-3, method, ctrl)

@@ -68,6 +68,7 @@ def _one_step_map(model, step, x0):
     return jac
 
 
+@pytest.mark.slow
 def test_the_zero_order_hold_loop_is_stable_and_one_rk4_step_is_not(exported):
     dt, n = 1e-3, exported.dof
     x0 = np.concatenate([[0.1, -0.1, 0.1, 0.1, -0.1, 0.1], np.zeros(n)])

@@ -13,6 +13,7 @@ from robodyn.robot.errors import StudyError
 from robodyn.studies import IdentificationMonteCarlo, UnderwaterEffects, run_serial, sweep
 
 
+@pytest.mark.slow
 def test_identification_error_grows_with_noise_and_vanishes_without():
     task = IdentificationMonteCarlo()
     cases = [{"torque_noise": s, "seed": k} for s in (0.0, 0.05, 0.5) for k in (1, 2)]

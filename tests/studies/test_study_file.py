@@ -117,6 +117,7 @@ def test_identification_and_underwater_tasks_run_from_study_files(tmp_path):
         read_study(_write(tmp_path, "task: nonesuch\nparameters:\n  a: [1]\n", "bad.yaml"))
 
 
+@pytest.mark.slow
 def test_cli_sweep_where_every_case_failed_exits_1_with_the_table(tmp_path, capsys):
     path = _write(tmp_path, SIZING + "parameters:\n  payload: [-50, -60]\n")
     assert main(["sweep", str(path), "--workers", "1", "-o", str(tmp_path / "out")]) == 1

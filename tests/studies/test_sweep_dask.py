@@ -37,6 +37,7 @@ def _sizing_task() -> ActuatorSizing:
                           dt=5e-3, settle=0.2)
 
 
+@pytest.mark.slow
 def test_sizing_sweep_equals_a_serial_loop_exactly(client):
     task = _sizing_task()
     grid = {"payload": [0.0, 50.0], "bandwidth_hz": [3.0, 5.0], "gravity_compensation": [True, False]}

@@ -76,6 +76,7 @@ def test_workers_that_join_after_submission_get_batches(grow):
     assert table["worker"].dropna().nunique() == 6
 
 
+@pytest.mark.slow
 @pytest.mark.tool("gcc|cc")  # here, to build the models shipped
 def test_workers_without_compiler_or_cache_get_the_compiled_models(tmp_path):
     # issue 24: compiled models were never shipped, so every worker needed the toolchain.

@@ -18,7 +18,8 @@ except ImportError:
 
 
 @pytest.mark.oracle("pinocchio")
-@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("seed", [pytest.param(s, marks=pytest.mark.slow) if s in (0, 2, 3) else s
+                                  for s in range(6)])
 def test_random_chain_matches_pinocchio(tmp_path, seed):
     rng = np.random.default_rng(seed)
     n = int(rng.integers(2, 6))
@@ -50,6 +51,7 @@ def test_random_chain_matches_pinocchio(tmp_path, seed):
 GEN3_URDF = Path(__file__).resolve().parents[3] / "shared" / "data" / "kinova-gen3" / "gen3.urdf"
 
 
+@pytest.mark.slow
 @pytest.mark.data(GEN3_URDF)
 @pytest.mark.oracle("pinocchio")
 def test_builtin_kinova_gen3_matches_pinocchio_on_the_original_urdf():

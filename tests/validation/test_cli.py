@@ -195,6 +195,7 @@ def test_identify_and_validate_accept_tool(command):
     assert args.tool == "flange"
 
 
+@pytest.mark.slow
 def test_validate_with_a_joint_without_sensor(tmp_path, capsys):
     # the README's example on RunTrajectory1 (no torque sensor on joint 1: an all-NaN column)
     # failed with "lowpass: non-finite value at row 0, column 0" after writing its outputs

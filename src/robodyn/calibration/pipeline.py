@@ -245,53 +245,22 @@ def calibrate(
         (reflectors) measured at each pose, each with its own offset on the last link, all fitted
         together. The instrument-to-base transform and the target offsets are unknown and
         estimated.
-    model : {"s-model", "hayati", "dh", "poe"}
-        The error model (:mod:`robodyn.calibration.models`).
-    sigma : float or array_like, shape (N,) or (N, 3)
-        Standard uncertainty of each measured coordinate, m (0.05 mm by default).
-    loss : {"linear", "huber", "soft_l1", "cauchy", "arctan"}
-        Robust loss (on weighted residuals, in units of sigma, scaled by ``loss_scale``).
-    initial : {"nominal", "circle-point"}
-        Start from the nominal geometry, or from circle-point analysis of ``circle_data``.
+    model, sigma, loss, initial, sigma_rot, loss_scale, parallel_tol, max_nfev
+        The choices: the attributes of the same names of
+        :class:`~robodyn.calibration.options.CalibrateOptions` (what each does, its values and
+        default). ``model``: "s-model" (default), "hayati", "dh" or "poe"; ``sigma``: the
+        standard uncertainty of each measured coordinate, m (0.05 mm by default).
+    nongeometric, payload, identify_payload, length_unit, angle_unit, deflection
+        Likewise.
     circle_data : sequence of (q, points), optional
         One data set per joint that moves only that joint (see
-        :func:`robodyn.calibration.circle_point.circle_point`); used for the initial estimate only.
+        :func:`robodyn.calibration.circle_point.circle_point`); used for the initial estimate only
+        (``initial="circle-point"``).
     orientations : array_like, shape (N, 3, 3), optional
         Measured target orientations in the instrument frame (then the target's orientation is
         estimated too).
-    sigma_rot : float
-        Standard uncertainty of a measured orientation, rad.
-    loss_scale : float
-    parallel_tol : float
-        Nominal consecutive axes closer than this to parallel (rad) get Hayati's link.
-    max_nfev : int, optional
-        Most residual evaluations of the final fit.
-    nongeometric : sequence of {"compliance", "harmonics"}
-        Non-geometric joint errors identified with the geometry
-        (:mod:`robodyn.calibration.nongeometric`): joint compliance under the gravity model's
-        holding torques, first harmonics of the joint (and motor) angles.
-    payload : (float, sequence of float), optional
-        Known payload for the compliance torques: mass (kg) and centre of mass in the tool frame (m).
-    identify_payload : bool
-        Estimate the payload (``payload.mass``, kg, and its first moments ``payload.mx``, ``.my``,
-        ``.mz``, kg m, in the tool frame; ``payload`` is then the starting value, else zero) with
-        the compliances. The payload acts only through the compliances, so the fit runs in
-        stages: compliances and geometry first, then again from that solution with the
-        identifiability checked there, while the identifiable set grows (at most three more
-        times). Needs ``"compliance"`` in ``nongeometric``.
-    length_unit : {"m", "mm"}
-        Unit of ``points`` and ``sigma`` (converted to m; the result is in m).
-    angle_unit : {"rad", "deg"}
-        Unit of the revolute joints' readings in ``q`` and of ``sigma_rot`` (converted to rad).
-    deflection : {"linear", "exact"}
-        Compliance model: the holding torque at the readings (``"linear"``, first order, compiles
-        nothing), or the static equilibrium at the deflected pose, ``x = u - C tau(x)``, solved by
-        Newton with the compiled model's analytic gravity derivatives and an exact Jacobian
-        (``"exact"``, :mod:`robodyn.numeric.deflection`; compiles the model on first use). Needs
-        ``"compliance"`` and link masses; not with ``identify_payload``.
     options : CalibrateOptions, optional
-        The choices above (all but the data ``q``, ``points``, ``circle_data`` and
-        ``orientations``) at once, instead of the keywords (a keyword other than its default
+        All the choices at once, instead of the keywords (a keyword other than its default
         given as well is refused); ``cal.options`` is the set a run used.
 
     Returns
