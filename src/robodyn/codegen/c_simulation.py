@@ -8,6 +8,7 @@ Emitted beside the kernels by :class:`robodyn.codegen.c.CPrinter` (``rd_simulate
 from __future__ import annotations
 
 from robodyn.codegen.cpu import BLOCK
+from robodyn.codegen.fixed_step import RK4, law_c_lines, semi_implicit_c_lines
 
 __all__ = ["ensemble_signature", "ensemble_source", "simulate_signature", "simulation_source"]
 
@@ -60,7 +61,6 @@ def ensemble_source(n: int, prefix: str, runtime: int = 0) -> str:
     # the block's parameter rows (the kernels index them like the states), one row per law
     blk = f", params + first * {runtime}" if runtime else ""
     own = f", params + (first + j) * {runtime}" if runtime else ""
-    stage = "        for (int i = 0; i < m * NX; ++i) xt[i] = x[i] + {h} * {k}[i];"
     lines = [
         f"/* trajectories first .. first + m - 1 (m <= {BLOCK}) of simulate_ensemble. */",
         f"static void {prefix}ensemble_block(long first, int m, long steps, double dt, int method, "
@@ -85,21 +85,13 @@ def ensemble_source(n: int, prefix: str, runtime: int = 0) -> str:
         "        }",
         "        if (method == 0) {",
         "            /* RK4 over the block: x += dt/6 (k1 + 2 k2 + 2 k3 + k4) */",
-        f"            {sd}(0, m, x, tau{blk}, k1, 0);",
-        stage.format(h="0.5 * dt", k="k1"),
-        f"            {sd}(0, m, xt, tau{blk}, k2, 0);",
-        stage.format(h="0.5 * dt", k="k2"),
-        f"            {sd}(0, m, xt, tau{blk}, k3, 0);",
-        stage.format(h="dt", k="k3"),
-        f"            {sd}(0, m, xt, tau{blk}, k4, 0);",
-        "            for (int i = 0; i < m * NX; ++i)",
-        "                x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);",
+        *RK4.c_lines("            ", [("x", "xt", "m * NX", "k")],
+                     lambda i, at: [f"            {sd}(0, m, {at[0]}, tau{blk}, k{i + 1}, 0);"]),
         "        } else {",
-        "            /* semi-implicit Euler: qd += dt qdd(q, qd); q += dt qd (new qd) */",
-        f"            {sd}(0, m, x, tau{blk}, k1, 0);",
+        *semi_implicit_c_lines("            ", "x", "k1",
+                               [f"            {sd}(0, m, x, tau{blk}, k1, 0);"])[:2],
         "            for (int j = 0; j < m; ++j) {",
-        "                for (int i = 0; i < N; ++i) x[j * NX + N + i] += dt * k1[j * NX + N + i];",
-        "                for (int i = 0; i < N; ++i) x[j * NX + i] += dt * x[j * NX + N + i];",
+        *semi_implicit_c_lines("                ", "x", "k1", [], "j * NX + ")[1:],
         "            }",
         "        }",
         "        for (int j = 0; j < m; ++j) {",
@@ -150,63 +142,10 @@ def _ensemble_driver(n: int, prefix: str, runtime: int, args: str) -> list[str]:
 
 def _law_source(n: int, prefix: str, has_gravity: bool, has_mass: bool,
                 runtime: int = 0) -> list[str]:
-    """``PREFIXcontrol_law``: the torque at one state from row ``row`` of the sampled inputs."""
-    p = ", params" if runtime else ""
-    lines = [
-        "/* tau = the control law at state x with the inputs of sample `row` (see simulate). */",
-        f"static void {prefix}control_law(long row, const double *x, const double *integ, "
-        "const double *feedforward, const double *reference, const double *gain, "
-        f"const double *integral_gain, int mode, const double *tau_limit, {_params_decl(runtime)}"
-        "double *tau) {",
-        f"    enum {{ N = {n}, NX = {2 * n} }};",
-        "    double e[NX], v[N];",
-        "    /* e = reference_row - x */",
-        "    for (int i = 0; i < NX; ++i) e[i] = (reference ? reference[row * NX + i] : 0.0) - x[i];",
-        "    /* v = feedforward_row + gain e + integral_gain * integral(e_q) */",
-        "    for (int i = 0; i < N; ++i) {",
-        "        double s = feedforward ? feedforward[row * N + i] : 0.0;",
-        "        if (gain) for (int j = 0; j < NX; ++j) s += gain[i * NX + j] * e[j];",
-        "        if (integral_gain) s += integral_gain[i] * integ[i];",
-        "        v[i] = s;",
-        "    }",
-    ]
-    if has_mass:
-        lines += [
-            "    if (mode == 2) {",
-            "        /* computed torque: tau = M(q) v + (C qd + g + friction) */",
-            "        double m[N * N], h[N], zero[N];",
-            "        for (int i = 0; i < N; ++i) zero[i] = 0.0;",
-            f"        {prefix}mass_matrix(x{p}, m);",
-            f"        {prefix}inverse_dynamics(x, x + N, zero{p}, h);",
-            "        for (int i = 0; i < N; ++i) {",
-            "            double s = h[i];",
-            "            for (int j = 0; j < N; ++j) s += m[i * N + j] * v[j];",
-            "            tau[i] = s;",
-            "        }",
-            "    } else {",
-            "        for (int i = 0; i < N; ++i) tau[i] = v[i];",
-            "    }",
-        ]
-    else:
-        lines += ["    for (int i = 0; i < N; ++i) tau[i] = v[i];"]
-    if has_gravity:
-        lines += [
-            "    if (mode == 1) {",
-            "        /* gravity compensation: tau += g(q) */",
-            "        double gq[N];",
-            f"        {prefix}gravity(x{p}, gq);",
-            "        for (int i = 0; i < N; ++i) tau[i] += gq[i];",
-            "    }",
-        ]
-    lines += [
-        "    if (tau_limit) for (int i = 0; i < N; ++i) {",
-        "        if (tau[i] > tau_limit[i]) tau[i] = tau_limit[i];",
-        "        if (tau[i] < -tau_limit[i]) tau[i] = -tau_limit[i];",
-        "    }",
-        "}",
-        "",
-    ]
-    return lines
+    """``PREFIXcontrol_law``: the torque at one state from row ``row`` of the sampled inputs
+    (:func:`robodyn.codegen.fixed_step.law_c_lines`)."""
+    return law_c_lines(n, prefix, has_gravity, has_mass, ", params" if runtime else "",
+                       _params_decl(runtime))
 
 
 def _staged_rk4(prefix: str, args: str, p: str = "") -> list[str]:
@@ -216,25 +155,17 @@ def _staged_rk4(prefix: str, args: str, p: str = "") -> list[str]:
     """
     sd, law = f"{prefix}state_derivative", f"{prefix}control_law"
     ind = "            "
-    lines = [f"{ind}{law}(2 * k, x, integ, {args}, tau);",
-             f"{ind}{sd}(x, tau{p}, k1);",
-             f"{ind}{prefix}error_rate(2 * k, x, reference, r1);"]
-    # stages 2-4: state and integral advanced by (dt/2, dt/2, dt) times the previous slopes
-    for (frac, row), (kp, rp), (kn, rn) in zip((("0.5 * dt", "2 * k + 1"), ("0.5 * dt", "2 * k + 1"),
-                                               ("dt", "2 * k + 2")),
-                                              (("k1", "r1"), ("k2", "r2"), ("k3", "r3")),
-                                              (("k2", "r2"), ("k3", "r3"), ("k4", "r4")), strict=True):
-        lines += [f"{ind}for (int i = 0; i < NX; ++i) xt[i] = x[i] + {frac} * {kp}[i];",
-                  f"{ind}for (int i = 0; i < N; ++i) zt[i] = integ[i] + {frac} * {rp}[i];",
-                  f"{ind}{law}({row}, xt, zt, {args}, ts);",
-                  f"{ind}{sd}(xt, ts{p}, {kn});",
-                  f"{ind}{prefix}error_rate({row}, xt, reference, {rn});"]
-    lines += [f"{ind}/* x += dt/6 (k1 + 2 k2 + 2 k3 + k4), the same for z */",
-              f"{ind}for (int i = 0; i < NX; ++i)",
-              f"{ind}    x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);",
-              f"{ind}for (int i = 0; i < N; ++i)",
-              f"{ind}    integ[i] += dt / 6.0 * (r1[i] + 2.0 * r2[i] + 2.0 * r3[i] + r4[i]);"]
-    return lines
+
+    def slopes(i: int, at: tuple[str, ...]) -> list[str]:
+        # stage i: the law at the stage's state and sample, then both slopes
+        row = "2 * k" + (f" + {RK4.rows[i]}" if RK4.rows[i] else "")
+        tau = "tau" if i == 0 else "ts"
+        return [f"{ind}{law}({row}, {at[0]}, {at[1]}, {args}, {tau});",
+                f"{ind}{sd}({at[0]}, {tau}{p}, k{i + 1});",
+                f"{ind}{prefix}error_rate({row}, {at[0]}, reference, r{i + 1});"]
+
+    return RK4.c_lines(ind, [("x", "xt", "NX", "k"), ("integ", "zt", "N", "r")], slopes,
+                       "/* x += dt/6 (k1 + 2 k2 + 2 k3 + k4), the same for z */")
 
 
 def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool,
@@ -292,20 +223,10 @@ def simulation_source(n: int, prefix: str, has_gravity: bool, has_mass: bool,
         f"            {law}(row, x, integ, {args}, tau);",
         "            if (method == 0) {",
         "                /* RK4: x += dt/6 (k1 + 2 k2 + 2 k3 + k4) */",
-        f"                {sd}(x, tau{p}, k1);",
-        "                for (int i = 0; i < NX; ++i) xt[i] = x[i] + 0.5 * dt * k1[i];",
-        f"                {sd}(xt, tau{p}, k2);",
-        "                for (int i = 0; i < NX; ++i) xt[i] = x[i] + 0.5 * dt * k2[i];",
-        f"                {sd}(xt, tau{p}, k3);",
-        "                for (int i = 0; i < NX; ++i) xt[i] = x[i] + dt * k3[i];",
-        f"                {sd}(xt, tau{p}, k4);",
-        "                for (int i = 0; i < NX; ++i)",
-        "                    x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);",
+        *RK4.c_lines("                ", [("x", "xt", "NX", "k")],
+                     lambda i, at: [f"                {sd}({at[0]}, tau{p}, k{i + 1});"]),
         "            } else {",
-        "                /* semi-implicit Euler: qd += dt qdd(q, qd); q += dt qd (new qd) */",
-        f"                {sd}(x, tau{p}, k1);",
-        "                for (int i = 0; i < N; ++i) x[N + i] += dt * k1[N + i];",
-        "                for (int i = 0; i < N; ++i) x[i] += dt * x[N + i];",
+        *semi_implicit_c_lines("                ", "x", "k1", [f"                {sd}(x, tau{p}, k1);"]),
         "            }",
         "        }",
         "        for (int i = 0; i < NX; ++i) {",

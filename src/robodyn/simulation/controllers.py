@@ -25,6 +25,8 @@ from typing import Any
 import numpy as np
 from scipy.linalg import solve_continuous_are
 
+from robodyn.codegen.fixed_step import LAW_MODES
+from robodyn.codegen.fixed_step import law as sampled_law
 from robodyn.numeric.model import Model
 from robodyn.robot.errors import InputError
 from robodyn.simulation.linearize import Linearization, linearize
@@ -45,18 +47,35 @@ class Controller:
         return type(self).__name__
 
     # --- to override ---------------------------------------------------------------------------
-    def law(self, model: Model, t: float, x: np.ndarray, integral: np.ndarray | None = None) -> np.ndarray:
-        """Unclipped torque (n,) at time ``t`` (s) and state ``x = [q; qd]`` (2 n,).
-
-        ``integral`` is the time integral of the position error (rad s or m s), used by PID.
-        """
-        raise NotImplementedError
-
     def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
-        """Keyword arguments of ``Model.integrate`` for steps starting at times ``t`` (steps,)."""
+        """Keyword arguments of ``Model.integrate`` for steps starting at times ``t`` (steps,):
+        the law's inputs (:func:`robodyn.codegen.fixed_step.law`) and its ``mode``."""
         raise NotImplementedError
 
     # --- shared --------------------------------------------------------------------------------
+    def law(self, model: Model | None, t: float, x: np.ndarray,
+            integral: np.ndarray | None = None) -> np.ndarray:
+        """Unclipped torque (n,) at time ``t`` (s) and state ``x = [q; qd]`` (2 n,).
+
+        The controller's inputs at ``t`` (:meth:`sampled`) through the one law that the
+        generated C and NumPy integrators run (:func:`robodyn.codegen.fixed_step.law`).
+        ``integral`` is the time integral of the position error (rad s or m s), used by PID.
+        ``model``: the plant's model (the controller's own ``model=`` is used instead for the
+        model terms of gravity compensation and computed torque when it has one).
+        """
+        x = np.asarray(x, dtype=float)
+        n = x.size // 2
+        inputs = self.sampled(model if model is not None else _Joints(n), np.array([float(t)]))
+        mode = _MODE[inputs["mode"]]
+        z = np.zeros(n) if integral is None else np.asarray(integral, dtype=float)
+        own = _need_model(self, model) if mode else None
+        zero = np.zeros(n)
+        terms = {"mass_matrix": lambda q, qd: own.mass_matrix(q),  # type: ignore[union-attr]
+                 "bias": lambda q, qd: own.inverse_dynamics(q, qd, zero),  # type: ignore[union-attr]
+                 "gravity": lambda q, qd: own.gravity(q)}  # type: ignore[union-attr]
+        return sampled_law({**inputs, "tau_limit": None}, 0, x, z, mode,
+                           lambda name, q, qd: terms[name](q, qd))
+
     @property
     def has_integral(self) -> bool:
         """True when the law needs the error integral as extra state."""
@@ -78,6 +97,17 @@ class Controller:
         model = self.model
         x = np.concatenate([np.asarray(q, dtype=float), np.asarray(qd, dtype=float)])
         return self.clip(self.law(model, t, x, None))  # type: ignore[arg-type]
+
+
+@dataclass(frozen=True)
+class _Joints:
+    """Stands for a model where only its number of joints is needed (a controller called alone)."""
+
+    dof: int
+
+
+#: The law's mode names to the integer the integrators take.
+_MODE = {name: k for k, name in LAW_MODES.items()}
 
 
 def _freeze(a: np.ndarray | None) -> np.ndarray | None:
@@ -163,12 +193,6 @@ class PD(Controller):
     def _ref(self) -> Reference:
         return self.q_ref
 
-    def law(self, model: Model, t: float, x: np.ndarray, integral: np.ndarray | None = None) -> np.ndarray:
-        n = x.size // 2
-        q_r, qd_r, _ = _reference_at(self.q_ref, t, n)
-        # tau = Kp e + Kd ed
-        return _gain(self.kp, n, "kp") @ (q_r - x[:n]) + _gain(self.kd, n, "kd") @ (qd_r - x[n:])
-
     def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
         return {**_pd_sampled(self.kp, self.kd, self.q_ref, model.dof, t), "mode": "feedback"}
 
@@ -212,14 +236,6 @@ class PID(Controller):
         """Forget the accumulated integral of the callable form."""
         self._state.clear()
 
-    def law(self, model: Model, t: float, x: np.ndarray, integral: np.ndarray | None = None) -> np.ndarray:
-        n = x.size // 2
-        q_r, qd_r, _ = _reference_at(self.q_ref, t, n)
-        z = np.zeros(n) if integral is None else integral
-        # tau = Kp e + Ki z + Kd ed
-        return (_gain(self.kp, n, "kp") @ (q_r - x[:n]) + self._ki(n) * z
-                + _gain(self.kd, n, "kd") @ (qd_r - x[n:]))
-
     def __call__(self, t: float, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         q = np.asarray(q, dtype=float)
         e = self.position_error(t, q)
@@ -256,14 +272,6 @@ class GravityCompensation(Controller):
 
     def _ref(self) -> Reference:
         return self.q_ref
-
-    def law(self, model: Model, t: float, x: np.ndarray, integral: np.ndarray | None = None) -> np.ndarray:
-        model = _need_model(self, model)
-        n = x.size // 2
-        q_r, qd_r, _ = _reference_at(self.q_ref, t, n)
-        # tau = Kp e + Kd ed + g(q)
-        return (_gain(self.kp, n, "kp") @ (q_r - x[:n]) + _gain(self.kd, n, "kd") @ (qd_r - x[n:])
-                + model.gravity(x[:n]))
 
     def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
         return {**_pd_sampled(self.kp, self.kd, self.q_ref, model.dof, t), "mode": "gravity"}
@@ -303,16 +311,6 @@ class ComputedTorque(Controller):
 
     def _ref(self) -> Reference:
         return self.trajectory
-
-    def law(self, model: Model, t: float, x: np.ndarray, integral: np.ndarray | None = None) -> np.ndarray:
-        model = _need_model(self, model)
-        n = x.size // 2
-        q, qd = x[:n], x[n:]
-        q_r, qd_r, qdd_r = _reference_at(self.trajectory, t, n)
-        # v = qdd_ref + Kp e + Kd ed
-        v = qdd_r + _gain(self.kp, n, "kp") @ (q_r - q) + _gain(self.kd, n, "kd") @ (qd_r - qd)
-        # tau = M(q) v + h(q, qd)
-        return model.mass_matrix(q) @ v + model.inverse_dynamics(q, qd, np.zeros(n))
 
     def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
         _, _, qdd_r = _reference_at(self.trajectory, t, model.dof)
@@ -421,10 +419,6 @@ class LQR(Controller):
 
     def _ref(self) -> Reference:
         return self.x_eq[: self.u_eq.size]
-
-    def law(self, model: Model, t: float, x: np.ndarray, integral: np.ndarray | None = None) -> np.ndarray:
-        # tau = u_eq + K (x_eq - x)
-        return self.u_eq + self.K @ (self.x_eq - x)
 
     def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
         steps, n = t.size, model.dof

@@ -12,6 +12,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from robodyn.codegen.fixed_step import RK4
 from robodyn.numeric.model import Model
 from robodyn.numeric.rollout import MAX_INTEGRATE_BYTES
 from robodyn.robot.errors import InputError, SimulationError
@@ -183,17 +184,17 @@ def _fixed_step_python(model: Model, x0: np.ndarray, steps: int, dt: float, deci
         if k % decimate == 0:
             x_out[k // decimate], tau_out[k // decimate] = x, tau
         if continuous:
-            # RK4 with the callable evaluated at every stage
-            k1 = f(x, tau)
-            xs = x + 0.5 * dt * k1
-            k2 = f(xs, law(tk + 0.5 * dt, xs))
-            xs = x + 0.5 * dt * k2
-            k3 = f(xs, law(tk + 0.5 * dt, xs))
-            xs = x + dt * k3
-            k4 = f(xs, law(tk + dt, xs))
-            x = x + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            # RK4 (robodyn.codegen.fixed_step.RK4) with the callable at every stage's time
+            last = [x]
+
+            def slopes(i: int, s: tuple[np.ndarray, ...], tk: float = tk, tau: np.ndarray = tau,
+                       last: list[np.ndarray] = last) -> tuple[np.ndarray]:
+                last[0] = s[0]
+                return (f(s[0], tau if i == 0 else law(tk + 0.5 * RK4.rows[i] * dt, s[0])),)
+
+            x = RK4.step((x,), dt, slopes)[0]
             if not np.all(np.isfinite(x)):
-                model.check_mass_matrix(xs[:n])
+                model.check_mass_matrix(last[0][:n])
                 raise SimulationError(f"the simulated state stopped being finite at step {k} "
                                       f"(t = {tk:g} s); reduce dt or check the inputs")
         else:
