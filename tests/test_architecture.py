@@ -8,6 +8,9 @@ must have no cycle between files or between packages, and no import may run up t
 from __future__ import annotations
 
 import ast
+import re
+import subprocess
+import sys
 from collections import defaultdict
 from pathlib import Path
 
@@ -171,3 +174,19 @@ def test_every_function_body_under_the_size_limit() -> None:
             if node.end_lineno - start + 1 > MAX_FUNCTION_LINES:
                 long.append(f"{path.relative_to(SRC)}:{node.lineno} {node.name}")
     assert long == []
+
+
+def test_the_library_never_switches_the_matplotlib_backend() -> None:
+    """Figures are object-oriented (``matplotlib.figure.Figure``): no ``matplotlib.use`` and no
+    pyplot anywhere in the library, so a notebook user's backend is left as it was."""
+    offenders = [f"{path.relative_to(SRC)}:{k}" for path in sorted(SRC.rglob("*.py"))
+                 for k, line in enumerate(path.read_text().splitlines(), 1)
+                 if re.search(r"matplotlib\.use\(|import matplotlib\.pyplot|from matplotlib import pyplot",
+                              line)]
+    assert not offenders, offenders
+    code = ("import matplotlib; matplotlib.use('pdf'); "
+            "import robodyn.report.underwater, robodyn.report.study_report, "
+            "robodyn.studies.simulation_plots, robodyn.cli.record, robodyn.report.calibration_report; "
+            "print(matplotlib.get_backend())")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "pdf"

@@ -63,18 +63,15 @@ def _cmd_info(args: argparse.Namespace) -> int:
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     rec = _read(args)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
     fields = [f for f in _FIELDS if getattr(rec, f) is not None]
     for k, name in enumerate(rec.joint_names):
-        fig, axes = plt.subplots(len(fields), 1, sharex=True, figsize=(8, 1.8 * len(fields) + 0.6),
-                                 squeeze=False)
+        fig = Figure(figsize=(8, 1.8 * len(fields) + 0.6))
+        axes = fig.subplots(len(fields), 1, sharex=True, squeeze=False)
         for ax, field in zip(axes[:, 0], fields, strict=True):
             ax.plot(rec.t, getattr(rec, field)[:, k], lw=0.8)
             est = " (estimated)" if field in rec.estimated else ""
@@ -85,7 +82,6 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         fig.tight_layout()
         path = out / f"{Path(rec.source).name.split('.')[0]}_{name}.png"
         fig.savefig(path, dpi=100)
-        plt.close(fig)
         print(path)
     return 0
 

@@ -46,10 +46,7 @@ def study_figures(table: pd.DataFrame, varying: Sequence[str], directory: str | 
     plot : mapping, optional
         ``x``, ``y``, ``result`` column names overriding the defaults.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     plot = dict(plot or {})
     ok = table[table["error"].isna()] if "error" in table else table
@@ -63,7 +60,8 @@ def study_figures(table: pd.DataFrame, varying: Sequence[str], directory: str | 
     axes = [a for a in (plot.get("x"), plot.get("y")) if a] or [v for v in varying if _numeric(ok, v)][:2]
     if len(axes) >= 2 and all(_numeric(ok, a) for a in axes[:2]):
         x, y = axes[:2]
-        fig, ax = plt.subplots(figsize=(6, 4.5))
+        fig = Figure(figsize=(6, 4.5))
+        ax = fig.subplots()
         grid = ok.groupby([y, x])[result].mean().unstack(x)
         if len(ok) == grid.size and not grid.isna().to_numpy().any():
             # a full grid: heat map of the result (cell = one case)
@@ -79,18 +77,18 @@ def study_figures(table: pd.DataFrame, varying: Sequence[str], directory: str | 
         paths.append(out / "study_map.png")
         fig.tight_layout()
         fig.savefig(paths[-1], dpi=100)
-        plt.close(fig)
     elif len(axes) == 1 and _numeric(ok, axes[0]):
-        fig, ax = plt.subplots(figsize=(6, 4))
+        fig = Figure(figsize=(6, 4))
+        ax = fig.subplots()
         ax.plot(ok[axes[0]], ok[result], "o")
         ax.set_xlabel(axes[0])
         ax.set_ylabel(result)
         paths.append(out / "study_curve.png")
         fig.tight_layout()
         fig.savefig(paths[-1], dpi=100)
-        plt.close(fig)
     # the distribution of the result over the cases (Monte Carlo)
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig = Figure(figsize=(6, 4))
+    ax = fig.subplots()
     ax.hist(ok[result].to_numpy(dtype=float), bins=max(5, min(50, len(ok) // 4)))
     ax.set_xlabel(result)
     ax.set_ylabel("cases")
@@ -98,7 +96,6 @@ def study_figures(table: pd.DataFrame, varying: Sequence[str], directory: str | 
     paths.append(out / "study_histogram.png")
     fig.tight_layout()
     fig.savefig(paths[-1], dpi=100)
-    plt.close(fig)
     return tuple(paths)
 
 

@@ -1,4 +1,5 @@
-"""Figures, table files and the HTML section of the underwater effect series (matplotlib Agg).
+"""Figures, table files and the HTML section of the underwater effect series (matplotlib
+figures without pyplot: the user's backend is left alone).
 
 :func:`write_study` writes everything ``robodyn underwater ROBOT -o DIR`` produces::
 
@@ -21,16 +22,13 @@ from __future__ import annotations
 import html
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from robodyn.report.html import figure, html_table, page  # noqa: E402
-from robodyn.studies.underwater import EffectSeries  # noqa: E402
-from robodyn.studies.underwater_model_error import ModelErrorStudy  # noqa: E402
-from robodyn.studies.underwater_sensitivity import Sensitivity  # noqa: E402
+from robodyn.report.html import figure, html_table, page
+from robodyn.studies.underwater import EffectSeries
+from robodyn.studies.underwater_model_error import ModelErrorStudy
+from robodyn.studies.underwater_sensitivity import Sensitivity
 
 __all__ = ["model_error_figure", "model_error_section", "sensitivity_figure",
            "sensitivity_section", "study_figures", "study_section", "write_study"]
@@ -44,8 +42,8 @@ def _per_joint(series: EffectSeries, path: Path, title: str, ylabel: str, pick, 
                reference: np.ndarray | None = None) -> Path:
     """One subplot per joint, one line per variant; ``pick(run) -> (t, (N, n) values)``."""
     names = series.table["joint"].unique()
-    fig, axes = plt.subplots(len(names), 1, figsize=(8, 2.6 * len(names)), sharex=True,
-                             squeeze=False)
+    fig = Figure(figsize=(8, 2.6 * len(names)))
+    axes = fig.subplots(len(names), 1, sharex=True, squeeze=False)
     for run in series.runs:
         t, y = pick(run)
         for i, ax in enumerate(axes[:, 0]):
@@ -60,7 +58,6 @@ def _per_joint(series: EffectSeries, path: Path, title: str, ylabel: str, pick, 
     axes[-1, 0].set_xlabel("time, s")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
@@ -114,7 +111,8 @@ def sensitivity_figure(sens: Sensitivity, path: Path) -> Path:
     """Added peak torque against each swept value, and the free runs of each case."""
     table = sens.table
     joints = table["joint"].unique()
-    fig, axes = plt.subplots(2, 2, figsize=(10, 6.5), squeeze=False)
+    fig = Figure(figsize=(10, 6.5))
+    axes = fig.subplots(2, 2, squeeze=False)
     for row, (name, unit) in enumerate((("C_d", ""), ("current", ", m/s"))):
         part = table[table["parameter"] == name]
         ax = axes[row, 0]
@@ -138,7 +136,6 @@ def sensitivity_figure(sens: Sensitivity, path: Path) -> Path:
     axes[1, 0].set_title(f"{sens.robot}: sensitivity to the current speed")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
@@ -160,8 +157,8 @@ def sensitivity_section(sens: Sensitivity, figures: tuple[Path, ...] = ()) -> st
 def model_error_figure(study: ModelErrorStudy, path: Path) -> Path:
     """Tracking error q_ref - q per joint, one line per omitted effect (symmetric log scale)."""
     names = study.table["joint"].unique()
-    fig, axes = plt.subplots(len(names), 1, figsize=(8, 2.8 * len(names)), sharex=True,
-                             squeeze=False)
+    fig = Figure(figsize=(8, 2.8 * len(names)))
+    axes = fig.subplots(len(names), 1, sharex=True, squeeze=False)
     for effect, run in study.runs.items():
         err = study.reference.at(run.t)[0] - run.q
         for i, ax in enumerate(axes[:, 0]):
@@ -176,7 +173,6 @@ def model_error_figure(study: ModelErrorStudy, path: Path) -> Path:
     axes[-1, 0].set_xlabel("time, s")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 

@@ -1,19 +1,17 @@
-"""Figures and animations of the simulation studies (matplotlib, Agg backend, files only)."""
+"""Figures and animations of the simulation studies (matplotlib figures without pyplot: files only, the
+user's backend untouched)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import matplotlib
+import numpy as np
+from matplotlib.animation import FuncAnimation, PillowWriter
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
-
-from robodyn.numeric.model import Model  # noqa: E402
-from robodyn.simulation.energy import frame_origins  # noqa: E402
+from robodyn.numeric.model import Model
+from robodyn.simulation.energy import frame_origins
 
 if TYPE_CHECKING:
     from robodyn.simulation.simulation import Trajectory
@@ -35,7 +33,9 @@ def aa300_figures(study: AA300Study, model: Model, directory: Path) -> tuple[Pat
     q_r = study.plan.at(sim.t)[0]
     paths = []
 
-    fig, axes = plt.subplots(3, 2, figsize=(11, 8), sharex=True)
+    fig = Figure(figsize=(11, 8))
+
+    axes = fig.subplots(3, 2, sharex=True)
     for j in range(3):
         ax = axes[j, 0]
         _shade(ax, study)
@@ -56,9 +56,10 @@ def aa300_figures(study: AA300Study, model: Model, directory: Path) -> tuple[Pat
     fig.tight_layout()
     paths.append(directory / "aa300_joints.png")
     fig.savefig(paths[-1], dpi=110)
-    plt.close(fig)
 
-    fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
+    fig = Figure(figsize=(9, 8))
+
+    axes = fig.subplots(3, 1, sharex=True)
     for j, d in enumerate(study.demands):
         ax = axes[j]
         _shade(ax, study)
@@ -74,10 +75,9 @@ def aa300_figures(study: AA300Study, model: Model, directory: Path) -> tuple[Pat
     fig.tight_layout()
     paths.append(directory / "aa300_torques.png")
     fig.savefig(paths[-1], dpi=110)
-    plt.close(fig)
 
     tool = model.forward_kinematics(sim.q)[:, :3, 3]
-    fig = plt.figure(figsize=(10, 4.5))
+    fig = Figure(figsize=(10, 4.5))
     ax = fig.add_subplot(1, 2, 1)
     ax.plot(tool[:, 0], tool[:, 1])
     ax.plot(0, 0, "ko")
@@ -94,7 +94,6 @@ def aa300_figures(study: AA300Study, model: Model, directory: Path) -> tuple[Pat
     fig.tight_layout()
     paths.append(directory / "aa300_tool_path.png")
     fig.savefig(paths[-1], dpi=110)
-    plt.close(fig)
     return tuple(paths)
 
 
@@ -104,7 +103,7 @@ def aa300_animation(study: AA300Study, model: Model, path: Path, fps: int = 12) 
     every = max(1, int(round(1.0 / (fps * sim.dt))))
     frames = np.arange(0, sim.t.size, every)
     tool = model.forward_kinematics(sim.q)[:, :3, 3]
-    fig = plt.figure(figsize=(5.5, 5))
+    fig = Figure(figsize=(5.5, 5))
     ax = fig.add_subplot(projection="3d")
     ax.set_xlim(-1.5, 1.5)
     ax.set_ylim(-1.5, 1.5)
@@ -128,14 +127,14 @@ def aa300_animation(study: AA300Study, model: Model, path: Path, fps: int = 12) 
 
     anim = FuncAnimation(fig, draw, frames=frames, blit=False)
     anim.save(path, writer=PillowWriter(fps=fps), dpi=80)
-    plt.close(fig)
     return path
 
 
 def balance_figure(result: BalanceResult, path: Path) -> Path:
     """Angles, trolley position and force of the LQR balance run."""
     sim = result.simulation
-    fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
+    fig = Figure(figsize=(8, 7))
+    axes = fig.subplots(3, 1, sharex=True)
     axes[0].plot(sim.t, np.degrees(sim.q[:, 1]), label="theta1 (rod 1)")
     axes[0].plot(sim.t, np.degrees(sim.q[:, 1] + sim.q[:, 2]), label="theta1 + theta2 (rod 2)")
     axes[0].set_ylabel("angle from upright (deg)")
@@ -148,7 +147,6 @@ def balance_figure(result: BalanceResult, path: Path) -> Path:
     fig.suptitle("Trolley double inverted pendulum held upright by LQR (force on the trolley only)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
@@ -170,7 +168,8 @@ def trajectory_figure(sim: Trajectory, names: tuple[str, ...], path: Path,
     -------
     Path
     """
-    fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True)
+    fig = Figure(figsize=(9, 10))
+    axes = fig.subplots(4, 1, sharex=True)
     for j, name in enumerate(names):
         (line,) = axes[0].plot(sim.t, sim.q[:, j], lw=1.2, label=name)
         if reference is not None:
@@ -189,7 +188,6 @@ def trajectory_figure(sim: Trajectory, names: tuple[str, ...], path: Path,
     fig.suptitle(f"{sim.robot}: {sim.method}, dt = {sim.dt:g} s, controller {sim.controller}")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
