@@ -37,7 +37,7 @@ from robodyn.robot.model import Robot
 from robodyn.symbolic.eom import EquationsOfMotion, derive
 from robodyn.symbolic.render import render_json, render_latex, render_text
 from robodyn.symbolic.render_mathml import render_mathml
-from robodyn.text import progress, steps, table
+from robodyn.text import markdown_table, progress, steps, table
 
 #: The thesis the demo re-creates, cited in the report.
 CITATION = ("The thesis: a PhD thesis on robotic manipulator modelling (dynamic formulations, "
@@ -254,17 +254,13 @@ def _csv(counts: list[list[object]]) -> str:
 
 def _markdown(robot: Robot, counts: list[list[object]], results: Sequence[Agreement],
               samples: int) -> str:
-    def mdtable(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> list[str]:
-        out = ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)]
-        return out + ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
-
     lines = [f"# Efficiency of the formulations: {robot.name}", "",
              f"robodyn {__version__}; description sha256 `{robot.description_hash}`.", "",
              f"Derivation time (s) and {_CSV_NOTE}.", ""]
-    lines += mdtable(COUNT_HEADERS, counts)
+    lines += [markdown_table(COUNT_HEADERS, counts)]
     lines += ["", f"## Agreement (max relative difference over {samples} random states, "
               f"tolerance {TOLERANCE:g})", ""]
-    lines += mdtable(AGREEMENT_HEADERS, agreement_rows(results))
+    lines += [markdown_table(AGREEMENT_HEADERS, agreement_rows(results))]
     return "\n".join(lines) + "\n"
 
 

@@ -60,6 +60,7 @@ from robodyn.simulation.simulation import Trajectory, simulate
 from robodyn.simulation.trajectory import JointTrajectory, quintic
 from robodyn.studies.underwater_effects import DEFAULT_CURRENT, EFFECTS, LABELS
 from robodyn.symbolic.hydro.lift_reach import lift_reaches_joints
+from robodyn.text import markdown_table
 
 __all__ = [
     "DEFAULT_CURRENT",
@@ -162,12 +163,9 @@ class EffectSeries:
 
     def markdown(self, digits: int = 4) -> str:
         """The table as GitHub markdown (numbers to ``digits`` significant figures)."""
-        cols = list(self.table.columns)
-        lines = ["| " + " | ".join(cols) + " |", "|" + "|".join("---" for _ in cols) + "|"]
-        for row in self.table.itertuples(index=False):
-            cells = [f"{v:.{digits}g}" if isinstance(v, float) else str(v) for v in row]
-            lines.append("| " + " | ".join(cells) + " |")
-        return "\n".join(lines + [""] + list(self.notes)) + "\n"
+        rows = [[f"{v:.{digits}g}" if isinstance(v, float) else str(v) for v in row]
+                for row in self.table.itertuples(index=False)]
+        return "\n".join([markdown_table(list(self.table.columns), rows), "", *self.notes]) + "\n"
 
 
 def _has_hydro(robot: Robot) -> bool:
