@@ -33,11 +33,14 @@ def test_simulate_passive_double_pendulum_writes_csv_and_plot(tmp_path, capsys):
     cols = _columns(tmp_path / "trolley_double_pendulum_simulation.csv")
     assert (tmp_path / "trolley_double_pendulum_simulation.png").stat().st_size > 10_000
     assert len(cols["t"]) == 2001 and cols["t"][-1] == pytest.approx(2.0)
-    assert cols["q_theta1"][0] == 0.3 and cols["q_theta2"][0] == -0.2
+    assert cols["q[theta1]"][0] == 0.3 and cols["q[theta2]"][0] == -0.2
     # passive and frictionless: RK4 at 1 ms keeps the energy to well under 1e-5 relative
-    e = cols["energy"]
+    e = _columns(tmp_path / "trolley_double_pendulum_energy.csv")["energy"]
     assert np.abs(e - e[0]).max() < 1e-5 * abs(e[0])
-    assert np.all(cols["tau_x"] == 0)
+    assert np.all(cols["tau[x]"] == 0)
+    # the recording layout: the run reads back as a recording
+    rec = rd.read_recording(tmp_path / "trolley_double_pendulum_simulation.csv")
+    assert np.array_equal(rec.q[:, 1], cols["q[theta1]"]) and np.array_equal(rec.tau[:, 0], cols["tau[x]"])
     out = capsys.readouterr().out
     drift = float(re.search(r"relative drift ([0-9.e+-]+)", out).group(1))
     assert drift < 1e-5
@@ -49,7 +52,7 @@ def test_simulate_computed_torque_reaches_the_target(tmp_path, capsys):
                ",".join(map(str, target)), "--duration", "2", "--move-time", "1", "-o", str(tmp_path)])
     assert rc == 0
     cols = _columns(tmp_path / "puma560_simulation.csv")
-    final = np.array([cols[f"q_q{j}"][-1] for j in range(1, 7)])
+    final = np.array([cols[f"q[q{j}]"][-1] for j in range(1, 7)])
     # the law holds tau over each 1 ms step and the PUMA has Coulomb friction: mrad, not exact
     np.testing.assert_allclose(final, target, atol=5e-3)
     assert "max |q - q_ref|" in capsys.readouterr().out

@@ -14,7 +14,7 @@ def test_excite_writes_a_rest_to_rest_trajectory(tmp_path, capsys):
     assert "condition number" in text and f"wrote {out}" in text
     table = pd.read_csv(out)
     assert len(table) == 201  # one 2 s period at 10 ms, both ends
-    qd = table[[c for c in table.columns if c.startswith("qd_")]].to_numpy()
+    qd = table[[c for c in table.columns if c.startswith("qd[")]].to_numpy()
     assert qd.shape[1] == 2
     # the program starts and ends at rest
     assert np.allclose(qd[0], 0.0, atol=1e-9) and np.allclose(qd[-1], 0.0, atol=1e-9)
@@ -26,7 +26,7 @@ def test_testprog_jointwise_moves_one_joint_at_a_time(tmp_path, capsys):
     assert "moves" in capsys.readouterr().out
     traj = pd.read_csv(tmp_path / "prog" / "jointwise.csv")
     assert (tmp_path / "prog" / "jointwise_segments.csv").is_file()
-    qd = traj[[c for c in traj.columns if c.startswith("qd_")]].to_numpy()
+    qd = traj[[c for c in traj.columns if c.startswith("qd[")]].to_numpy()
     # never two joints moving at once
     assert np.all((np.abs(qd) > 1e-9).sum(axis=1) <= 1)
     assert np.any(np.abs(qd[:, 0]) > 0) and np.any(np.abs(qd[:, 1]) > 0)

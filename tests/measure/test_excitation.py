@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from robodyn.measure.csv_io import read_csv
 from robodyn.studies.excitation import (
     ExcitationLimits,
     FourierTrajectory,
@@ -106,11 +107,14 @@ def test_csv_round_trip(tmp_path, planar):
                     dt=0.01)
     path = ex.to_csv(tmp_path / "traj.csv")
     df = pd.read_csv(path)
-    assert list(df.columns) == ["t", "q_q1", "q_q2", "qd_q1", "qd_q2", "qdd_q1", "qdd_q2"]
+    assert list(df.columns) == ["t", "q[q1]", "q[q2]", "qd[q1]", "qd[q2]", "qdd[q1]", "qdd[q2]"]
     assert len(df) == ex.t.size == 401
     assert np.array_equal(df["t"].to_numpy(), ex.t)
-    assert np.array_equal(df[["q_q1", "q_q2"]].to_numpy(), ex.q)
-    assert np.array_equal(df[["qdd_q1", "qdd_q2"]].to_numpy(), ex.qdd)
+    assert np.array_equal(df[["q[q1]", "q[q2]"]].to_numpy(), ex.q)
+    assert np.array_equal(df[["qdd[q1]", "qdd[q2]"]].to_numpy(), ex.qdd)
+    # the recording layout: it reads back as a recording with the same numbers
+    rec = read_csv(path)
+    assert rec.joint_names == ("q1", "q2") and np.array_equal(rec.qd, ex.qd)
 
 
 def test_joint_trajectory_matches_series(planar):

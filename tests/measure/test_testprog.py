@@ -59,7 +59,7 @@ def test_program_csv(tmp_path, puma):
     prog = jointwise(puma, joints=["q2"], speeds=(1.0,), dt=0.01)
     traj_path, seg_path = prog.to_csv(tmp_path / "out")
     df = pd.read_csv(traj_path)
-    assert np.array_equal(df["q_q2"].to_numpy(), prog.q[:, 1])
+    assert np.array_equal(df["q[q2]"].to_numpy(), prog.q[:, 1])
     assert np.array_equal(df["t"].to_numpy(), prog.t)
     segs = pd.read_csv(seg_path)
     assert list(segs["kind"]) == [s.kind for s in prog.segments]

@@ -17,6 +17,8 @@ import numpy as np
 
 import robodyn as rd
 from robodyn.cli.args import ROBOT_HELP, floats
+from robodyn.measure.csv_io import write_csv
+from robodyn.measure.recording import Recording
 from robodyn.output_names import check_stem, output_path
 from robodyn.robot.errors import InputError
 from robodyn.text import err, progress, table
@@ -129,13 +131,15 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             # the controller's or the integrator's message, as one line and exit 2
             raise InputError(str(exc)) from None
     names = robot.joint_names
-    with csv_path.open("w", newline="", encoding="utf-8") as fh:
+    # the run in the recording layout (reads back with robodyn record / rd.read_recording), the
+    # energy beside it
+    write_csv(Recording(t=sim.t, q=sim.q, qd=sim.qd, qdd=sim.qdd, tau=sim.tau, joint_names=names,
+                        source=csv_path.name), csv_path)
+    energy_path = output_path(out, robot.name, "_energy.csv", what="robot name")
+    with energy_path.open("w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
-        w.writerow(["t", *(f"q_{j}" for j in names), *(f"qd_{j}" for j in names),
-                    *(f"qdd_{j}" for j in names), *(f"tau_{j}" for j in names), "energy"])
-        for k in range(len(sim.t)):
-            w.writerow([repr(float(v)) for v in (sim.t[k], *sim.q[k], *sim.qd[k], *sim.qdd[k],
-                                                 *sim.tau[k], sim.energy[k])])
+        w.writerow(["t", "energy"])
+        w.writerows([repr(float(t)), repr(float(e))] for t, e in zip(sim.t, sim.energy, strict=True))
     with progress("plotting"):
         fig = trajectory_figure(sim, names, output_path(out, robot.name, "_simulation.png"), plan)
     rows = [[j, f"{sim.q[-1, k]:.6g}", f"{np.abs(sim.qd[:, k]).max():.4g}",
@@ -150,7 +154,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     print(f"{len(sim.t) - 1} steps, {sim.evaluations} right-hand-side evaluations; energy "
           f"{sim.energy[0]:.6g} J -> {sim.energy[-1]:.6g} J"
           + (f" (relative drift {sim.energy_drift:.3g})" if controller is None else ""))
-    print(f"wrote {csv_path} and {fig}")
+    print(f"wrote {csv_path}, {energy_path} and {fig}")
     return 0
 
 

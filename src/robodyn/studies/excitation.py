@@ -45,7 +45,6 @@ limit.
 
 from __future__ import annotations
 
-import csv
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -58,6 +57,8 @@ from scipy.interpolate import BPoly, PPoly
 from scipy.optimize import minimize
 
 from robodyn.identification.stacking import identification_matrix as stacked_matrix
+from robodyn.measure.csv_io import write_csv
+from robodyn.measure.recording import Recording
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
@@ -252,17 +253,13 @@ class Excitation:
 
 def write_trajectory_csv(path: str | Path, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
                          qdd: np.ndarray, joint_names: Sequence[str]) -> Path:
-    """Write a sampled joint trajectory as CSV: header ``t, q_<name>..., qd_<name>...,
-    qdd_<name>...``; SI units (s, rad, rad/s, rad/s^2), 17 significant digits."""
-    out = Path(path)
-    header = (["t"] + [f"q_{j}" for j in joint_names] + [f"qd_{j}" for j in joint_names]
-              + [f"qdd_{j}" for j in joint_names])
-    data = np.column_stack([t, q, qd, qdd])
-    with out.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        w.writerows([[f"{v:.17g}" for v in row] for row in data])
-    return out
+    """Write a sampled joint trajectory (each array (N, n), ``t`` (N,)) in robodyn's recording
+    layout: ``t, q[NAME]..., qd[NAME]..., qdd[NAME]...``; SI units (s, rad, rad/s, rad/s^2), 17
+    significant digits. It reads back with :func:`robodyn.read_recording` (``robodyn record``) as the
+    same numbers (:func:`robodyn.measure.csv_io.write_csv`)."""
+    rec = Recording(t=np.asarray(t, float), q=np.asarray(q, float), qd=np.asarray(qd, float),
+                    qdd=np.asarray(qdd, float), joint_names=tuple(joint_names), source=str(path))
+    return write_csv(rec, path)
 
 
 # ----------------------------------------------------------------------------------------------
