@@ -246,7 +246,7 @@ class Excitation:
                                kind="fourier excitation", _pp=pp)
 
     def to_csv(self, path: str | Path) -> Path:
-        """Write ``t, q_<joint>..., qd_<joint>..., qdd_<joint>...`` (s, rad, rad/s, rad/s^2), one
+        """Write ``t, q[joint]..., qd[joint]..., qdd[joint]...`` (s, rad, rad/s, rad/s^2), one
         row per sample, for a controller to play. Returns the path."""
         return write_trajectory_csv(path, self.t, self.q, self.qd, self.qdd, self.joint_names)
 
