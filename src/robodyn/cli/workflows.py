@@ -17,8 +17,6 @@ import numpy as np
 
 import robodyn as rd
 from robodyn.cli.args import ROBOT_HELP, floats
-from robodyn.measure.csv_io import write_csv
-from robodyn.measure.recording import Recording
 from robodyn.output_names import check_stem, output_path
 from robodyn.robot.errors import InputError
 from robodyn.text import err, progress, table
@@ -104,6 +102,8 @@ def _check_size(args: argparse.Namespace, n: int) -> None:
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from robodyn.codegen.build import CompilerNotFoundError
+    from robodyn.measure.csv_io import write_csv
+    from robodyn.measure.recording import Recording
     from robodyn.studies.simulation_plots import trajectory_figure
 
     robot = rd.load(args.robot, tool=args.tool)
