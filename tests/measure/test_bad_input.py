@@ -117,6 +117,26 @@ def test_spec_value_errors(tmp_path):
             _read(tmp_path, GOOD, spec)
 
 
+def test_spec_numbers_outside_their_plausible_range_are_refused(tmp_path):
+    index = {"column": "time", "unit": "index"}
+    bad = [
+        (dict(SPEC, time=dict(index, period=1e300)), r"time.period: 1e\+300 is outside the plausible"),
+        (dict(SPEC, time=dict(index, period=1e-300)), r"time.period: 1e-300 is outside the plausible"),
+        (dict(SPEC, position={"columns": "pos{k}", "unit": "deg", "gear_ratio": 1e300}),
+         r"position.gear_ratio\[0\]: 1e\+300 is outside the plausible"),
+        (dict(SPEC, position={"columns": "pos{k}", "unit": "deg", "gear_ratio": [1.0, "1e-300"]}),
+         r"position.gear_ratio\[1\]: 1e-300 is outside the plausible"),
+        (dict(SPEC, position={"columns": "pos{k}", "unit": "deg", "offset": "one"}),
+         r"position.offset\[0\]: expected a finite number, got 'one'"),
+    ]
+    for spec, message in bad:
+        with pytest.raises(RecordingError, match=r"spec: " + message):
+            _read(tmp_path, GOOD, spec)
+    # "1e-3" is a number although YAML 1.1 reads it as text
+    rec = _read(tmp_path, GOOD, dict(SPEC, time=dict(index, period="1e-3")))
+    assert rec.dt == pytest.approx(1e-3)
+
+
 def test_not_own_layout_without_spec(tmp_path):
     with pytest.raises(RecordingError, match=r"run.csv: spec: the file is not in robodyn's own layout"):
         _read(tmp_path, GOOD, None)

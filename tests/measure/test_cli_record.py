@@ -1,5 +1,7 @@
 """``robodyn record info|plot|convert``."""
 
+import os
+
 import numpy as np
 
 import robodyn as rd
@@ -48,7 +50,9 @@ def test_convert_never_overwrites_its_input(tmp_path, capsys):
     assert main(["record", "convert", str(tmp_path / "run.mcap"), "-o", str(csv_path)]) == 0
     before = csv_path.read_bytes()
     capsys.readouterr()
-    for target in (csv_path, tmp_path / "." / "same.csv"):
+    hard = tmp_path / "hard.csv"
+    os.link(csv_path, hard)  # a hard link: another name of the same file
+    for target in (csv_path, tmp_path / "." / "same.csv", hard):
         assert main(["record", "convert", str(csv_path), "-o", str(target)]) == 2
         assert "-o is the file being converted" in capsys.readouterr().err
     assert csv_path.read_bytes() == before

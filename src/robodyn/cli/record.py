@@ -8,6 +8,7 @@ public API and print. Bad input raises :class:`~robodyn.robot.errors.RecordingEr
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 
 import numpy as np
@@ -92,9 +93,11 @@ def _cmd_convert(args: argparse.Namespace) -> int:
 
     out = Path(args.output)
     source = Path(args.file)
-    if out.exists() and source.exists() and out.resolve() == source.resolve():
-        raise InputError(f"{out}: -o is the file being converted; write to another file "
-                         "(the input is never overwritten)")
+    # the same file by any name: a symbolic or a hard link, another path to it
+    if out.exists() and source.exists() and (out.resolve() == source.resolve()
+                                             or os.path.samefile(out, source)):
+        raise InputError(f"{out}: -o is the file being converted (or a link to it); write to "
+                         "another file (the input is never overwritten)")
     rec = _read(args)
     if out.suffix.lower() not in (".mcap", ".csv", ".gz"):
         raise InputError(f"{out}: -o must end in .csv, .csv.gz or .mcap")

@@ -10,6 +10,7 @@ Built-in specs live in ``robodyn/measure/specs/*.yaml``.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
@@ -159,6 +160,28 @@ def _unit(value: Any, table: Mapping[str, Any], name: str, path: str) -> str:
     return str(value)
 
 
+#: A number written in exponent form without a dot (``1e-3``): YAML 1.1 reads it as text.
+_EXPONENT_NUMBER = re.compile(r"[-+]?[0-9]+[eE][-+]?[0-9]+")
+
+#: Magnitudes a spec's per-joint numbers may take: beyond them a value is a typo or a unit
+#: mistake, and it would turn every sample into nonsense (1e-300 rad per count, a 1e300 s period).
+SPANS = {"gear_ratio": (1e-6, 1e6), "counts_per_rev": (1.0, 1e12), "torque_constant": (1e-6, 1e6),
+         "gain": (1e-9, 1e9), "offset": (0.0, 1e6), "period": (1e-7, 3600.0)}
+
+
+def spec_number(v: Any, name: str, path: str, span: tuple[float, float] | None = None) -> float:
+    """A finite number of a spec (``1e-3`` accepted although YAML 1.1 reads it as text), with
+    its magnitude in ``span`` when given, else :class:`RecordingError` naming ``path``."""
+    if isinstance(v, str) and _EXPONENT_NUMBER.fullmatch(v.strip()):
+        v = float(v)
+    if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+        raise RecordingError(f"{name}: {path}: expected a finite number, got {v!r}")
+    if span is not None and not (span[0] <= abs(v) <= span[1] or v == 0.0 and span[0] == 0.0):
+        raise RecordingError(f"{name}: {path}: {v!r} is outside the plausible range "
+                             f"{span[0]:g} .. {span[1]:g} in magnitude (a typo or a unit mistake?)")
+    return float(v)
+
+
 def _per_joint(value: Any, n: int, name: str, path: str, default: float,
                positive: bool = False, nonzero: bool = False) -> np.ndarray:
     if value is None:
@@ -168,13 +191,14 @@ def _per_joint(value: Any, n: int, name: str, path: str, default: float,
         raise RecordingError(f"{name}: {path}: expected one number or a list of {n} (one per joint), "
                              f"got {len(items)}")
     out = np.empty(n)
+    span = SPANS.get(path.rsplit(".", 1)[-1])
     for k, v in enumerate(items):
-        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-            raise RecordingError(f"{name}: {path}[{k}]: expected a finite number, got {v!r}")
+        v = spec_number(v, name, f"{path}[{k}]")
         if positive and v <= 0 or nonzero and v == 0:
             raise RecordingError(f"{name}: {path}[{k}]: must be {'positive' if positive else 'non-zero'}, "
                                  f"got {v!r}")
-        out[k] = float(v)
+        spec_number(v, name, f"{path}[{k}]", span)
+        out[k] = v
     return out
 
 
@@ -286,8 +310,11 @@ def _parse(data: dict[str, Any], name: str) -> RecordingSpec:
     tunit = _unit(time.get("unit"), TIME_UNITS, name, "time.unit")
     period = time.get("period")
     if tunit == "index":
-        ok = period == "estimate" or (isinstance(period, int | float) and not isinstance(period, bool)
-                                      and math.isfinite(period) and period > 0)
+        if period != "estimate" and period is not None:
+            period = spec_number(period, name, "time.period")
+        ok = period == "estimate" or (isinstance(period, float) and period > 0)
+        if ok and period != "estimate":
+            spec_number(period, name, "time.period", SPANS["period"])
         if not ok:
             raise RecordingError(f"{name}: time.period: with unit 'index' give the sample period in s "
                                  f"or 'estimate', got {period!r}")
