@@ -226,3 +226,21 @@ def test_time_unit_contradicted_by_positions_and_velocities(tmp_path):
     ok = rd.read_recording(path, spec={**spec, "time": {"column": "idx", "unit": "index",
                                                          "period": "estimate"}})
     assert ok.dt == pytest.approx(1e-3, rel=1e-3)
+
+
+def test_one_corrupt_cell_of_any_field_or_stamp_is_named():
+    t = 1e-3 * np.arange(100)
+    q = np.sin(np.outer(t, [1.0, 2.0]))
+    for field, value, what in (("qd", 1e300, "joint velocity"), ("tau", -1e300, "joint torque"),
+                               ("current", 1e7, "motor current")):
+        arr = np.ones_like(q)
+        arr[40, 1] = value
+        with pytest.raises(RecordingError, match=rf"run.csv: {field}: .* at row 40, column 1 \('b'\) "
+                                                 rf"is not a plausible {what}"):
+            rd.Recording(t=t, q=q, joint_names=("a", "b"), source="run.csv", **{field: arr})
+    # a last stamp far off: the filter's uniform grid would need 10^10 samples
+    far = t.copy()
+    far[-1] = 1e7
+    with pytest.raises(RecordingError, match=r"run.csv: t: a step of 1e\+07 s after row 98 .* split the "
+                                             r"recording at the gap"):
+        rd.Recording(t=far, q=q, joint_names=("a", "b"), source="run.csv")

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from robodyn.measure.recording import PLAUSIBLE
 from robodyn.robot.errors import InputError
 
 __all__ = ["counts_to_angle", "current_to_torque", "estimate_period", "unwrap_counter",
@@ -116,7 +117,9 @@ def estimate_period(q: np.ndarray, qd: np.ndarray) -> float:
     with np.errstate(over="ignore", invalid="ignore"):
         dq = np.diff(q, axis=0).ravel()
         vbar = (0.5 * (qd[1:] + qd[:-1])).ravel()  # trapezoidal rule: dq = T (v_k + v_k+1) / 2
-    ok = np.isfinite(dq) & np.isfinite(vbar)
+    # implausible cells (checked and named when the recording is built) set nothing here
+    ok = (np.isfinite(dq) & np.isfinite(vbar) & (np.abs(vbar) <= PLAUSIBLE["qd"][0])
+          & (np.abs(dq) <= PLAUSIBLE["q"][0]))
     dq, vbar = dq[ok], vbar[ok]
     if not np.any(vbar != 0.0):
         raise InputError("cannot estimate the sample period: the measured velocity is zero throughout")

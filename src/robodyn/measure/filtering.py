@@ -101,11 +101,25 @@ def bandwidth_cutoff(t: np.ndarray, x: np.ndarray, snr: float = 100.0) -> float:
     return float(np.clip(best, lo, hi))
 
 
+#: At most this many times the recorded samples on the uniform grid of the filter (gaps are
+#: interpolated; a longer grid means a gap far longer than the run, or a corrupt stamp).
+UNIFORM_GROWTH = 10.0
+
+
 def _uniform(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
     """``(t_u, x_u, resampled)``: x on a uniform grid at the median period (cubic)."""
     if is_uniform(t):
         return t, x, False
-    dt = float(np.median(np.diff(t)))
+    steps = np.diff(t)
+    dt = float(np.median(steps))
+    count = (t[-1] - t[0]) / dt + 1.0
+    if count > UNIFORM_GROWTH * t.size + 1000:
+        # a gap (or a corrupt stamp) that a uniform grid would fill with interpolated samples
+        k = int(np.argmax(steps))
+        raise RecordingError(f"t: a step of {steps[k]:.6g} s after row {k} (median period {dt:.6g} s) "
+                             f"would need {count:.3g} samples on the uniform grid that filtering "
+                             f"uses, for {t.size} samples recorded; check that time stamp, or split "
+                             "the recording at the gap (Recording.slice)")
     tu = t[0] + dt * np.arange(int(np.floor((t[-1] - t[0]) / dt + 1e-9)) + 1)
     return tu, make_interp_spline(t, x, k=3, axis=0)(tu), True
 

@@ -41,6 +41,16 @@ def _readonly(a: np.ndarray) -> np.ndarray:
 #: Largest joint position a recording may hold, rad or m (10^6 rad is 160,000 turns).
 MAX_POSITION = 1e6
 
+#: Per field: the largest magnitude a recording may hold and what the field is. Far beyond any
+#: arm (10^5 rad/s is a million rpm at the joint; 10^8 N m, 10^6 A): one corrupt cell would
+#: otherwise set every scale of the run (a filter's overflow, a duration of 1e304 s).
+PLAUSIBLE = {"q": (MAX_POSITION, "joint position (rad or m)"),
+             "qd": (1e5, "joint velocity (rad/s or m/s)"),
+             "qdd": (1e9, "joint acceleration (rad/s^2 or m/s^2)"),
+             "tau": (1e8, "joint torque (N m or N)"),
+             "current": (1e6, "motor current (A)"),
+             "temperature": (1e4, "temperature (deg C)")}
+
 
 @dataclass(frozen=True, eq=False)
 class Recording:
@@ -134,8 +144,8 @@ class Recording:
                 raise RecordingError(f"{self._where(name)}: expected shape ({t.size}, {n}) like q, "
                                      f"got {a.shape}")
             self._finite(name, a, names, allow_nan_columns=name in _MAY_LACK_COLUMNS)
-            if name == "q":
-                self._plausible(name, a, names, MAX_POSITION, "joint position (rad or m)")
+            if name in PLAUSIBLE:
+                self._plausible(name, a, names, *PLAUSIBLE[name])
             set_(self, name, _readonly(a))
         self._tool()
         units = dict(DEFAULT_UNITS)
@@ -205,7 +215,10 @@ class Recording:
                 raise RecordingError(f"{self._where('qd')}: cannot estimate velocities from "
                                      f"{self.n_samples} samples (at least 8 are needed)")
             with np.errstate(over="ignore", invalid="ignore"):
-                _, qd, qdd = differentiate(self.t, self.q)
+                try:
+                    _, qd, qdd = differentiate(self.t, self.q)
+                except RecordingError as exc:  # the filter's own message, with the file
+                    raise RecordingError(f"{self.source or 'Recording'}: {exc}") from None
             if not (np.all(np.isfinite(qd)) and np.all(np.isfinite(qdd))):
                 raise RecordingError(f"{self._where('q')}: positions too large to differentiate "
                                      f"(largest magnitude {np.max(np.abs(self.q)):.3g}); check "
