@@ -38,3 +38,10 @@ def test_bad_arguments_exit_2_with_one_line(tmp_path, capsys):
     assert err.startswith("robodyn: error:") and "harmonics" in err and "\n" not in err
     assert main(["testprog", "no_such_robot", "--kind", "jointwise", "-o", str(tmp_path)]) == 2
     assert "no_such_robot" in capsys.readouterr().err
+    # sizes and rates that would ask for terabytes or an aliased trajectory: one line, exit 2
+    for argv, why in ((["excite", "planar_2r", "--frequency", "1e-9", "--dt", "1000"], "base_frequency"),
+                      (["excite", "planar_2r", "--frequency", "1", "--dt", "0.1"], "fewer than 4 times"),
+                      (["testprog", "planar_2r", "--kind", "jointwise", "--dt", "1e-12"], "more than")):
+        assert main([*argv, "-o", str(tmp_path / "x.csv")]) == 2
+        err = capsys.readouterr().err.strip()
+        assert why in err and "\n" not in err, err

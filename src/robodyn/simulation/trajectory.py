@@ -17,6 +17,7 @@ from scipy.spatial.transform import Rotation
 
 from robodyn.numeric.model import Model
 from robodyn.robot.errors import InputError
+from robodyn.robot.sizes import time_grid_steps
 from robodyn.simulation.ik import UnreachableError, inverse_kinematics
 
 
@@ -346,6 +347,7 @@ def _from_ppoly(pp: PPoly, duration: float, dt: float, kind: str) -> JointTrajec
 
 def _steps(duration: float, dt: float) -> int:
     dt = _positive(dt, "dt")
+    time_grid_steps(duration, dt, "trajectory")  # the sample count bounded before allocating
     return int(np.ceil(duration / dt - 1e-9))
 
 

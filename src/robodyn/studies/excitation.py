@@ -274,6 +274,10 @@ def _starts(starts: int, progress: bool) -> Any:
     return tqdm(range(starts), desc="optimising the excitation", unit="start", leave=False)
 
 
+#: Accepted base frequencies of an excitation, Hz: a period of 0.01 s to 10^4 s (2.8 h).
+BASE_FREQUENCY = (1e-4, 100.0)
+
+
 def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float = 0.1,
                duration: float | None = None, limits: ExcitationLimits | None = None, *,
                criterion: Criterion = "cond", starts: int = 6, seed: int = 0, dt: float = 1e-3,
@@ -291,7 +295,8 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
         Harmonics L per joint (>= 3: the rest-to-rest constraints use three of the 2 L + 1
         numbers per joint).
     base_frequency : float
-        ``f``, Hz; the period is ``1 / f`` and the highest frequency ``L f``.
+        ``f``, Hz, in :data:`BASE_FREQUENCY`; the period is ``1 / f`` and the highest frequency
+        ``L f`` (sampled at least 4 times per period by ``dt``).
     duration : float, optional
         Length of the returned trajectory, s: a whole number of periods (default one period).
     limits : ExcitationLimits, optional
@@ -333,9 +338,15 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
     if not isinstance(harmonics, int | np.integer) or harmonics < 3:
         raise InputError(f"excitation: harmonics must be an integer >= 3, got {harmonics!r}")
     f = float(base_frequency)
-    if not np.isfinite(f) or f <= 0:
-        raise InputError(f"excitation: base_frequency must be a positive number of Hz, "
-                         f"got {base_frequency!r}")
+    if not np.isfinite(f) or not BASE_FREQUENCY[0] <= f <= BASE_FREQUENCY[1]:
+        raise InputError(f"excitation: base_frequency must be a number of Hz in "
+                         f"[{BASE_FREQUENCY[0]:g}, {BASE_FREQUENCY[1]:g}] (a period of 0.01 s to "
+                         f"{1 / BASE_FREQUENCY[0]:g} s), got {base_frequency!r}")
+    if isinstance(dt, int | float) and not isinstance(dt, bool) and np.isfinite(dt) and dt > 0 \
+            and harmonics * f * dt > 0.25:
+        raise InputError(f"excitation: dt {dt:g} s samples the highest harmonic ({harmonics} x "
+                         f"{f:g} Hz) fewer than 4 times per period; use dt <= "
+                         f"{0.25 / (harmonics * f):.3g} s")
     period = 1.0 / f
     total = period if duration is None else float(duration)
     periods = total / period
