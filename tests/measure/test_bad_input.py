@@ -208,6 +208,12 @@ def test_gzip_bomb_and_long_files_refused_while_reading(tmp_path, monkeypatch, c
     with pytest.raises(RecordingError, match=r"long.csv: 300001 lines, more than the 1000 read "
                                              r"\(set ROBODYN_MAX_ROWS"):
         rd.read_recording(plain)
+    # short cells under the size limit: refused by their count (5 x 10^7 by default), before parsing
+    monkeypatch.setenv("ROBODYN_MAX_ROWS", "1000000")
+    monkeypatch.setenv("ROBODYN_MAX_CELLS", "100000")
+    with pytest.raises(RecordingError, match=r"long.csv: 300001 lines of 2 fields, more than the "
+                                             r"100000 cells read \(set ROBODYN_MAX_CELLS"):
+        rd.read_recording(plain)
 
 
 def test_time_unit_contradicted_by_positions_and_velocities(tmp_path):

@@ -75,6 +75,17 @@ def max_rows() -> int:
     return env_limit("ROBODYN_MAX_ROWS", MAX_ROWS)
 
 
+#: Most cells (lines x fields) a recording file may hold (``$ROBODYN_MAX_CELLS`` raises it):
+#: 5 x 10^7 numbers are 400 MB once parsed; a text of short cells ("0,0,0,...") under the size
+#: limit would otherwise parse to several gigabytes.
+MAX_CELLS = 50_000_000
+
+
+def max_cells() -> int:
+    """The cell limit: ``$ROBODYN_MAX_CELLS`` when set to a positive integer, else the default."""
+    return env_limit("ROBODYN_MAX_CELLS", MAX_CELLS)
+
+
 def read_text_bytes(path: Path, error: type[Exception]) -> bytes:
     """The bytes of a text file, gunzipped when its name ends in ``.gz``, refused (``error``)
     beyond :func:`max_file_bytes`: a gzip bomb of 0.8 MB expanding to gigabytes is stopped
@@ -96,7 +107,7 @@ def read_text_bytes(path: Path, error: type[Exception]) -> bytes:
                                 "decompressed (set ROBODYN_MAX_FILE_MB to read it)")
     except (OSError, EOFError) as exc:
         raise error(f"{name}: not a readable gzip file ({exc})") from None
-    return bytes(out)
+    return out  # type: ignore[return-value]  # a bytearray decodes like bytes, without a copy
 
 
 #: The ``delimiter`` of a recording spec for fields separated by runs of spaces or tabs.
@@ -110,14 +121,23 @@ class _Table:
     def __init__(self, path: Path, delimiter: str | None, header: bool, comment: str | None):
         self.name = path.name
         raw = read_text_bytes(path, RecordingError)
+        # lines and cells counted on the bytes, before a decoded copy exists
+        rows, limit = raw.count(b"\n"), max_rows()
+        if rows > limit:
+            raise RecordingError(f"{self.name}: {rows} lines, more than the {limit} read (set "
+                                 "ROBODYN_MAX_ROWS to read it)")
+        end = raw.find(b"\n")
+        first = bytes(raw[:end if end >= 0 else len(raw)])
+        sep = [b",", b"\t", b";"] + ([delimiter.encode()] if delimiter not in (None, WHITESPACE) else [])
+        fields = max([len(first.split())] + [first.count(d) + 1 for d in sep])
+        if rows * fields > max_cells():
+            raise RecordingError(f"{self.name}: {rows} lines of {fields} fields, more than the "
+                                 f"{max_cells():g} cells read (set ROBODYN_MAX_CELLS to read it)")
         try:
             text = raw.decode("utf-8-sig")
         except UnicodeDecodeError as exc:
             raise RecordingError(f"{self.name}: not UTF-8 text (byte {exc.start})") from None
-        rows, limit = text.count("\n"), max_rows()
-        if rows > limit:
-            raise RecordingError(f"{self.name}: {rows} lines, more than the {limit} read (set "
-                                 "ROBODYN_MAX_ROWS to read it)")
+        del raw
         lines = text.splitlines()
         keep = [k for k, line in enumerate(lines)
                 if line.strip() and not (comment and line.lstrip().startswith(comment))]
