@@ -49,16 +49,18 @@ def _no_compiler():
     raise build.CompilerNotFoundError("no C compiler found (tried $CC, cc, gcc, clang)")
 
 
-def test_without_a_compiler_simulate_names_the_numpy_backend(tmp_path, capsys, monkeypatch):
+def test_without_a_compiler_simulate_falls_back_to_numpy_or_names_it(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(build, "find_compiler", _no_compiler)
     # an empty cache: a library built before would load without a compiler (the cache index)
     monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path / "cache"))
-    code = main(["simulate", "planar_2r", "--duration", "0.1", "-o", str(tmp_path)])
+    # the default (auto): the NumPy backend, with a note
+    assert main(["simulate", "planar_2r", "--duration", "0.1", "-o", str(tmp_path)]) == 0
+    err = capsys.readouterr().err
+    assert "robodyn: note: no C compiler found" in err and "using the NumPy backend" in err
+    # C asked for explicitly: one line naming the NumPy backend, exit 2
+    code = main(["simulate", "planar_2r", "--duration", "0.1", "--backend", "c", "-o", str(tmp_path)])
     (line,) = _error_lines(capsys.readouterr().err)
     assert code == 2 and "--backend numpy" in line
-    # and that backend needs none
-    assert main(["simulate", "planar_2r", "--duration", "0.1", "--backend", "numpy",
-                 "-o", str(tmp_path)]) == 0
 
 
 def test_without_a_compiler_the_demo_falls_back_to_numpy_with_a_note(capsys, monkeypatch):

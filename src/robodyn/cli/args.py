@@ -10,7 +10,9 @@ import argparse
 
 import numpy as np
 
-__all__ = ["ROBOT_HELP", "floats"]
+from robodyn.text import err
+
+__all__ = ["BACKENDS", "BACKEND_HELP", "ROBOT_HELP", "floats", "resolve_backend"]
 
 #: Help of every command's ROBOT argument.
 ROBOT_HELP = "built-in robot name (see 'robodyn list') or path to a .yaml/.yml/.urdf description"
@@ -22,3 +24,25 @@ def floats(text: str) -> np.ndarray:
         return np.array([float(v) for v in text.replace(" ", "").split(",") if v], dtype=float)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
+
+
+#: ``--backend`` choices of the commands that compile a model; "auto": C when a compiler is found.
+BACKENDS = ("auto", "c", "numpy")
+BACKEND_HELP = ("compiled C (needs a C compiler), pure NumPy (no compiler; same results, slower), "
+                "or auto: C when a compiler is found, else NumPy with a note (default: %(default)s)")
+
+
+def resolve_backend(choice: str) -> str:
+    """``"c"`` or ``"numpy"`` for a ``--backend`` choice: "auto" is C when a C compiler is found,
+    else NumPy, said in a note on stderr."""
+    if choice != "auto":
+        return choice
+    from robodyn.codegen.build import CompilerNotFoundError, find_compiler
+
+    try:
+        find_compiler()
+    except CompilerNotFoundError as exc:
+        err(f"robodyn: note: {' '.join(str(exc).split())}; using the NumPy backend (same results, "
+            "slower)")
+        return "numpy"
+    return "c"

@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 
 import robodyn as rd
+from robodyn.cli.args import BACKEND_HELP, BACKENDS, resolve_backend
 from robodyn.studies.underwater_effects import (
     DEFAULT_CD_VALUES,
     DEFAULT_CURRENT,
@@ -47,6 +48,7 @@ def _cmd_underwater(args: argparse.Namespace) -> int:
     from robodyn.studies.underwater_sensitivity import sensitivity
 
     robot = rd.load(args.robot)
+    args.backend = resolve_backend(args.backend)
     params = dict(args.set or [])
     series = effect_series(
         robot, start=args.start, end=args.end, move_time=args.move_time,
@@ -121,6 +123,5 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                         "direction (default: %(default)s)")
     p.add_argument("--series-only", action="store_true",
                    help="only the effect series (no sensitivity sweep, no model-error study)")
-    p.add_argument("--backend", choices=("c", "numpy"), default="c",
-                   help="compiled C or the NumPy fallback (default: %(default)s)")
+    p.add_argument("--backend", choices=BACKENDS, default="auto", help=BACKEND_HELP)
     p.set_defaults(func=_cmd_underwater)

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 import robodyn as rd
-from robodyn.cli.args import ROBOT_HELP, floats
+from robodyn.cli.args import BACKEND_HELP, BACKENDS, ROBOT_HELP, floats, resolve_backend
 from robodyn.output_names import check_stem, output_path
 from robodyn.robot.errors import InputError
 from robodyn.text import err, progress, table
@@ -114,6 +114,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     _check_size(args, n)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
+    args.backend = resolve_backend(args.backend)
     with progress(f"compiling {robot.name} ({args.backend} backend)"):
         try:
             model = rd.compile_model(robot, backend=args.backend)
@@ -416,9 +417,7 @@ def _simulate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
                         "digital controller at 1/dt), or at every RK4 stage (continuous-time) "
                         "(default: %(default)s)")
     p.add_argument("--tau-limit", type=floats, metavar="T", help="actuator limits, N m or N")
-    p.add_argument("--backend", choices=("c", "numpy"), default="c",
-                   help="compiled C (needs a C compiler) or pure NumPy (no compiler; slower) "
-                        "(default: %(default)s)")
+    p.add_argument("--backend", choices=BACKENDS, default="auto", help=BACKEND_HELP)
     p.add_argument("--substeps", type=int, default=1, metavar="K",
                    help="sampled control: hold the law over K integration steps of dt/K (for a "
                         "plant stiffer than the control rate) (default: %(default)s)")
