@@ -60,3 +60,18 @@ def test_gravity_scale_is_one_for_the_same_model_and_nan_without_gravity_load():
     # joint 1 turns about the vertical: no gravity load to scale
     assert np.isnan(scale[0])
     np.testing.assert_allclose(scale[1:3], 1.0, rtol=1e-12)
+
+
+def test_figures_of_a_joint_without_a_sensor_raise_no_warning(tmp_path):
+    from robodyn.validation.figures import validation_figures
+    from tests.validation.helpers import puma_run, recording
+
+    robot, model, sim = puma_run(duration=0.5)
+    tau = sim.tau.copy()
+    tau[:, 0] = np.nan  # joint 1 has no torque sensor
+    rec = recording(t=sim.t, q=sim.q, qd=sim.qd, tau=tau, joint_names=robot.joint_names)
+    val = rd.validate(robot, rec, "tau", model=model)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # before: "All-NaN slice encountered" from the histogram
+        paths = validation_figures(val, tmp_path, "run")
+    assert paths and all(Path(p).stat().st_size > 1000 for p in paths.values())

@@ -92,13 +92,19 @@ def error_histogram_figure(val: Validation, path: Path) -> Path:
     for k, ax in enumerate(axes):
         e = val.predicted[:, k] - val.measured[:, k]
         noise = val.measured[:, k] - val.filtered[:, k]
-        lim = max(np.abs(e).max(), np.abs(noise).max(), 1e-12)
+        if not np.isfinite(e).any():  # a joint without a sensor: nothing to show
+            ax.text(0.5, 0.5, "no measurement", ha="center", va="center", transform=ax.transAxes)
+            ax.set_xlabel(f"{val.joint_names[k]} / {val.unit}", fontsize=8)
+            continue
+        lim = max(np.nanmax(np.abs(e)), np.nanmax(np.abs(noise)), 1e-12)
         bins = np.linspace(-lim, lim, 60)
         ax.hist(e, bins=bins, alpha=0.7, color="C3", label="prediction error")
         ax.hist(noise, bins=bins, histtype="step", color="k", lw=1.0, label="noise (raw - filtered)")
         ax.set_xlabel(f"{val.joint_names[k]} / {val.unit}", fontsize=8)
         ax.tick_params(labelsize=7)
-    axes[0].legend(fontsize=7)
+    shown = [ax for ax in axes if ax.get_legend_handles_labels()[0]]
+    if shown:
+        shown[0].legend(fontsize=7)
     fig.suptitle(_noise_title(val), fontsize=9)
     return _save(fig, path)
 
