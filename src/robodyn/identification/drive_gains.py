@@ -29,12 +29,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robodyn.identification.estimate import thin_svd
+from robodyn.identification.estimate import RANK_RTOL, truncated_lstsq
 from robodyn.robot.errors import IdentificationError
 
 __all__ = ["DriveGains", "GN_ITERATIONS", "RANK_RTOL", "estimate_drive_gains"]
 
-RANK_RTOL = 1e-9
 GN_ITERATIONS = 30
 
 
@@ -67,9 +66,7 @@ def _lstsq(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     """Truncated-SVD least squares on unit-norm columns: ``x``, scale, singular values, ``V^T``."""
     scale = np.linalg.norm(a, axis=0)
     scale = np.where(scale > 0, scale, 1.0)
-    u, s, vt = thin_svd(a / scale)
-    keep = s > RANK_RTOL * s[0]
-    z = vt[keep].T @ ((u[:, keep].T @ b) / s[keep])
+    z, s, vt, _ = truncated_lstsq(a / scale, b)
     return z / scale, scale, s, vt
 
 

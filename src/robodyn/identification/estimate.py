@@ -30,7 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["FOLDS", "LAMBDA_GRID", "RANK_RTOL", "LinearFit", "candidate_cv_errors", "fit_linear"]
+__all__ = ["FOLDS", "LAMBDA_GRID", "RANK_RTOL", "LinearFit", "candidate_cv_errors", "fit_linear",
+           "thin_svd", "truncated_lstsq"]
 
 RANK_RTOL = 1e-9
 #: Eigenvalues of a Gram matrix below this fraction of the largest are dropped (:func:`_gram_cv`).
@@ -86,6 +87,20 @@ def thin_svd(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     q, r = np.linalg.qr(a)
     u_r, s, vt = np.linalg.svd(r)
     return q @ u_r, s, vt
+
+
+def truncated_lstsq(a: np.ndarray, b: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Least squares on the excited directions of ``a`` (m, p), ``b`` (m,): ``x`` (p,), the
+    singular values ``s``, ``V^T`` and the kept mask (``s > RANK_RTOL s_max``).
+
+    ``x = V_k S_k^-1 U_k^T b``: directions below the rank tolerance are left at zero (the
+    ``lam = 0`` case of the Tikhonov solution with a zero prior).
+    """
+    u, s, vt = thin_svd(a)
+    keep = s > RANK_RTOL * (s[0] if s.size else 1.0)
+    # x = V S^-1 U^T b on the kept directions
+    return vt[keep].T @ ((u[:, keep].T @ b) / s[keep]), s, vt, keep
 
 
 def _solve(a: np.ndarray, b: np.ndarray, z0: np.ndarray, lams: np.ndarray

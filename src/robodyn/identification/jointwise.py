@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from robodyn.identification.estimate import truncated_lstsq
 from robodyn.identification.preprocess import Preprocess, preprocess, resolve_preprocess
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
@@ -146,10 +147,7 @@ def identify_joint(robot: Robot, recording: Any, joint: int | str | None = None,
     if a.shape[0] < 2 * int(used.sum()):
         raise IdentificationError(f"{src}: too few samples ({a.shape[0]}) for {int(used.sum())} "
                                   f"parameters of joint {name!r}")
-    u, sv, vt = np.linalg.svd(a[:, used], full_matrices=False)
-    keep = sv > 1e-9 * sv[0]
-    # x = V S^-1 U^T y on the excited directions
-    x_used = vt[keep].T @ ((u[:, keep].T @ y) / sv[keep])
+    x_used, sv, vt, keep = truncated_lstsq(a[:, used], y)
     r = y - a[:, used] @ x_used
     sigma2 = float(r @ r) / max(a.shape[0] - int(keep.sum()), 1)
     cov = (vt[keep].T / sv[keep] ** 2) @ vt[keep] * sigma2

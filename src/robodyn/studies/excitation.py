@@ -278,6 +278,22 @@ def _starts(starts: int, progress: bool) -> Any:
 BASE_FREQUENCY = (1e-4, 100.0)
 
 
+def _checked_frequency(base_frequency: float, harmonics: int, dt: float) -> float:
+    """The base frequency, Hz, within :data:`BASE_FREQUENCY` and with its highest harmonic
+    sampled at least 4 times per period by ``dt`` (s), else :class:`InputError`."""
+    f = float(base_frequency)
+    if not np.isfinite(f) or not BASE_FREQUENCY[0] <= f <= BASE_FREQUENCY[1]:
+        raise InputError(f"excitation: base_frequency must be a number of Hz in "
+                         f"[{BASE_FREQUENCY[0]:g}, {BASE_FREQUENCY[1]:g}] (a period of 0.01 s to "
+                         f"{1 / BASE_FREQUENCY[0]:g} s), got {base_frequency!r}")
+    if isinstance(dt, int | float) and not isinstance(dt, bool) and np.isfinite(dt) and dt > 0 \
+            and harmonics * f * dt > 0.25:
+        raise InputError(f"excitation: dt {dt:g} s samples the highest harmonic ({harmonics} x "
+                         f"{f:g} Hz) fewer than 4 times per period; use dt <= "
+                         f"{0.25 / (harmonics * f):.3g} s")
+    return f
+
+
 def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float = 0.1,
                duration: float | None = None, limits: ExcitationLimits | None = None, *,
                criterion: Criterion = "cond", starts: int = 6, seed: int = 0, dt: float = 1e-3,
@@ -337,16 +353,7 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
     n = model.dof
     if not isinstance(harmonics, int | np.integer) or harmonics < 3:
         raise InputError(f"excitation: harmonics must be an integer >= 3, got {harmonics!r}")
-    f = float(base_frequency)
-    if not np.isfinite(f) or not BASE_FREQUENCY[0] <= f <= BASE_FREQUENCY[1]:
-        raise InputError(f"excitation: base_frequency must be a number of Hz in "
-                         f"[{BASE_FREQUENCY[0]:g}, {BASE_FREQUENCY[1]:g}] (a period of 0.01 s to "
-                         f"{1 / BASE_FREQUENCY[0]:g} s), got {base_frequency!r}")
-    if isinstance(dt, int | float) and not isinstance(dt, bool) and np.isfinite(dt) and dt > 0 \
-            and harmonics * f * dt > 0.25:
-        raise InputError(f"excitation: dt {dt:g} s samples the highest harmonic ({harmonics} x "
-                         f"{f:g} Hz) fewer than 4 times per period; use dt <= "
-                         f"{0.25 / (harmonics * f):.3g} s")
+    f = _checked_frequency(base_frequency, harmonics, dt)
     period = 1.0 / f
     total = period if duration is None else float(duration)
     periods = total / period
