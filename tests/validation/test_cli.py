@@ -225,7 +225,14 @@ def test_validate_and_underwater_without_a_c_compiler(files, tmp_path, monkeypat
                  "-o", str(tmp_path / "val")]) == 0
     err = capsys.readouterr().err
     assert "no C compiler found" in err and "using the NumPy backend" in err
-    assert main(["underwater", "underwater_2r", "-o", str(tmp_path / "uw")]) == 2
+    # underwater's default --backend auto takes the NumPy backend with the same note ...
+    from robodyn.cli.args import resolve_backend
+
+    assert resolve_backend("auto") == "numpy"
+    err = capsys.readouterr().err
+    assert "no C compiler found" in err and "using the NumPy backend" in err
+    # ... and --backend c says in one line that there is none
+    assert main(["underwater", "underwater_2r", "--backend", "c", "-o", str(tmp_path / "uw")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1].startswith("robodyn: error: no C compiler found") and "--backend numpy" in err[-1]
 
