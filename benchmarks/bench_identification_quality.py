@@ -22,8 +22,9 @@ Data sets:
   1 kHz with gaps in the stamps, a held-out part of the period.
 
 Speed (``--only speed``): 10^5 samples x 7 joints (Gen3, 1 kHz, a simulated run with noise and
-a measured velocity) identified by the default ``rd.identify`` (WLS, velocity source and
-Tikhonov weight chosen by cross-validation) and by the textbook script, both on one core
+a measured velocity) identified by the default ``rd.identify`` (physically consistent, velocity
+source, cut-off, friction law and position ripple chosen by cross-validation) and by the
+textbook script, both on one core
 (BLAS and OpenMP limited to one thread before NumPy loads), each the best of 2.
 
 Run: ``python benchmarks/bench_identification_quality.py [--quick] [--only kuka,kinova,virtual,speed]``.
@@ -177,8 +178,10 @@ def _nominal(case: Case, model: rd.Model) -> Callable[[rd.Recording], np.ndarray
     return predict
 
 
-METHODS: Sequence[tuple[str, dict]] = (("robodyn default", {}), ("ols", {"method": "ols"}),
-                                       ("consistent", {"method": "consistent"}),
+METHODS: Sequence[tuple[str, dict]] = (("robodyn default", {}),
+                                       ("wls (default before)", {"method": "wls"}),
+                                       ("ols", {"method": "ols"}),
+                                       ("no ripple", {"ripple": False}),
                                        ("stribeck", {"friction": "stribeck"}),
                                        ("thermal", {"thermal": True}))
 

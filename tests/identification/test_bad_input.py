@@ -130,11 +130,12 @@ def test_options_object_checks_once_and_runs_like_the_keywords(arm):
     for bad, message in [({"method": "lasso"}, r"method: expected one of \('ols', 'wls', 'consistent'\)"),
                          ({"spikes": "clip"}, r"spikes: expected one of \('keep', 'drop'\)"),
                          ({"weights": "state-noise"}, r"state_noise: weights='state-noise' needs"),
-                         ({"thermal": 1}, r"thermal: expected False, True or 'auto', got 1")]:
+                         ({"thermal": 1}, r"thermal: expected False, True or 'auto', got 1"),
+                         ({"ripple": "yes"}, r"ripple: expected False, True or 'auto', got 'yes'")]:
         with pytest.raises(IdentificationError, match=message):
             rd.IdentifyOptions(**bad)
     with pytest.raises(IdentificationError, match=r"options: given together with the keyword\(s\) "
                                                   r"method, spikes"):
-        rd.identify(robot, rec, options=opts, method="consistent", spikes="drop", model=model)
+        rd.identify(robot, rec, options=opts, method="wls", spikes="drop", model=model)
     with pytest.raises(IdentificationError, match="options: expected IdentifyOptions, got dict"):
         rd.identify(robot, rec, options={"method": "ols"}, model=model)

@@ -132,7 +132,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                             friction=args.friction, velocity=args.velocity,
                             dead_band=args.dead_band, spikes=args.spikes, cutoff=args.cutoff,
                             regularization=args.regularization, decimate=args.decimate,
-                            sensor=args.sensor, **extra)
+                            sensor=args.sensor, ripple=args.ripple, **extra)
     paths = {"yaml": out / f"{stem}.yaml", "urdf": out / f"{stem}.urdf",
              "parameters": out / "parameters.csv"}
     paths["yaml"].write_text(dump_yaml(ident.robot), encoding="utf-8")
@@ -159,7 +159,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
             + ("" if pre.cutoff is None else f", zero-phase low-pass at {pre.cutoff:.3g} Hz")
             + (f", Coulomb dead band {pre.dead_band:g} rad/s" if pre.dead_band else ""))
     if pre.velocity == "position" and not pre.dead_band and ident.friction_fit is None \
-            and ident.thermal_fit is None and pre.cutoff is not None:
+            and ident.thermal_fit is None and ident.ripple_fit is None and pre.cutoff is not None:
         note += (f"; robodyn validate {paths['yaml']} --target {ident.target} --cutoff "
                  f"{pre.cutoff:.17g} reproduces these figures from the written description")
     for k, path in enumerate(_write_predictions(vals, out, note)):
@@ -358,12 +358,12 @@ def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
                "      --data run1.csv.gz run2.csv.gz --validate run3.csv.gz -o ident/\n"
                "  robodyn identify kinova_gen3 --spec kinova_gen3 --target current \\\n"
                "      --gains 9.13,9.13,9.13,9.13,5.852,5.852,5.852 --data run1.csv.gz -o ident/\n"
-               "  robodyn identify my_arm.yaml --data bag.mcap --method consistent -o ident/")
+               "  robodyn identify my_arm.yaml --data bag.mcap --method wls -o ident/")
     p.add_argument("robot", metavar="ROBOT", help=robot_help)
     p.add_argument("--data", required=True, nargs="+", metavar="FILE",
                    help="identification recordings (CSV, CSV.gz or MCAP)")
     p.add_argument("--validate", nargs="+", metavar="FILE", help="held-out recordings to validate on")
-    p.add_argument("--method", choices=("ols", "wls", "consistent"), default="wls",
+    p.add_argument("--method", choices=("ols", "wls", "consistent"), default="consistent",
                    help="estimator: ordinary or weighted least squares, or physically consistent "
                         "(pseudo-inertia LMIs) (default: %(default)s)")
     p.add_argument("--gains", type=floats, metavar="K",
@@ -405,6 +405,14 @@ def _auto_or(kind: type, *, none: bool = False) -> Any:
     return parse
 
 
+def _ripple(text: str) -> bool | str:
+    """``--ripple``: "auto", "on" (True) or "off" (False)."""
+    values = {"auto": "auto", "on": True, "off": False}
+    if text not in values:
+        raise argparse.ArgumentTypeError(f"expected auto, on or off, got {text!r}")
+    return values[text]
+
+
 def _preprocessing(p: argparse.ArgumentParser) -> None:
     """The identification's preprocessing options (rd.identify's keywords of the same names)."""
     p.add_argument("--velocity", choices=("auto", "position", "measured"), default="auto",
@@ -419,6 +427,10 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
                    help="one-sample glitches (a position or target sample far off the line "
                         "through its neighbours) in the identification recordings: keep them, or "
                         "drop those rows before the fit (default: %(default)s)")
+    p.add_argument("--ripple", type=_ripple, default="auto", metavar="{auto,on,off}",
+                   help="a torque once per revolution of each revolute joint (a sin q + b cos q), "
+                        "fitted on what the model leaves: on, off, or auto: kept when it predicts "
+                        "held-out time blocks better (default: %(default)s)")
     p.add_argument("--cutoff", type=_auto_or(float, none=True), default="auto", metavar="HZ",
                    help="zero-phase low-pass cut-off in Hz, none (the recording's own "
                         "velocities and accelerations), or auto: the motion's bandwidth within "

@@ -109,6 +109,11 @@ class Choices:
         else None.
     friction_scores : tuple of (str, float)
         Each law's relative held-out error of the friction residual (``friction="auto"``).
+    ripple : bool or None
+        Whether ``ripple="auto"`` kept the position ripple (:mod:`robodyn.identification.ripple`),
+        else None.
+    ripple_scores : tuple of (str, float)
+        Relative held-out error of the model's residual without and with the ripple.
     """
 
     velocity: str
@@ -121,6 +126,8 @@ class Choices:
     chosen: Candidate | None = None
     friction: str | None = None
     friction_scores: tuple[tuple[str, float], ...] = ()
+    ripple: bool | None = None
+    ripple_scores: tuple[tuple[str, float], ...] = ()
 
     def summary(self) -> str:
         """A few lines for the terminal and the report."""
@@ -132,6 +139,10 @@ class Choices:
             scores = ", ".join(f"{law} {score:.4f}" for law, score in self.friction_scores)
             lines.append(f"  friction law {self.friction} (held-out blocks of the friction "
                          f"residual: {scores})")
+        if self.ripple is not None:
+            scores = ", ".join(f"{k} {v:.4f}" for k, v in self.ripple_scores)
+            lines.append(f"  position ripple {'kept' if self.ripple else 'not kept'} (held-out "
+                         f"blocks of the model's residual: {scores})")
         if len(self.candidates) > 1:
             for c in self.candidates:
                 mark = "*" if self.chosen is not None and c.key == self.chosen.key else " "
@@ -182,7 +193,7 @@ def candidates(velocity: str, dead_band: float | str, thermal: bool | str, measu
     ``thermal="auto"``: without, and with when every recording has temperatures; ``cutoffs``:
     the cut-offs to try (the first is the plain one).
     """
-    vels = (["position", "measured"] if measured_available else ["position"]) \
+    vels = (["measured", "position"] if measured_available else ["position"]) \
         if velocity == "auto" else [velocity]
     bands = [0.0, float(default_band)] if dead_band == "auto" else [float(dead_band)]
     therms = ([False, True] if temperatures_available else [False]) if thermal == "auto" \

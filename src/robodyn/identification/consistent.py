@@ -96,7 +96,9 @@ def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray,
 
     n = robot.dof
     names = relations.standard_names
-    w = fit.weights[joint]
+    # the row weights relative to the largest: the program is the same (every term scales with
+    # w^2), but noise-free data give weights of 1e15 and Clarabel's absolute tolerances fail
+    w = fit.weights[joint] / max(float(np.max(fit.weights)), 1e-300)
     a = phi * w[:, None]
     b = y * w
     norms = np.linalg.norm(a, axis=0)

@@ -80,6 +80,11 @@ class IdentifyOptions:
         by default: on the real logs here the test also flags 0.5-3 % of ordinary samples, and
         dropping them changed the quality table's held-out errors by -0.4 % to +5.5 %
         (benchmarks/bench_identification_quality.py cases, one run).
+    ripple : bool or "auto"
+        A torque once per revolution of each revolute joint, ``a_j sin q_j + b_j cos q_j``,
+        fitted on what the identified model leaves of the target
+        (:mod:`robodyn.identification.ripple`); "auto": kept when it predicts held-out time
+        blocks of that residual better than none.
 
     Raises
     ------
@@ -87,7 +92,7 @@ class IdentifyOptions:
         On construction: a value outside its choices, naming the field.
     """
 
-    method: str = "wls"
+    method: str = "consistent"
     friction: str = "auto"
     regularization: float | str | None = "auto"
     cutoff: float | str | None = "auto"
@@ -101,6 +106,7 @@ class IdentifyOptions:
     thermal: bool | str = False
     sensor: str = "motor"
     spikes: str = "keep"
+    ripple: bool | str = "auto"
 
     def __post_init__(self) -> None:
         _choice("method", self.method, METHODS)
@@ -118,6 +124,8 @@ class IdentifyOptions:
                                       f"{self.dead_band!r}")
         _choice("gains", self.gains, ("auto", "description", "absorbed"))
         _choice("spikes", self.spikes, ("keep", "drop"))
+        if not any(self.ripple is v for v in (False, True)) and self.ripple != "auto":
+            raise IdentificationError(f"ripple: expected False, True or 'auto', got {self.ripple!r}")
 
 
 def _choice(name: str, value: Any, choices: tuple[str, ...]) -> None:

@@ -14,6 +14,7 @@ from robodyn.identification.choices import Choices
 from robodyn.identification.friction import FrictionFit, without_friction
 from robodyn.identification.options import IdentifyOptions
 from robodyn.identification.preprocess import Preprocess, prediction_rows, preprocess
+from robodyn.identification.ripple import RippleFit
 from robodyn.identification.thermal import ThermalFit, temperatures
 from robodyn.numeric.model import Model
 from robodyn.robot.model import Robot
@@ -136,6 +137,9 @@ class Identification:
         needs temperatures); ``robot`` carries the friction at the reference temperature.
     options : IdentifyOptions or None
         The choices the run was made with (:mod:`robodyn.identification.options`).
+    ripple_fit : RippleFit or None
+        The position ripple (:mod:`robodyn.identification.ripple`): :meth:`predict` adds its
+        torque; ``robot`` does not carry it.
     """
 
     robot: Robot
@@ -159,6 +163,7 @@ class Identification:
     choices: Choices | None = None
     thermal_fit: ThermalFit | None = None
     options: IdentifyOptions | None = None
+    ripple_fit: RippleFit | None = None
 
     @property
     def gains_identified(self) -> bool:
@@ -200,6 +205,8 @@ class Identification:
             load = y @ without_friction(self.standard)  # rigid body and rotor inertia
             tau = load + self.friction_fit.torque(s.qd, load)
         tau = tau + thermal  # (T - T_ref)(cv qd + cc sign qd)
+        if self.ripple_fit is not None:
+            tau = tau + self.ripple_fit.torque(s.q)  # a sin q + b cos q
         if payload is not None:
             from robodyn.identification.payload import payload_standard, payload_torque
 
