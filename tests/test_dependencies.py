@@ -72,8 +72,8 @@ def test_optional_modules_are_not_imported_at_module_level() -> None:
 
 
 def test_a_missing_extra_names_the_pip_command(monkeypatch) -> None:
-    monkeypatch.setitem(sys.modules, "cvxpy", None)  # import cvxpy now raises ImportError
-    with pytest.raises(MissingExtraError, match=r"pip install 'robodyn\[sdp\]'") as info:
-        require("cvxpy", "identify(method='consistent')")
+    monkeypatch.setitem(sys.modules, "mcap", None)  # import mcap now raises ImportError
+    with pytest.raises(MissingExtraError, match=r"pip install 'robodyn\[ros\]'") as info:
+        require("mcap", "rd.read_recording('run.mcap')")
     assert isinstance(info.value, RobodynError) and isinstance(info.value, ImportError)
-    assert "identify(method='consistent')" in str(info.value)
+    assert "rd.read_recording('run.mcap')" in str(info.value)

@@ -1,15 +1,15 @@
 """Optional features and the pip extras that install them.
 
 robodyn's core (descriptions, equations, code generation, compiled models, simulation,
-recordings from CSV, calibration, identification by least squares, reports) needs only the
+recordings from CSV, calibration, identification (its semidefinite programs on cvxpy and
+Clarabel included), reports) needs only the
 packages in ``pyproject.toml``'s ``dependencies``. These features need an extra::
 
     study   rd.sweep and robodyn sweep on Dask, Parquet tables   dask[distributed], cloudpickle,
                                                                   pyarrow
-    sdp     identify(method="consistent") (an SDP)                cvxpy, clarabel
     ros     ROS 2 bags (MCAP) in and out                           mcap, mcap-ros2-support
 
-``pip install "robodyn[study,sdp,ros]"`` installs them all (``make`` installs ``robodyn[test]``,
+``pip install "robodyn[study,ros]"`` installs them all (``make`` installs ``robodyn[test]``,
 which includes every extra). A feature whose extra is missing raises :class:`MissingExtraError`
 naming the feature and the command that installs it.
 """
@@ -26,7 +26,6 @@ __all__ = ["EXTRAS", "MissingExtraError", "require"]
 #: Extra of each optional top-level module.
 EXTRAS: dict[str, str] = {
     "dask": "study", "distributed": "study", "cloudpickle": "study", "pyarrow": "study",
-    "cvxpy": "sdp", "clarabel": "sdp",
     "mcap": "ros", "mcap_ros2": "ros", "zstandard": "ros",
 }
 

@@ -12,7 +12,7 @@ predictions, is physical. :func:`consistent_completion` looks for it::
                                J_j(p) >= EPS 1 (every link's pseudo-inertia)
 
 (``S`` the inverse magnitudes of ``p0``, as in :mod:`robodyn.identification.consistent`), a
-semidefinite program solved by cvxpy with Clarabel (the ``sdp`` extra). When it is infeasible the
+semidefinite program solved by cvxpy with Clarabel. When it is infeasible the
 base parameters themselves are not physical (only ``method="consistent"`` can then give a
 physical model, with other base parameters), and the completion ``p0`` is kept.
 """
@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from robodyn.extras import MissingExtraError, require
 from robodyn.identification.base import BaseRelations
 from robodyn.identification.consistent import EPS, _project_link, _pseudo_expr, pseudo_inertia
 from robodyn.robot.validation import inertia_problems
@@ -54,14 +53,11 @@ def physical(p: np.ndarray, n: int) -> bool:
 def consistent_completion(relations: BaseRelations, p0: np.ndarray, n: int) -> np.ndarray:
     """``p0`` (15 n,) when it is physical, else the physical standard set closest to it with the
     same base parameters, rotor inertias and friction (module docstring), else ``p0`` (none
-    exists, or the ``sdp`` extra is not installed)."""
+    exists)."""
     if physical(p0, n) or any(p0[PER_JOINT * j + 10] < 0 for j in range(n)):
         return p0  # physical already, or a negative rotor inertia no completion can change
-    try:
-        cp = require("cvxpy", "the physical completion of identified parameters")
-        require("clarabel", "the physical completion of identified parameters")
-    except MissingExtraError:
-        return p0
+    import cvxpy as cp  # a core dependency, imported when used (slow to import)
+
     k = relations.matrix
     theta = k @ p0
     mag = np.maximum(np.abs(p0), 1e-3)

@@ -28,7 +28,6 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from robodyn.extras import require
 from robodyn.identification.base import BaseRelations
 from robodyn.identification.estimate import LinearFit, thin_svd
 from robodyn.robot.errors import IdentificationError
@@ -91,8 +90,7 @@ def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray,
     IdentificationError
         Infeasible problem, solver failure, or a result that fails the inertia checks.
     """
-    cp = require("cvxpy", "identify(method='consistent')")
-    require("clarabel", "identify(method='consistent')")
+    import cvxpy as cp  # a core dependency, imported when used (slow to import)
 
     n = robot.dof
     names = relations.standard_names

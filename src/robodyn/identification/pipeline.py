@@ -47,7 +47,7 @@ from robodyn.identification.preprocess import (
 )
 from robodyn.identification.prior import joint_prior
 from robodyn.identification.result import BaseParameters, Identification
-from robodyn.identification.ripple import block_of, choose_ripple, fit_ripple, residual_of, ripple_rows
+from robodyn.identification.ripple import with_ripple
 from robodyn.identification.spikes import drop_spikes
 from robodyn.identification.state_noise import state_noise_std, torque_variance
 from robodyn.identification.thermal import ThermalData, ThermalFit, thermal_data
@@ -213,7 +213,10 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     if law in NONLINEAR:
         result = replace(result, friction_fit=fit_friction_samples(result, data.samples, data.y_full,
                                                                     law))
-    return replace(_with_ripple(robot, result, data, opts.ripple), options=opts)
+    revolute = np.array([j.type == "revolute" for j in robot.joints])
+    result = with_ripple(result, data.full, data.samples, data.y_full, data.settings, revolute,
+                         opts.ripple)
+    return replace(result, options=opts)
 
 
 def _regularization(method: str, regularization: float | str | None) -> float | str | None:
@@ -225,25 +228,6 @@ def _regularization(method: str, regularization: float | str | None) -> float | 
     if regularization == "auto" and method == "consistent":
         return None
     return regularization
-
-
-def _with_ripple(robot: Robot, result: Identification, data: _Prepared, ripple: bool | str
-                 ) -> Identification:
-    """``result`` with the position ripple fitted on what it leaves of the target
-    (:mod:`robodyn.identification.ripple`): always for ``ripple=True``, when it predicts held-out
-    blocks better for ``"auto"``, never for False."""
-    revolute = np.array([j.type == "revolute" for j in robot.joints])
-    if ripple is False or not revolute.any():
-        return result
-    rows = np.vstack(ripple_rows(data.full, data.settings, revolute))
-    residual = residual_of(result, data.samples, data.y_full)
-    if ripple == "auto":
-        keep, scores = choose_ripple(residual, rows, block_of(data.samples), revolute)
-        result = replace(result, choices=replace(result.choices, ripple=keep,
-                                                 ripple_scores=tuple(scores.items())))
-        if not keep:
-            return result
-    return replace(result, ripple_fit=fit_ripple(residual, rows, revolute))
 
 
 @dataclass(frozen=True, eq=False)

@@ -29,7 +29,7 @@ it: :meth:`Identification.predict` adds it, the written robot does not.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -38,7 +38,7 @@ from robodyn.identification.estimate import FOLDS
 from robodyn.identification.friction_choice import MIN_GAIN
 from robodyn.identification.preprocess import Preprocess, Samples, evaluation_step, filtered_rows
 
-__all__ = ["RippleFit", "choose_ripple", "fit_ripple", "ripple_columns", "ripple_rows"]
+__all__ = ["RippleFit", "choose_ripple", "fit_ripple", "ripple_columns", "ripple_rows", "with_ripple"]
 
 
 def ripple_columns(q: np.ndarray, revolute: np.ndarray) -> np.ndarray:
@@ -178,3 +178,36 @@ def residual_of(ident: Any, samples: Sequence[Samples], y_full: Sequence[np.ndar
     load = np.vstack([a @ p_nf for a in y_full])
     qd = np.vstack([s.qd for s in samples])
     return y - load - ident.friction_fit.torque(qd, load)  # r = K H y - H Y p_nf - f
+
+
+def with_ripple(result: Any, full: Sequence[Samples], samples: Sequence[Samples],
+                y_full: Sequence[np.ndarray], settings: Preprocess, revolute: np.ndarray,
+                ripple: bool | str) -> Any:
+    """The identification ``result`` with the position ripple fitted on what it leaves.
+
+    Parameters
+    ----------
+    result : Identification
+    full : sequence of Samples
+        The processed samples before decimation, (N_k, n) each.
+    samples : sequence of Samples
+        The same decimated, with the filtered target.
+    y_full : sequence of numpy.ndarray, shape (N_k, n, 15 n)
+        The fit's filtered regressor rows of ``samples``.
+    settings : Preprocess
+    revolute : numpy.ndarray of bool, shape (n,)
+    ripple : bool or "auto"
+        Always, never, or when it predicts held-out blocks better (``result.choices`` then
+        records the choice and the scores).
+    """
+    if ripple is False or not np.any(revolute):
+        return result
+    rows = np.vstack(ripple_rows(full, settings, revolute))
+    residual = residual_of(result, samples, y_full)
+    if ripple == "auto":
+        keep, scores = choose_ripple(residual, rows, block_of(samples), revolute)
+        result = replace(result, choices=replace(result.choices, ripple=keep,
+                                                 ripple_scores=tuple(scores.items())))
+        if not keep:
+            return result
+    return replace(result, ripple_fit=fit_ripple(residual, rows, revolute))
