@@ -153,6 +153,24 @@ def test_identify_preprocessing_options_and_no_report(files, tmp_path, capsys):
     assert "Ia" not in {r["name"][:2] for r in _rows(tmp_path / "parameters.csv")}
 
 
+def test_identify_prints_and_reports_the_friction_and_ripple_choices(files, tmp_path, capsys):
+    train, _ = files
+    rc = main(["identify", "puma560", "--data", str(train), "--cutoff", "none", "-o", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert rc == 0  # the default, physically consistent, writes a description that loads
+    assert "friction law linear" in out or "friction law stribeck" in out
+    assert "position ripple kept" in out or "position ripple not kept" in out
+    page = (tmp_path / "report.html").read_text(encoding="utf-8")
+    assert "Friction law <b>" in page and "Position ripple (a sin q + b cos q per joint) <b>" in page
+    rc = main(["identify", "puma560", "--data", str(train), "--cutoff", "none", "--ripple", "off",
+               "--no-report", "-o", str(tmp_path / "off")])
+    assert rc == 0 and "position ripple" not in capsys.readouterr().out
+    with pytest.raises(SystemExit) as exc:
+        main(["identify", "puma560", "--data", str(train), "--ripple", "maybe", "-o", str(tmp_path)])
+    assert exc.value.code == 2
+    assert "--ripple: expected auto, on or off, got 'maybe'" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("option, value", [("--cutoff", "fast"), ("--regularization", "inf"),
                                            ("--dead-band", "wide"), ("--decimate", "2.5")])
 def test_identify_bad_preprocessing_option_is_refused(files, tmp_path, capsys, option, value):

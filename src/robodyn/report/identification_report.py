@@ -170,10 +170,21 @@ def _choices_html(ident: Any) -> str:
     table = ("<table><tr><th>candidate</th><th>held-out blocks, relative</th><th>best weight</th>"
              "<th></th></tr>" + rows + "</table>"
              if len(ch.candidates) > 1 else "")
+    laws = ""
+    if ch.friction is not None:
+        scores = ", ".join(f"{k} {v:.4f}" for k, v in ch.friction_scores)
+        laws += (f"<p>Friction law <b>{html.escape(ch.friction)}</b> (held-out blocks of the "
+                 f"friction residual: {html.escape(scores)}).</p>\n")
+    if ch.ripple is not None:
+        scores = ", ".join(f"{k} {v:.4f}" for k, v in ch.ripple_scores)
+        kept = "kept" if ch.ripple else "not kept"
+        laws += (f"<p>Position ripple (a sin q + b cos q per joint) <b>{kept}</b> (held-out "
+                 f"blocks of the model's residual: "
+                 f"{html.escape(scores)}).</p>\n")
     return (f"<h2>Choices</h2>\n<p>Velocity <b>{html.escape(ch.velocity)}</b>, Coulomb dead band "
             f"<b>{ch.dead_band:g} rad/s</b>, cut-off {_cutoff(ident)}, Tikhonov weight "
             f"{ch.regularization:.3g}{', thermal friction' if ch.thermal else ''}: "
-            f"{html.escape(ch.reason)}.</p>\n{table}")
+            f"{html.escape(ch.reason)}.</p>\n{laws}{table}")
 
 
 def _cutoff(ident: Any) -> str:
