@@ -4,6 +4,9 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
+# test processes (pytest-xdist): one per core, at most 4 (each may hold ~1 GB); JOBS=1 runs serially
+JOBS   ?= $(shell $(PYTHON) -c 'import os; print(max(1, min(4, len(os.sched_getaffinity(0)))))' 2>/dev/null || echo 1)
+PYTEST := $(BIN)/pytest -q -n $(JOBS) --dist loadfile
 
 .PHONY: venv demo test quick bench clean distclean
 
@@ -25,15 +28,16 @@ demo: $(STAMP)
 	@echo "next: open out/report.html; run robodyn as $(BIN)/robodyn --help" \
 	      "(or '. $(BIN)/activate' first, then plain 'robodyn'); sample input files in examples/"
 
-## test: lint, then the test suite (tests needing a missing oracle/tool skip one by one and are
-## counted at the end; ROBODYN_REQUIRE_ALL=1 make test turns those skips into failures, as in CI)
+## test: lint, then the test suite on JOBS processes, a test file per process at a time (tests
+## needing a missing oracle/tool skip one by one and are counted at the end;
+## ROBODYN_REQUIRE_ALL=1 make test turns those skips into failures, as in CI)
 test: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks && $(BIN)/pytest -q
+	$(BIN)/ruff check src tests benchmarks && $(PYTEST)
 
 ## quick: lint, then the suite without the tests marked slow (each over ~3 s: large models
 ## compiled, whole command-line workflows); the full `make test` is what CI runs
 quick: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks && $(BIN)/pytest -q -m "not slow"
+	$(BIN)/ruff check src tests benchmarks && $(PYTEST) -m "not slow"
 
 ## bench: timing suites in benchmarks/; bench_kernels.py, bench_simulation.py and bench_hydro.py
 ## merge theirs into benchmarks/results/<machine>.json (CPU, flags, load, min/median of every

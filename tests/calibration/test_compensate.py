@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from robodyn.calibration import build_model, calibrate, compensate, robot_geometry
-from robodyn.calibration.compensation import inverse_kinematics
+from robodyn.calibration.compensation import readings_for_points
 from robodyn.studies.calibration_study import perturbed_robot, robot_positions
 from tests.calibration.helpers import TARGET, TRACKER, poses, robot
 
@@ -19,7 +19,7 @@ def test_corrected_joint_targets_reach_the_desired_points_on_the_true_robot():
     desired = robot_positions(true, q_goal)
     # the joint targets the nominal kinematics (placed in the tracker frame) would command
     nominal = build_model("dh", robot_geometry(cal.before_robot))
-    q_nominal = inverse_kinematics(nominal, nominal.initial, desired, q_goal)
+    q_nominal = readings_for_points(nominal, nominal.initial, desired, q_goal)
     nominal_error = np.linalg.norm(robot_positions(true, q_nominal) - desired, axis=1)
     q_corrected = compensate(cal, desired, q_nominal)
     np.testing.assert_allclose(cal.predict(q_corrected), desired, atol=1e-10)

@@ -110,3 +110,4 @@ def test_consistent_default_fits_without_tikhonov_weight(puma):
     wls = rd.identify(robot, _run(model, 7, False, seconds=10.0), cutoff=None, model=model,
                       method="wls")
     assert "no Tikhonov weight" not in wls.choices.reason
+

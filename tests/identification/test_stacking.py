@@ -50,3 +50,18 @@ def test_threads_do_not_change_the_matrix():
     model, q, qd, qdd = _model_and_states(50)
     np.testing.assert_array_equal(identification_matrix(model, q, qd, qdd, threads=2),
                                   identification_matrix(model, q, qd, qdd))
+
+
+def test_pivoted_columns_is_the_one_base_column_rule():
+    from robodyn.identification.base import pivoted_columns
+    from robodyn.studies import excitation
+
+    rng = np.random.default_rng(0)
+    a = rng.standard_normal((50, 2))
+    # columns: a0, 1e6 a1 (units must not decide), a0 - 1e6 a1 (dependent), a structural zero
+    w = np.column_stack([a[:, 0], 1e6 * a[:, 1], a[:, 0] - 1e6 * a[:, 1], np.zeros(50)])
+    norms, used, _, piv, rank = pivoted_columns(w)
+    assert rank == 2 and list(used) == [0, 1, 2]
+    np.testing.assert_allclose(norms, np.linalg.norm(w, axis=0))
+    # excitation design takes its base columns through the same function
+    assert excitation.pivoted_columns is pivoted_columns

@@ -11,7 +11,7 @@ from robodyn.calibration.models import ErrorModel
 from robodyn.calibration.result import Calibration
 from robodyn.robot.errors import InputError
 
-__all__ = ["compensate", "inverse_kinematics"]
+__all__ = ["compensate", "readings_for_points"]
 
 def compensate(
     calibration: Calibration,
@@ -58,14 +58,17 @@ def compensate(
         pts = pts @ b[:3, :3].T + b[:3, 3]
     elif frame != "instrument":
         raise InputError(f"frame must be 'instrument' or 'base', got {frame!r}")
-    return inverse_kinematics(calibration.model, calibration.params, pts, q, tol=tol, max_iter=max_iter)
+    return readings_for_points(calibration.model, calibration.params, pts, q, tol=tol, max_iter=max_iter)
 
 
-def inverse_kinematics(model: ErrorModel, params: np.ndarray, points: np.ndarray, q_seed: np.ndarray,
+def readings_for_points(model: ErrorModel, params: np.ndarray, points: np.ndarray, q_seed: np.ndarray,
                        *, tol: float = 1e-10, max_iter: int = 100) -> np.ndarray:
     """Readings (M, n) that put the model's target on ``points`` (M, 3), from ``q_seed`` (M, n).
 
-    Newton steps with the minimum-norm (pseudo-inverse) joint correction.
+    Newton steps with the minimum-norm (pseudo-inverse) joint correction, all poses at once, on
+    a calibration's error model (``params`` its parameters). Not the robot's own inverse
+    kinematics (:func:`robodyn.simulation.inverse_kinematics`: one pose of a compiled model, with
+    joint limits and restarts): this one inverts the calibrated kinematics near a good seed.
 
     Raises
     ------

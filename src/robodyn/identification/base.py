@@ -127,6 +127,44 @@ def random_states(model: Model, samples: int, rng: np.random.Generator,
     return q, qd, rng.standard_normal((samples, n))
 
 
+def pivoted_columns(w: np.ndarray, rtol: float = RANK_RTOL
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
+    """QR with column pivoting of a stacked regressor on its unit-norm columns: the base columns.
+
+    The one rule of robodyn for which regressor columns are independent (identification and
+    excitation design alike): columns whose norm is below ``BETA_ZERO`` of the largest (at least
+    1) are structural zeros and left out; the others are scaled to unit norm, so that the units of
+    the parameters do not decide the rank, and a pivot ``|R_kk| <= rtol |R_00|`` is dependent.
+
+    Parameters
+    ----------
+    w : numpy.ndarray, shape (m, p)
+        Stacked regressor rows.
+    rtol : float
+        Rank tolerance relative to the largest pivot.
+
+    Returns
+    -------
+    norms : numpy.ndarray, shape (p,)
+        Column norms of ``w``.
+    used : numpy.ndarray of int, shape (k,)
+        The columns that are not structural zeros.
+    r : numpy.ndarray, shape (min(m, k), k)
+        ``R`` of ``W[:, used] D^-1 P = Q R``.
+    piv : numpy.ndarray of int, shape (k,)
+        The pivot order, into ``used``.
+    rank : int
+        The first ``rank`` pivots are the independent (base) columns.
+    """
+    norms = np.linalg.norm(w, axis=0)
+    used = np.flatnonzero(norms > BETA_ZERO * max(1.0, float(norms.max()) if norms.size else 1.0))
+    # W P = Q R on unit-norm columns: the pivots order the columns by independence
+    _, r, piv = scipy.linalg.qr(w[:, used] / norms[used], mode="economic", pivoting=True)
+    d = np.abs(np.diag(r))
+    rank = int(np.sum(d > rtol * d[0])) if d.size else 0
+    return norms, used, r, piv, rank
+
+
 def base_relations(model: Model, *, samples: int | None = None, seed: int = 0,
                    at_rest: np.ndarray | None = None, unseen: np.ndarray | None = None
                    ) -> BaseRelations:
@@ -162,13 +200,8 @@ def base_relations(model: Model, *, samples: int | None = None, seed: int = 0,
     w = model.regressor(q, qd, qdd).reshape(count * n, -1)
     if unseen is not None:
         w[:, np.asarray(unseen, dtype=int)] = 0.0
-    norms = np.linalg.norm(w, axis=0)
-    used = np.flatnonzero(norms > BETA_ZERO * max(1.0, float(norms.max())))
+    norms, used, r, piv, rank = pivoted_columns(w)
     zero = np.setdiff1d(np.arange(w.shape[1]), used)
-    # W P = Q R on unit-norm columns: the pivots order the columns by independence
-    _, r, piv = scipy.linalg.qr(w[:, used] / norms[used], mode="economic", pivoting=True)
-    d = np.abs(np.diag(r))
-    rank = int(np.sum(d > RANK_RTOL * d[0]))
     ind_local = used[piv[:rank]]
     dep_local = used[piv[rank:]]
     # beta in original (unscaled) units: W_d = W_b beta

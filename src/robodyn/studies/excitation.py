@@ -56,6 +56,7 @@ import scipy.linalg
 from scipy.interpolate import BPoly, PPoly
 from scipy.optimize import minimize
 
+from robodyn.identification.base import pivoted_columns
 from robodyn.identification.stacking import identification_matrix as stacked_matrix
 from robodyn.measure.csv_io import write_csv
 from robodyn.measure.recording import Recording
@@ -99,8 +100,7 @@ def base_columns(model: Model, rng: np.random.Generator | int | None = 0, *, sam
     limits or ``+-pi``, velocities and accelerations standard normal) and stacked; QR with column
     pivoting picks the columns, and the rank is the number of ``|R_kk| > rtol |R_00|`` after the
     columns are scaled to unit norm (so the units of the parameters do not decide the rank): the
-    rule of :func:`robodyn.identification.base.base_relations`, which also gives the combinations the
-    dependent columns make (not needed here, and importing it would tie ``measure`` to ``identify``).
+    rule of :func:`robodyn.identification.base.pivoted_columns`, the one identification uses.
 
     Parameters
     ----------
@@ -124,12 +124,7 @@ def base_columns(model: Model, rng: np.random.Generator | int | None = 0, *, sam
     hi = np.array([np.pi if j.upper is None else float(j.upper) for j in model.robot.joints])
     q = gen.uniform(lo, hi, (samples, n))
     y = model.regressor(q, gen.standard_normal((samples, n)), gen.standard_normal((samples, n)))
-    w = y.reshape(samples * n, -1)
-    norms = np.linalg.norm(w, axis=0)
-    used = np.flatnonzero(norms > 0)
-    _, r, piv = scipy.linalg.qr(w[:, used] / norms[used], mode="economic", pivoting=True)
-    d = np.abs(np.diag(r))
-    rank = int(np.sum(d > rtol * d[0])) if d.size else 0
+    _, used, _, piv, rank = pivoted_columns(y.reshape(samples * n, -1), rtol)
     return tuple(sorted(int(c) for c in used[piv[:rank]]))
 
 
