@@ -13,7 +13,7 @@ import pytest
 
 import robodyn as rd
 from robodyn.identification.choices import candidates
-from robodyn.identification.ripple import RippleFit, ripple_columns
+from robodyn.identification.ripple import RippleFit, gravity_free_joints, ripple_columns
 from robodyn.robot.errors import IdentificationError
 from tests.identification.helpers import fourier, load_quiet
 
@@ -101,13 +101,12 @@ def test_measured_velocity_is_the_plain_candidate_when_every_recording_has_one()
     assert candidates("auto", 0.0, False, False, False, 1e-3)[0].velocity == "position"
 
 
-def test_consistent_default_fits_without_tikhonov_weight(puma):
+def test_ripple_is_offered_only_where_gravity_does_not_carry_the_joints_own_harmonic(puma):
+    # PUMA 560: joint 1 has a vertical axis (no gravity torque); joint 2 lifts link 2, whose
+    # first moments give its torque exactly a sin q2 + b cos q2; joint 3's gravity depends on
+    # q2 + q3 and the wrist's on several angles, never on their own angle alone.
     robot, model = puma
-    ident = rd.identify(robot, _run(model, 7, False, seconds=10.0), cutoff=None, model=model)
-    assert ident.method == "consistent" and ident.options.regularization == "auto"
-    assert ident.regularization == 0.0
-    assert "no Tikhonov weight" in ident.choices.reason
-    wls = rd.identify(robot, _run(model, 7, False, seconds=10.0), cutoff=None, model=model,
-                      method="wls")
-    assert "no Tikhonov weight" not in wls.choices.reason
-
+    np.testing.assert_array_equal(gravity_free_joints(model, np.ones(6, bool)),
+                                  [True, False, True, True, True, True])
+    np.testing.assert_array_equal(gravity_free_joints(model, np.array([False, True, True] * 2)),
+                                  [False, False, True, False, True, True])

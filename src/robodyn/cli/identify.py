@@ -132,7 +132,8 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                             friction=args.friction, velocity=args.velocity,
                             dead_band=args.dead_band, spikes=args.spikes, cutoff=args.cutoff,
                             regularization=args.regularization, decimate=args.decimate,
-                            sensor=args.sensor, ripple=args.ripple, **extra)
+                            sensor=args.sensor, ripple=args.ripple,
+                            prediction_cutoff=args.prediction_cutoff, **extra)
     paths = {"yaml": out / f"{stem}.yaml", "urdf": out / f"{stem}.urdf",
              "parameters": out / "parameters.csv"}
     paths["yaml"].write_text(dump_yaml(ident.robot), encoding="utf-8")
@@ -153,13 +154,14 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                                                                       strict=True))
         print(f"drive gains from the payload run(s), N m/A: {gain_text}")
     paths["metrics"] = _write_metrics([v for _, v in vals], out / "validation.csv")
-    pre = ident.preprocess
+    pre = ident.prediction_settings
     note = ("predicted by the identified model at states processed as the identification's: "
             + ("measured velocity" if pre.velocity == "measured" else "velocity from positions")
             + ("" if pre.cutoff is None else f", zero-phase low-pass at {pre.cutoff:.3g} Hz")
             + (f", Coulomb dead band {pre.dead_band:g} rad/s" if pre.dead_band else ""))
     if pre.velocity == "position" and not pre.dead_band and ident.friction_fit is None \
-            and ident.thermal_fit is None and ident.ripple_fit is None and pre.cutoff is not None:
+            and ident.thermal_fit is None and ident.ripple_fit is None and pre.cutoff is not None \
+            and ident.prediction is None:
         note += (f"; robodyn validate {paths['yaml']} --target {ident.target} --cutoff "
                  f"{pre.cutoff:.17g} reproduces these figures from the written description")
     for k, path in enumerate(_write_predictions(vals, out, note)):
@@ -413,6 +415,19 @@ def _ripple(text: str) -> bool | str:
     return values[text]
 
 
+def _prediction_cutoff(text: str) -> float | str:
+    """``--prediction-cutoff``: "fit", "auto" or a frequency in Hz."""
+    if text in ("fit", "auto"):
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected fit, auto or a frequency in Hz, got {text!r}") from None
+    if not (np.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected a positive frequency in Hz, got {text!r}")
+    return value
+
+
 def _preprocessing(p: argparse.ArgumentParser) -> None:
     """The identification's preprocessing options (rd.identify's keywords of the same names)."""
     p.add_argument("--velocity", choices=("auto", "position", "measured"), default="auto",
@@ -431,6 +446,12 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
                    help="a torque once per revolution of each revolute joint (a sin q + b cos q), "
                         "fitted on what the model leaves: on, off, or auto: kept when it predicts "
                         "held-out time blocks better (default: %(default)s)")
+    p.add_argument("--prediction-cutoff", type=_prediction_cutoff, default="fit",
+                   metavar="{fit,auto,HZ}",
+                   help="low-pass cut-off of the states the model is evaluated at in predictions: "
+                        "the fit's, a frequency in Hz, or auto: a wider one when it predicts the "
+                        "raw target of the identification data better (lower error against the "
+                        "raw target, higher against a low-passed one) (default: %(default)s)")
     p.add_argument("--cutoff", type=_auto_or(float, none=True), default="auto", metavar="HZ",
                    help="zero-phase low-pass cut-off in Hz, none (the recording's own "
                         "velocities and accelerations), or auto: the motion's bandwidth within "

@@ -114,6 +114,12 @@ class Choices:
         else None.
     ripple_scores : tuple of (str, float)
         Relative held-out error of the model's residual without and with the ripple.
+    prediction_cutoff : float or None
+        The cut-off of the states ``ident.predict`` uses, chosen by ``prediction_cutoff="auto"``
+        (:mod:`robodyn.identification.bandwidth`), Hz; else None.
+    prediction_scores : tuple of (str, float)
+        Each candidate cut-off's relative error against the raw target of the identification
+        recordings.
     """
 
     velocity: str
@@ -128,6 +134,8 @@ class Choices:
     friction_scores: tuple[tuple[str, float], ...] = ()
     ripple: bool | None = None
     ripple_scores: tuple[tuple[str, float], ...] = ()
+    prediction_cutoff: float | None = None
+    prediction_scores: tuple[tuple[str, float], ...] = ()
 
     def summary(self) -> str:
         """A few lines for the terminal and the report."""
@@ -143,6 +151,10 @@ class Choices:
             scores = ", ".join(f"{k} {v:.4f}" for k, v in self.ripple_scores)
             lines.append(f"  position ripple {'kept' if self.ripple else 'not kept'} (held-out "
                          f"blocks of the model's residual: {scores})")
+        if self.prediction_cutoff is not None:
+            scores = ", ".join(f"{k} {v:.4f}" for k, v in self.prediction_scores)
+            lines.append(f"  prediction cut-off {self.prediction_cutoff:g} Hz (raw target of the "
+                         f"identification recordings: {scores})")
         if len(self.candidates) > 1:
             for c in self.candidates:
                 mark = "*" if self.chosen is not None and c.key == self.chosen.key else " "
@@ -228,7 +240,7 @@ def choose(cands: Sequence[Candidate], stacked: Callable[[Candidate], Problem]
         per_block = candidate_cv_errors(pr.phi, pr.y, pr.theta0, pr.joint, pr.blocks, pr.phi_test,
                                         pr.y_test)
         per_block = per_block / max(float(pr.y_test @ pr.y_test), 1e-300)
-        k = int(np.argmin(per_block.sum(axis=0)))
+        k = int(np.argmin(per_block.sum(axis=0)))  # each candidate at its best weight
         scored.append(replace(cand, score=float(np.sqrt(per_block[:, k].sum())),
                               lam=float(LAMBDA_GRID[k])))
         blocks_err.append(per_block[:, k])

@@ -13,6 +13,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from robodyn.identification.friction import FRICTION_MODELS
 from robodyn.robot.errors import IdentificationError
 
@@ -85,6 +87,12 @@ class IdentifyOptions:
         fitted on what the identified model leaves of the target
         (:mod:`robodyn.identification.ripple`); "auto": kept when it predicts held-out time
         blocks of that residual better than none.
+    prediction_cutoff : float, "auto" or "fit"
+        Cut-off (Hz) of the states :meth:`Identification.predict` evaluates the model at
+        (:mod:`robodyn.identification.bandwidth`): "fit" (the default) is the fit's cut-off;
+        "auto" tries it and wider ones on the identification recordings against their raw
+        target and keeps a wider one only when it is better by more than one standard error
+        (lower error against the raw target, higher against a low-passed one: see the module).
 
     Raises
     ------
@@ -107,6 +115,7 @@ class IdentifyOptions:
     sensor: str = "motor"
     spikes: str = "keep"
     ripple: bool | str = "auto"
+    prediction_cutoff: float | str = "fit"
 
     def __post_init__(self) -> None:
         _choice("method", self.method, METHODS)
@@ -126,6 +135,13 @@ class IdentifyOptions:
         _choice("spikes", self.spikes, ("keep", "drop"))
         if not any(self.ripple is v for v in (False, True)) and self.ripple != "auto":
             raise IdentificationError(f"ripple: expected False, True or 'auto', got {self.ripple!r}")
+        pc = self.prediction_cutoff
+        if isinstance(pc, str) or isinstance(pc, bool) or not isinstance(pc, (int, float)):
+            if pc not in ("auto", "fit"):
+                raise IdentificationError(f"prediction_cutoff: expected a frequency in Hz, 'auto' or "
+                                          f"'fit', got {pc!r}")
+        elif not (np.isfinite(pc) and pc > 0):
+            raise IdentificationError(f"prediction_cutoff: expected a positive frequency in Hz, got {pc!r}")
 
 
 def _choice(name: str, value: Any, choices: tuple[str, ...]) -> None:

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
+from robodyn.identification.bandwidth import check_prediction_cutoff, with_prediction_cutoff
 from robodyn.identification.base import BaseRelations, base_relations
 from robodyn.identification.choices import Candidate, Choices, Problem, candidates, choose
 from robodyn.identification.completion import consistent_completion
@@ -47,7 +48,7 @@ from robodyn.identification.preprocess import (
 )
 from robodyn.identification.prior import joint_prior
 from robodyn.identification.result import BaseParameters, Identification
-from robodyn.identification.ripple import with_ripple
+from robodyn.identification.ripple import gravity_free_joints, with_ripple
 from robodyn.identification.spikes import drop_spikes
 from robodyn.identification.state_noise import state_noise_std, torque_variance
 from robodyn.identification.thermal import ThermalData, ThermalFit, thermal_data
@@ -110,7 +111,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
              bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None,
              payloads: Sequence[Payload | None] | None = None, weights: str = "residual",
              state_noise: Any = None, thermal: bool | str = False, sensor: str = "motor",
-             spikes: str = "keep", ripple: bool | str = "auto",
+             spikes: str = "keep", ripple: bool | str = "auto", prediction_cutoff: float | str = "fit",
              options: IdentifyOptions | None = None) -> Identification:
     """Identify the base inertial, drive and friction parameters of a robot from recordings.
 
@@ -128,7 +129,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         The choices: the attributes of the same names of
         :class:`~robodyn.identification.options.IdentifyOptions` (what each does, its values
         and default). ``method``: "ols", "wls" or "consistent" (default).
-    weights, state_noise, thermal, sensor, spikes, ripple
+    weights, state_noise, thermal, sensor, spikes, ripple, prediction_cutoff
         Likewise.
     model : Model, optional
         A compiled model of ``robot`` to reuse (default ``rd.compile_model(robot)``).
@@ -156,9 +157,10 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         method=method, friction=friction, regularization=regularization, cutoff=cutoff,
         decimate=decimate, velocity=velocity, dead_band=dead_band, gains=gains, bounds=bounds,
         weights=weights, state_noise=state_noise, thermal=thermal, sensor=sensor, spikes=spikes,
-        ripple=ripple),
+        ripple=ripple, prediction_cutoff=prediction_cutoff),
         IdentificationError)
     recs, target, pays = checked_inputs(robot, recordings, target, opts.sensor, payloads)
+    check_prediction_cutoff(recs, opts.prediction_cutoff)
     if opts.spikes == "drop":  # one-sample glitches removed from the fit's recordings
         recs = [drop_spikes(r, target)[0] for r in recs]
     model = model if model is not None else compile_model(robot)
@@ -191,17 +193,13 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     cands = candidates(opts.velocity, opts.dead_band, opts.thermal, measured, temps, DEAD_BAND, cutoffs)
     best, problem, scored = choose(cands, stacked)
     data, drive, prior, loads = problem.payload
-    reg = _regularization(opts.method, opts.regularization)
-    step, thermal_fit = _linear_step(robot, data, drive.k, loads, prior, opts.method, reg,
+    step, thermal_fit = _linear_step(robot, data, drive.k, loads, prior, opts.method, opts.regularization,
                                      opts.weights, opts.state_noise)
     theta, standard = _estimate_standard(robot, data.relations, step, prior, opts.method, opts.bounds)
     result = _identification(robot, data, step, theta, standard, drive, target, opts.method)
     reason = (f"held-out time blocks ({FOLDS} per recording), {len(scored)} candidates: the plain "
               "processing unless another is better by more than one standard error"
               if len(scored) > 1 else "as given")
-    if reg is None and opts.regularization == "auto":
-        reason += ("; no Tikhonov weight: method='consistent' keeps weakly excited directions "
-                   "physical by its constraints")
     result = replace(result, choices=Choices(best.velocity, best.dead_band, data.settings.cutoff,
                                              step.fit.lam, tuple(scored), reason, best.thermal, best),
                      thermal_fit=thermal_fit)
@@ -214,20 +212,11 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         result = replace(result, friction_fit=fit_friction_samples(result, data.samples, data.y_full,
                                                                     law))
     revolute = np.array([j.type == "revolute" for j in robot.joints])
-    result = with_ripple(result, data.full, data.samples, data.y_full, data.settings, revolute,
+    result = with_ripple(result, data.full, data.samples, data.y_full, data.settings,
+                         gravity_free_joints(model, revolute),
                          opts.ripple)
+    result = with_prediction_cutoff(result, recs, pays, target, opts.prediction_cutoff)
     return replace(result, options=opts)
-
-
-def _regularization(method: str, regularization: float | str | None) -> float | str | None:
-    """The Tikhonov weight to fit with: ``"auto"`` is none for ``method="consistent"``, whose
-    pseudo-inertia constraints keep the weakly excited directions physical (a pull toward the
-    description then only adds the description's errors: on the KUKA runs of the quality table
-    it raised the error on another trajectory from 0.049 to 0.050-0.053), and chosen by
-    time-block cross-validation for least squares."""
-    if regularization == "auto" and method == "consistent":
-        return None
-    return regularization
 
 
 @dataclass(frozen=True, eq=False)

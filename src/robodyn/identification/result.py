@@ -140,6 +140,9 @@ class Identification:
     ripple_fit : RippleFit or None
         The position ripple (:mod:`robodyn.identification.ripple`): :meth:`predict` adds its
         torque; ``robot`` does not carry it.
+    prediction : Preprocess or None
+        The processing :meth:`predict` uses when it differs from ``preprocess``: the same with
+        the prediction cut-off chosen from the data (:mod:`robodyn.identification.bandwidth`).
     """
 
     robot: Robot
@@ -164,6 +167,7 @@ class Identification:
     thermal_fit: ThermalFit | None = None
     options: IdentifyOptions | None = None
     ripple_fit: RippleFit | None = None
+    prediction: Preprocess | None = None
 
     @property
     def gains_identified(self) -> bool:
@@ -174,9 +178,11 @@ class Identification:
         """Predicted target at the recording's own samples.
 
         The raw recording is processed as the identification data were, by the same functions
-        (same filter cut-off and order, same derivative estimates, the same Coulomb dead band),
-        without decimation; the prediction is the model's effort ``Y(q, qd, qdd) p`` at the
-        processed states (:func:`robodyn.identification.preprocess.prediction_rows`).
+        (same filter order, same derivative estimates, the same Coulomb dead band), without
+        decimation, at the prediction cut-off (:attr:`prediction_settings`: the fit's, or a
+        wider one chosen from the data by :mod:`robodyn.identification.bandwidth`); the
+        prediction is the model's effort ``Y(q, qd, qdd) p`` at the processed states
+        (:meth:`effort`).
 
         Parameters
         ----------
@@ -193,12 +199,25 @@ class Identification:
         from robodyn.identification.inputs import check_recording
 
         check_recording(self.robot, recording, 0, None)
-        s = preprocess(recording, self.preprocess, None)
+        s = preprocess(recording, self.prediction_settings, None)
+        temp = temperatures(recording, 0, self.robot.dof) if self.thermal_fit is not None else None
+        return self.effort(s, temp, payload)
+
+    @property
+    def prediction_settings(self) -> Preprocess:
+        """The processing of a recording that :meth:`predict` evaluates the model on: the fit's
+        (``preprocess``) with the prediction cut-off chosen by ``rd.identify``
+        (:mod:`robodyn.identification.bandwidth`)."""
+        return self.preprocess if self.prediction is None else self.prediction
+
+    def effort(self, s: Any, temperature: np.ndarray | None = None, payload: Any = None) -> np.ndarray:
+        """The model's effort at processed samples ``s`` (:class:`Samples`, (N, n) states),
+        in the target's unit (N m, N or A), (N, n); ``temperature`` (N, n), deg C, is needed
+        with thermal friction; ``payload`` as for :meth:`predict`."""
         y = prediction_rows(self._model, s, self.preprocess)
         thermal = 0.0
         if self.thermal_fit is not None:
-            temp = temperatures(recording, 0, self.robot.dof)
-            thermal = self.thermal_fit.torque(s.qd, temp, self.preprocess.dead_band)
+            thermal = self.thermal_fit.torque(s.qd, temperature, self.preprocess.dead_band)
         if self.friction_fit is None:
             tau = y @ self.standard  # tau = Y(q, qd, qdd) p
         else:

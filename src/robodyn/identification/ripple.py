@@ -38,7 +38,17 @@ from robodyn.identification.estimate import FOLDS
 from robodyn.identification.friction_choice import MIN_GAIN
 from robodyn.identification.preprocess import Preprocess, Samples, evaluation_step, filtered_rows
 
-__all__ = ["RippleFit", "choose_ripple", "fit_ripple", "ripple_columns", "ripple_rows", "with_ripple"]
+__all__ = ["RippleFit", "choose_ripple", "fit_ripple", "gravity_free_joints", "ripple_columns",
+           "ripple_rows", "with_ripple"]
+
+#: Relative residual below which ``sin q_j, cos q_j`` count as explained by joint ``j``'s gravity
+#: columns (:func:`gravity_free_joints`).
+SPAN_TOL = 1e-3
+#: Directions of the gravity columns weaker than this fraction of the strongest (over all joints)
+#: do not count: a description's rounding (an axis tilted by 1e-5 rad) is no gravity torque.
+WEAK = 1e-4
+#: Random postures at which the gravity columns are evaluated.
+POSTURES = 64
 
 
 def ripple_columns(q: np.ndarray, revolute: np.ndarray) -> np.ndarray:
@@ -64,6 +74,48 @@ def ripple_rows(full: Sequence[Samples], settings: Preprocess, revolute: np.ndar
         m = evaluation_step(s.t, settings, d)
         out.append(filtered_rows(s.t[::m], ripple_columns(s.q[::m], revolute), settings, d // m))
     return out
+
+
+def gravity_free_joints(model: Any, revolute: np.ndarray, seed: int = 0) -> np.ndarray:
+    """The revolute joints whose own angle's first harmonic is not a gravity torque of theirs.
+
+    Joint ``j`` qualifies unless ``sin q_j`` and ``cos q_j`` lie in the span of its row of the
+    regressor at rest, ``Y(q, 0, 0)[j, :]`` over all postures (tested at :data:`POSTURES`
+    random postures: relative least-squares residual below :data:`SPAN_TOL`). Where they lie in
+    it (a shoulder or elbow lifting its own link) a ripple would be the same function of the
+    posture as the first moments of the link it lifts, and fitted after a fit pulled toward a
+    description it would take up the gravity the rigid-body parameters leave, which does not
+    carry over to postures held still; a vertical first axis or a roll joint keeps it.
+
+    Parameters
+    ----------
+    model : Model
+        Compiled model (its regressor).
+    revolute : numpy.ndarray of bool, shape (n,)
+    seed : int
+        Seed of the random postures (the test does not depend on it beyond rounding).
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (n,)
+    """
+    from robodyn.identification.stacking import regressor_rows_of
+
+    revolute = np.asarray(revolute, bool)
+    n = revolute.size
+    q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (POSTURES, n))
+    zero = np.zeros_like(q)
+    rows = regressor_rows_of(model, q, zero, zero)  # Y(q, 0, 0), (POSTURES, n, 15 n)
+    bases = [np.linalg.svd(rows[:, j, :], full_matrices=False)[:2] for j in range(n)]
+    strongest = max(float(s[0]) for _, s in bases if s.size)
+    keep = revolute.copy()
+    for j in np.flatnonzero(revolute):
+        u, s = bases[j]
+        u = u[:, s > WEAK * strongest]  # the joint's gravity (and offset) directions
+        harmonics = np.column_stack([np.sin(q[:, j]), np.cos(q[:, j])])
+        left = np.linalg.norm(harmonics - u @ (u.T @ harmonics)) / np.linalg.norm(harmonics)
+        keep[j] = bool(left > SPAN_TOL)  # not explained by its gravity columns
+    return keep
 
 
 @dataclass(frozen=True, eq=False)

@@ -306,7 +306,7 @@ def _model_states(t: np.ndarray, arrays: dict[str, np.ndarray], ident: Any,
                   cutoff: float | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The states (N, n) the model is evaluated at: as recorded, or processed as identification did."""
     q, qd, qdd = arrays["q"], arrays["qd"], arrays["qdd"]
-    settings = getattr(ident, "preprocess", None)
+    settings = getattr(ident, "prediction_settings", getattr(ident, "preprocess", None))
     if cutoff is None and settings is not None:
         cutoff = getattr(settings, "cutoff", None)
     if cutoff is None:

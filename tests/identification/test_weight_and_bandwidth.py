@@ -1,0 +1,93 @@
+"""The Tikhonov weight rule (least weight within one standard error of the best) and the
+prediction cut-off (``prediction_cutoff=``, robodyn.identification.bandwidth)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robodyn as rd
+from robodyn.identification.bandwidth import prediction_candidates
+from robodyn.identification.estimate import LAMBDA_GRID, cv_weight
+from robodyn.robot.errors import IdentificationError
+from tests.identification.helpers import load_quiet
+
+
+def test_weight_rule_prefers_the_data_unless_the_prior_is_clearly_better():
+    rng = np.random.default_rng(0)
+    k, count = 10, LAMBDA_GRID.size
+    # larger weights gain 0.1 % per grid step in total, but the blocks disagree by +-20 %
+    # (alternating): the gain is within one SE of the paired differences, the least weight wins
+    sign = np.where(np.arange(k) % 2 == 0, 1.0, -1.0)[:, None]
+    steps = np.arange(count)[None, :]
+    drift = 1.0 + 0.2 * sign * steps / (count - 1) - 0.001 * steps
+    assert int(np.argmin(drift.sum(axis=0))) == count - 1
+    assert cv_weight(drift) == 0.0
+    # the largest weight is better in every block by far more than the spread: it is taken
+    clear = np.ones((k, count)) + 0.01 * rng.standard_normal((k, count))
+    clear[:, -1] -= 0.5
+    assert cv_weight(clear) == LAMBDA_GRID[-1]
+    # a gain of 1 % in total with block differences of +-20 %: within one SE, the least weight
+    noisy = np.ones((k, count))
+    noisy[:, 5] = 1.0 - 0.01 + 0.2 * np.where(np.arange(k) % 2 == 0, 1.0, -1.0)
+    assert cv_weight(noisy) == 0.0
+
+
+def test_prediction_candidates_stop_below_a_fifth_of_the_rate():
+    assert prediction_candidates(5.0, 1000.0) == [5.0, 8.0, 12.5, 20.0]
+    assert prediction_candidates(5.0, 94.0) == pytest.approx([5.0, 8.0, 12.5, 18.8])
+    assert prediction_candidates(5.0, 25.0) == [5.0]
+
+
+@pytest.fixture(scope="module")
+def fast_run():
+    """PUMA 560 moving with content at 3-6 Hz, logged at 500 Hz with exact positions and 0.05 N m
+    torque noise; the fit is forced to a 1.5 Hz cut-off, below the motion."""
+    robot = load_quiet("puma560")
+    model = rd.compile_model(robot)
+    t = np.arange(0.0, 20.0, 0.002)
+    rng = np.random.default_rng(3)
+    q = np.zeros((t.size, 6)) + rng.uniform(-1, 1, 6)
+    qd, qdd = np.zeros_like(q), np.zeros_like(q)
+    for f, size in ((0.1, 0.5), (0.3, 0.3), (3.0, 0.02), (6.0, 0.01)):
+        w = 2 * np.pi * f
+        a = size * rng.choice([-1.0, 1.0], 6)
+        q += a * np.sin(w * t)[:, None]
+        qd += a * w * np.cos(w * t)[:, None]
+        qdd += -a * w * w * np.sin(w * t)[:, None]
+    tau = model.inverse_dynamics(q, qd, qdd)
+    noisy = tau + 0.05 * rng.standard_normal(tau.shape)
+    rec = rd.Recording(t=t, q=q, tau=noisy, joint_names=robot.joint_names, source="fast run")
+    return robot, model, rec, tau
+
+
+def test_auto_prediction_cutoff_widens_to_the_motion_and_predicts_it_better(fast_run):
+    robot, model, rec, tau = fast_run
+    fit = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False,
+                      friction="linear")
+    auto = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False,
+                       friction="linear", prediction_cutoff="auto")
+    assert fit.choices.prediction_cutoff is None and fit.prediction is None
+    # the motion reaches 6 Hz: the chosen cut-off is wider than the fit's
+    assert auto.choices.prediction_cutoff > 1.5
+    assert auto.prediction_settings.cutoff == auto.choices.prediction_cutoff
+    assert dict(auto.choices.prediction_scores).keys() >= {"1.5 Hz", "2.4 Hz"}
+    assert "prediction cut-off" in auto.choices.summary()
+    # the same parameters, evaluated on the wider states, are closer to the noise-free torque
+    err = [float(np.linalg.norm(i.predict(rec) - tau) / np.linalg.norm(tau)) for i in (fit, auto)]
+    assert err[1] < 0.5 * err[0]
+    np.testing.assert_array_equal(auto.standard, fit.standard)
+    # a fixed cut-off is used as given
+    fixed = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False,
+                        friction="linear", prediction_cutoff=9.0)
+    assert fixed.prediction_settings.cutoff == 9.0 and fixed.preprocess.cutoff == 1.5
+
+
+@pytest.mark.parametrize("value, message", [("wide", "expected a frequency in Hz, 'auto' or 'fit'"),
+                                            (-3.0, "expected a positive frequency"),
+                                            (True, "expected a frequency in Hz"),
+                                            (1e6, "must lie in")])
+def test_bad_prediction_cutoff_is_refused(fast_run, value, message):
+    robot, model, rec, _ = fast_run
+    with pytest.raises(IdentificationError, match=f"prediction_cutoff: {message}"):
+        rd.identify(robot, rec.slice(0.0, 2.0), target="tau", model=model, prediction_cutoff=value)
