@@ -182,6 +182,7 @@ METHODS: Sequence[tuple[str, dict]] = (("robodyn default", {}),
                                        ("wls (default before)", {"method": "wls"}),
                                        ("ols", {"method": "ols"}),
                                        ("no ripple", {"ripple": False}),
+                                       ("prediction cut-off auto", {"prediction_cutoff": "auto"}),
                                        ("stribeck", {"friction": "stribeck"}),
                                        ("thermal", {"thermal": True}))
 

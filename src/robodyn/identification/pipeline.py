@@ -193,7 +193,11 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     cands = candidates(opts.velocity, opts.dead_band, opts.thermal, measured, temps, DEAD_BAND, cutoffs)
     best, problem, scored = choose(cands, stacked)
     data, drive, prior, loads = problem.payload
-    step, thermal_fit = _linear_step(robot, data, drive.k, loads, prior, opts.method, opts.regularization,
+    # the consistent program's constraints bound what the weight bounds for least squares: its
+    # weight is the smallest within one standard error of the best (estimate.cv_weight)
+    reg = "auto-least" if opts.regularization == "auto" and opts.method == "consistent" \
+        else opts.regularization
+    step, thermal_fit = _linear_step(robot, data, drive.k, loads, prior, opts.method, reg,
                                      opts.weights, opts.state_noise)
     theta, standard = _estimate_standard(robot, data.relations, step, prior, opts.method, opts.bounds)
     result = _identification(robot, data, step, theta, standard, drive, target, opts.method)
