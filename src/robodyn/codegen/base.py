@@ -101,16 +101,7 @@ class Printer:
         """The complete text of one kernel in this language."""
         lines = self.open_function(kernel)
         body: list[str] = []
-        used = set()
-        for _, e in kernel.body:
-            used |= e.free_symbols
-        for arg in kernel.outputs:
-            for e in arg.entries:
-                used |= sp.sympify(e).free_symbols
-        for arg in kernel.inputs:
-            for k, sym in enumerate(arg.entries):
-                if sym in used:
-                    body.append(self.unpack(arg, k, sym))
+        body.extend(self.unpack(arg, k, sym) for arg, k, sym in kernel.used_inputs())
         body.extend(self.assign(s, e) for s, e in kernel.body)
         for arg in kernel.outputs:
             for k, e in enumerate(arg.entries):

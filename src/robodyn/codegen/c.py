@@ -214,19 +214,12 @@ class CPrinter(Printer):
         direct = direct or {}
         inline = f"{self.prefix.upper()}NOINLINE " if noinline else ""
         args = _parameters(core)
-        used: set[sp.Basic] = set()
-        for _, e in core.body:
-            used |= e.free_symbols
-        for arg in core.outputs:
-            for e in arg.entries:
-                used |= sp.sympify(e).free_symbols
         lines = [f"/* {core.summary}, for m_ <= {BLOCK} states stored structure-of-arrays. */",
                  f"{inline}static void {self.prefix}{core.name}(int m_, {', '.join(args)}) {{",
                  "    for (int k_ = 0; k_ < m_; ++k_) {"]
         ind = "        "
-        for arg in core.inputs:
-            lines += [f"{ind}const double {sym.name} = {arg.name}[{BLOCK * k} + k_];"
-                      for k, sym in enumerate(arg.entries) if sym in used]
+        lines += [f"{ind}const double {sym.name} = {arg.name}[{BLOCK * k} + k_];"
+                  for arg, k, sym in core.used_inputs()]
         lines += [ind + self.assign(s, e) for s, e in core.body]
         for arg in core.outputs:
             if arg.name in direct:

@@ -68,17 +68,6 @@ class _FExpr(FCodePrinter):
                 f"{self._print(cond)})")
 
 
-def _used_inputs(kernel: Kernel) -> list[tuple[Argument, int, sp.Symbol]]:
-    """Input scalars some assignment or output needs, as (argument, index, symbol)."""
-    used: set[sp.Symbol] = set()
-    for _, e in kernel.body:
-        used |= e.free_symbols
-    for arg in kernel.outputs:
-        for e in arg.entries:
-            used |= sp.sympify(e).free_symbols
-    return [(a, k, s) for a in kernel.inputs for k, s in enumerate(a.entries) if s in used]
-
-
 def _fortran_shape(arg: Argument) -> tuple[int, ...]:
     """Declared shape: vectors as they are, matrices transposed (C memory order)."""
     return arg.shape if len(arg.shape) == 1 else (arg.shape[1], arg.shape[0])
@@ -136,7 +125,7 @@ class FortranPrinter(Printer):
         lines += _join_declaration("real(c_double), intent(in)", dims, self.indent)
         outs = [f"{a.name}({', '.join(map(str, _fortran_shape(a)))})" for a in kernel.outputs]
         lines += _join_declaration("real(c_double), intent(out)", outs, self.indent)
-        scalars = [s.name for _, _, s in _used_inputs(kernel)] + [s.name for s in kernel.locals]
+        scalars = [s.name for _, _, s in kernel.used_inputs()] + [s.name for s in kernel.locals]
         lines += _join_declaration("real(c_double)", scalars, self.indent)
         return lines
 

@@ -107,6 +107,23 @@ class Kernel:
         """Every scalar the body assigns."""
         return tuple(s for s, _ in self.body)
 
+    def used_inputs(self) -> list[tuple[Argument, int, sp.Symbol]]:
+        """Input scalars some assignment or output needs.
+
+        Returns
+        -------
+        list of (Argument, int, Symbol)
+            The input argument, the scalar's row-major index in it and the scalar's symbol, in
+            the order of ``inputs`` and their entries (unused scalars left out).
+        """
+        used: set[sp.Basic] = set()
+        for _, e in self.body:
+            used |= e.free_symbols
+        for arg in self.outputs:
+            for e in arg.entries:
+                used |= sp.sympify(e).free_symbols
+        return [(a, k, s) for a in self.inputs for k, s in enumerate(a.entries) if s in used]
+
 
 @dataclass(frozen=True)
 class KernelSet:

@@ -15,6 +15,10 @@ from collections.abc import Iterable, Mapping, Sequence
 
 import sympy as sp
 
+from robodyn.symbolic.program import (
+    eliminate_common_subexpressions as eliminate_common_subexpressions,  # re-exported
+)
+
 Assignment = tuple[sp.Symbol, sp.Expr]
 
 #: Names no generated variable may take in any target language (keywords and common builtins).
@@ -75,41 +79,6 @@ def prune(assignments: Sequence[Assignment], outputs: Iterable[sp.Expr]) -> list
             kept.append((sym, expr))
             needed |= expr.free_symbols
     return kept[::-1]
-
-
-def eliminate_common_subexpressions(
-        assignments: Sequence[Assignment], outputs: Sequence[sp.Expr],
-        prefix: str = "t") -> tuple[list[Assignment], list[sp.Expr]]:
-    """``sympy.cse`` over a straight-line program, keeping a valid evaluation order.
-
-    Each extracted subexpression is emitted just before the first assignment (or output) that
-    uses it, after everything it uses.
-    """
-    taken = {s.name for s, _ in assignments}
-    names = (sp.Symbol(f"{prefix}{k}", real=True) for k in range(10**9)
-             if f"{prefix}{k}" not in taken)
-    rhs = [e for _, e in assignments] + list(outputs)
-    replacements, reduced = sp.cse(rhs, symbols=names, optimizations=None, order="none")
-    extracted = dict(replacements)
-    body: list[Assignment] = []
-    emitted: set[sp.Symbol] = set()
-
-    def emit_needed(expr: sp.Expr) -> None:
-        # depth-first: a subexpression's own subexpressions come first
-        for s in sorted(expr.free_symbols & extracted.keys() - emitted, key=lambda s: s.name):
-            if s in emitted:
-                continue
-            emit_needed(extracted[s])
-            emitted.add(s)
-            body.append((s, extracted[s]))
-
-    for (sym, _), expr in zip(assignments, reduced, strict=False):
-        emit_needed(expr)
-        body.append((sym, expr))
-    outs = list(reduced[len(assignments):])
-    for o in outs:
-        emit_needed(o)
-    return body, outs
 
 
 def safe_names(assignments: Sequence[Assignment], reserved: Iterable[str]) -> dict[sp.Symbol, sp.Symbol]:

@@ -167,8 +167,28 @@ def _pd_sampled(kp: np.ndarray, kd: np.ndarray, ref: Reference, n: int, t: np.nd
     return {"reference": np.hstack([q_r, qd_r]), "gain": np.hstack([_gain(kp, n, "kp"), _gain(kd, n, "kd")])}
 
 
+class _Tracking(Controller):
+    """A controller that follows a reference: a set point or a planned trajectory.
+
+    The dataclass field named by ``_reference_field`` (``q_ref`` unless a subclass names
+    another) holds the reference, a constant (n,) array (rad or m) or a
+    :class:`~robodyn.simulation.trajectory.JointTrajectory`; ``tau_limit`` (n,) N m or N.
+    Both are checked and frozen after construction.
+    """
+
+    _reference_field = "q_ref"
+
+    def __post_init__(self) -> None:
+        name = self._reference_field
+        object.__setattr__(self, name, _check_ref(getattr(self, name)))
+        object.__setattr__(self, "tau_limit", _limit(self.tau_limit))
+
+    def _ref(self) -> Reference:
+        return getattr(self, self._reference_field)
+
+
 @dataclass(frozen=True, eq=False)
-class PD(Controller):
+class PD(_Tracking):
     """``tau = Kp (q_ref - q) + Kd (qd_ref - qd)``.
 
     Parameters
@@ -186,19 +206,12 @@ class PD(Controller):
     q_ref: Reference
     tau_limit: np.ndarray | None = None
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "q_ref", _check_ref(self.q_ref))
-        object.__setattr__(self, "tau_limit", _limit(self.tau_limit))
-
-    def _ref(self) -> Reference:
-        return self.q_ref
-
     def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
         return {**_pd_sampled(self.kp, self.kd, self.q_ref, model.dof, t), "mode": "feedback"}
 
 
 @dataclass(frozen=True, eq=False)
-class PID(Controller):
+class PID(_Tracking):
     """``tau = Kp e + Ki integral(e dt) + Kd ed`` with ``e = q_ref - q``.
 
     ``ki`` must be diagonal (a scalar or (n,)). Used as a plain callable, the integral is
@@ -215,8 +228,7 @@ class PID(Controller):
     _state: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "q_ref", _check_ref(self.q_ref))
-        object.__setattr__(self, "tau_limit", _limit(self.tau_limit))
+        super().__post_init__()
         ki = np.asarray(self.ki, dtype=float)
         if ki.ndim > 1:
             raise InputError("PID: ki must be a scalar or an (n,) diagonal (the integral gain acts "
@@ -225,9 +237,6 @@ class PID(Controller):
     @property
     def has_integral(self) -> bool:
         return True
-
-    def _ref(self) -> Reference:
-        return self.q_ref
 
     def _ki(self, n: int) -> np.ndarray:
         return np.diag(_gain(self.ki, n, "ki")).copy()
@@ -252,7 +261,7 @@ class PID(Controller):
 
 
 @dataclass(frozen=True, eq=False)
-class GravityCompensation(Controller):
+class GravityCompensation(_Tracking):
     """PD plus the gravity load: ``tau = Kp e + Kd ed + g(q)``.
 
     Parameters as :class:`PD`. ``model``: the controller's model of the robot, needed for the
@@ -266,19 +275,12 @@ class GravityCompensation(Controller):
     tau_limit: np.ndarray | None = None
     model: Model | None = field(default=None, repr=False)
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "q_ref", _check_ref(self.q_ref))
-        object.__setattr__(self, "tau_limit", _limit(self.tau_limit))
-
-    def _ref(self) -> Reference:
-        return self.q_ref
-
     def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
         return {**_pd_sampled(self.kp, self.kd, self.q_ref, model.dof, t), "mode": "gravity"}
 
 
 @dataclass(frozen=True, eq=False)
-class ComputedTorque(Controller):
+class ComputedTorque(_Tracking):
     """Inverse-dynamics tracking of a planned trajectory.
 
     ``tau = M(q) (qdd_ref + Kp e + Kd ed) + h(q, qd)`` with ``h = C qd + g + friction`` (the
@@ -304,13 +306,7 @@ class ComputedTorque(Controller):
     kd: Any
     tau_limit: np.ndarray | None = None
     model: Model | None = field(default=None, repr=False)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "trajectory", _check_ref(self.trajectory))
-        object.__setattr__(self, "tau_limit", _limit(self.tau_limit))
-
-    def _ref(self) -> Reference:
-        return self.trajectory
+    _reference_field = "trajectory"
 
     def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
         _, _, qdd_r = _reference_at(self.trajectory, t, model.dof)

@@ -11,7 +11,7 @@ formulation's own straight-line form (after ``sympy.cse``) with NumPy, in second
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Literal
@@ -35,7 +35,7 @@ from robodyn.symbolic.kinematics import (
     joint_symbols,
 )
 from robodyn.symbolic.opcount import OpCount, cse_op_count
-from robodyn.symbolic.program import Program, Recorder
+from robodyn.symbolic.program import Program, Recorder, eliminate_common_subexpressions
 from robodyn.symbolic.regressor import (
     friction_columns,
     parameter_names,
@@ -345,34 +345,6 @@ def _merge(*programs: Program) -> tuple[list[dict[sp.Symbol, sp.Symbol]],
     return renames, out
 
 
-def _cse(assignments: Sequence[tuple[sp.Symbol, sp.Expr]], outputs: Sequence[sp.Expr]
-         ) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
-    """``sympy.cse`` over a straight-line program, each extracted term placed before its first use."""
-    taken = {s.name for s, _ in assignments}
-    names = (sp.Symbol(f"_c{k}", real=True) for k in range(10**9) if f"_c{k}" not in taken)
-    rhs = [e for _, e in assignments] + list(outputs)
-    replacements, reduced = sp.cse(rhs, symbols=names, optimizations=None, order="none")
-    extracted = dict(replacements)
-    body: list[tuple[sp.Symbol, sp.Expr]] = []
-    emitted: set[sp.Symbol] = set()
-
-    def emit(expr: sp.Expr) -> None:
-        # an extracted term's own extracted terms first
-        for sym in sorted(expr.free_symbols & extracted.keys() - emitted, key=lambda x: x.name):
-            if sym not in emitted:
-                emit(extracted[sym])
-                emitted.add(sym)
-                body.append((sym, extracted[sym]))
-
-    for (sym, _), expr in zip(assignments, reduced, strict=False):
-        emit(expr)
-        body.append((sym, expr))
-    outs = list(reduced[len(assignments):])
-    for o in outs:
-        emit(o)
-    return body, outs
-
-
 class _NumericFunction:
     """``M``, ``C``, ``g`` or ``tau`` of one formulation as a lambdified straight-line program."""
 
@@ -388,7 +360,7 @@ class _NumericFunction:
         free -= {s for s, _ in prog.assignments} | {s for v in joints for s in v}
         self.parameters = sorted(s.name for s in free)
         params = [sp.Symbol(p, real=True) for p in self.parameters]
-        body, outs = _cse(prog.assignments, list(prog.outputs))
+        body, outs = eliminate_common_subexpressions(prog.assignments, list(prog.outputs), "_c")
         # terms printed in their stored order: sorting every Add is half of lambdify's time
         printer = NumPyPrinter({"order": "none", "fully_qualified_modules": False, "inline": True,
                                 "allow_unknown_functions": True, "user_functions": {}})

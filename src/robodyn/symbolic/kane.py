@@ -31,8 +31,8 @@ import sympy as sp
 
 from robodyn import spatial as S
 from robodyn.robot.model import Robot
-from robodyn.symbolic.link_frames import joint_frames, tangent_matrix, tangents
-from robodyn.symbolic.program import Program, Recorder
+from robodyn.symbolic.link_frames import chain_program, tangent_matrix, tangents
+from robodyn.symbolic.program import Program
 
 
 @dataclass(frozen=True)
@@ -91,8 +91,7 @@ def kane(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
     KaneTerms
     """
     n = robot.dof
-    rec = Recorder({s.name for s in (*q, *qd, *qdd)} | set(robot.parameters))
-    geo = joint_frames(robot, q, rec)
+    rec, geo = chain_program(robot, q, qd, qdd)
     w = sp.zeros(3, 1)  # angular velocity of the previous link, its frame
     v = sp.zeros(3, 1)  # velocity of the previous link frame origin, its frame
     g = S.rotation(robot.base).T * robot.gravity  # gravity in the previous link frame

@@ -27,7 +27,7 @@ import sympy as sp
 from robodyn import spatial as S
 from robodyn.robot.model import Robot
 from robodyn.symbolic.coriolis import christoffel_program
-from robodyn.symbolic.link_frames import JointFrames, joint_frames, tangent, tangents
+from robodyn.symbolic.link_frames import JointFrames, chain_program, tangent, tangents
 from robodyn.symbolic.program import Program, Recorder
 
 
@@ -142,8 +142,7 @@ def lagrange(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
     LagrangeTerms
     """
     n = robot.dof
-    rec = Recorder({s.name for s in (*q, *qd, *qdd)} | set(robot.parameters))
-    geo = joint_frames(robot, q, rec)
+    rec, geo = chain_program(robot, q, qd, qdd)
     m = _mass_matrix(robot, geo, rec)
     potential = _potential(robot, geo, rec)
     v_prog = Program(tuple(rec.assignments), sp.ImmutableMatrix([[potential]])).pruned()

@@ -49,6 +49,29 @@ class JointFrames:
     trig: dict[sp.Expr, sp.Expr]
 
 
+def chain_program(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
+                  qdd: Sequence[sp.Symbol]) -> tuple[Recorder, JointFrames]:
+    """Start a formulation's straight-line program: a recorder and the joint frames in it.
+
+    Parameters
+    ----------
+    robot : Robot
+        The serial chain; its parameter names are reserved too.
+    q, qd, qdd : sequence of Symbol
+        The n joint variables: positions (rad or m), their rates and second rates. Only ``q``
+        enters the frames; all three names are reserved.
+
+    Returns
+    -------
+    rec : Recorder
+        Reserves the names of the joint variables and of the robot's parameters.
+    geo : JointFrames
+        :func:`joint_frames` of ``q``, its entries recorded in ``rec``.
+    """
+    rec = Recorder({s.name for s in (*q, *qd, *qdd)} | set(robot.parameters))
+    return rec, joint_frames(robot, q, rec)
+
+
 def joint_frames(robot: Robot, q: Sequence[sp.Expr], rec: Recorder) -> JointFrames:
     """Rotations ``R_k(q_k)`` (entries recorded), axes, offsets of every joint."""
     rots, axes, pres, offsets, pris = [], [], [], [], []

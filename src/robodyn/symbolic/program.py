@@ -109,3 +109,55 @@ def substitution_map(assignments: Sequence[tuple[sp.Symbol, sp.Expr]]) -> dict[s
     for sym, expr in assignments:
         values[sym] = expr.xreplace(values)
     return values
+
+
+def eliminate_common_subexpressions(
+        assignments: Sequence[tuple[sp.Symbol, sp.Expr]], outputs: Sequence[sp.Expr],
+        prefix: str = "t") -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
+    """``sympy.cse`` over a straight-line program, keeping a valid evaluation order.
+
+    Each extracted subexpression is emitted just before the first assignment (or output) that
+    uses it, after everything it uses.
+
+    Parameters
+    ----------
+    assignments : sequence of (Symbol, Expr), length A
+        The program's assignments in evaluation order.
+    outputs : sequence of Expr, length K
+        The program's outputs (scalars, in terms of the assigned symbols).
+    prefix : str
+        Names of the extracted subexpressions: ``prefix0``, ``prefix1``, ... skipping names the
+        assignments already use.
+
+    Returns
+    -------
+    body : list of (Symbol, Expr)
+        The assignments (A of them) with the extracted ones interleaved, in evaluation order.
+    outputs : list of Expr, length K
+        The outputs in terms of the body's symbols.
+    """
+    taken = {s.name for s, _ in assignments}
+    names = (sp.Symbol(f"{prefix}{k}", real=True) for k in range(10**9)
+             if f"{prefix}{k}" not in taken)
+    rhs = [e for _, e in assignments] + list(outputs)
+    replacements, reduced = sp.cse(rhs, symbols=names, optimizations=None, order="none")
+    extracted = dict(replacements)
+    body: list[tuple[sp.Symbol, sp.Expr]] = []
+    emitted: set[sp.Symbol] = set()
+
+    def emit_needed(expr: sp.Expr) -> None:
+        # depth-first: a subexpression's own subexpressions come first
+        for s in sorted(expr.free_symbols & extracted.keys() - emitted, key=lambda s: s.name):
+            if s in emitted:
+                continue
+            emit_needed(extracted[s])
+            emitted.add(s)
+            body.append((s, extracted[s]))
+
+    for (sym, _), expr in zip(assignments, reduced, strict=False):
+        emit_needed(expr)
+        body.append((sym, expr))
+    outs = list(reduced[len(assignments):])
+    for o in outs:
+        emit_needed(o)
+    return body, outs
