@@ -29,10 +29,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robodyn.robot.errors import SimulationError
+
 __all__ = ["Deflection", "DeflectionNotConvergedError", "exact_deflection"]
 
 
-class DeflectionNotConvergedError(ValueError):
+class DeflectionNotConvergedError(SimulationError):
     """Newton's method found no static equilibrium (compliance so large the arm would fold)."""
 
 

@@ -136,6 +136,6 @@ def with_parameters(robot: Robot, values: Mapping[str, float]) -> Robot:
     """A copy of ``robot`` with new default values for some named parameters."""
     unknown = set(values) - set(robot.parameters)
     if unknown:
-        raise KeyError(f"{robot.source}: unknown parameter(s) {sorted(unknown)}")
+        raise InputError(f"{robot.source}: unknown parameter(s) {sorted(unknown)}")
     merged = {**robot.parameters, **{k: float(v) for k, v in values.items()}}
     return replace(robot, parameters=merged, description_hash="")
