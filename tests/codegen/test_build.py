@@ -205,3 +205,45 @@ def test_cached_library_loads_without_a_compiler(cache: Path, monkeypatch) -> No
     finally:
         monkeypatch.undo()
         openmp_flags.cache_clear()
+
+
+@pytest.mark.parametrize("content", ["x = 1\n", "", "import numpy\nDOF = 2\n"])
+def test_cached_module_that_imports_but_is_not_the_generated_one_is_generated_again(
+        cache: Path, content: str) -> None:
+    # probe 23: a cached rd_model_*.py overwritten with valid Python (or emptied) imported fine
+    # and every later run failed with "has no attribute 'state_derivative'"
+    import numpy as np
+
+    import robodyn as rd
+
+    robot = rd.load("planar_2r")
+    q = np.array([0.3, -0.4])
+    expected = rd.compile_model(robot, backend="numpy").inverse_dynamics(q, q, q)
+    (src,) = cache.glob("rd_model_*.py")
+    good = src.read_bytes()
+    assert good.splitlines()[-1].startswith(b"# robodyn-sha256: ")
+    src.write_text(content)
+    sys.modules.pop(f"robodyn_generated_{src.stem.removeprefix('rd_model_')}", None)
+    again = rd.compile_model(robot, backend="numpy")
+    np.testing.assert_array_equal(again.inverse_dynamics(q, q, q), expected)
+    assert src.read_bytes() == good  # generated again, whole
+
+
+@pytest.mark.tool("cc")
+@pytest.mark.parametrize("entry", ["../../etc/passwd", "/etc/passwd", "sub/rd_0123456789abcdef01234567.so",
+                                   "rd_0123456789abcdef01234567.c", "\udcff"])
+def test_index_naming_anything_but_an_own_library_is_ignored(
+        cache: Path, monkeypatch: pytest.MonkeyPatch, entry: str) -> None:
+    # probe 23: a path in the .src index stopped every run with "ValueError: Invalid name"
+    lib = compile_library(source(50), DECL)
+    (index,) = cache.glob("rd_*.src")
+    index.write_bytes(entry.encode("utf-8", "surrogateescape") + b"\n")
+    assert build._indexed(index) is None
+    again = compile_library(source(50), DECL)  # with a compiler: the index is rewritten
+    assert again.path == lib.path and again.lib.rd_test_twice(1.0) == 2.0 + 50
+    assert index.read_text() == lib.path.name + "\n"
+    index.write_bytes(entry.encode("utf-8", "surrogateescape") + b"\n")
+    monkeypatch.setenv("PATH", str(cache / "no-tools"))
+    monkeypatch.setenv("CC", "")
+    with pytest.raises(build.CompilerNotFoundError):  # without one: as for a source never built
+        compile_library(source(50), DECL)

@@ -50,8 +50,15 @@ def test_study_file_expands_grid_times_samples(tmp_path):
     (("settings: {dt: 0.005}", "settings: {step: 0.005}"), r"study.yaml: settings: .*'step'"),
     # case-count bombs, refused before any case is built (issue 23: 15-23 GB before)
     (("sampler: {kind: random, n: 2}", "sampler: {kind: random, n: 1000000000}"),
-     r"study.yaml: sampler.n = 1000000000 times a grid of 6: 6e\+09 cases, more than 1,000,000"),
-    (("seed: 4", "seed: 4\nrepeat: 1000000000"), r"study.yaml: repeat: 1e\+09 cases, more than"),
+     r"study.yaml: parameters.payload = 2 times parameters.zeta.steps = 3 times "
+     r"sampler.n = 1000000000: 6e\+09 cases, more than 1,000,000"),
+    (("seed: 4", "seed: 4\nrepeat: 1000000000"),
+     r"study.yaml: .* times repeat = 1000000000: 1.2e\+10 cases, more than"),
+    # probe 23: steps: 1e12 was a 7 TiB linspace (MemoryError), 1e8 took > 4 GB before refusal
+    (("steps: 3}", "steps: 1000000000000}"),
+     r"study.yaml: parameters.payload = 2 times parameters.zeta.steps = 1000000000000 times "
+     r"sampler.n = 2: 4e\+12 cases, more than 1,000,000 \(fewer values"),
+    (("steps: 3}", "steps: 100000000}"), r"study.yaml: .*zeta.steps = 100000000 .*: 4e\+08 cases"),
 ])
 def test_bad_study_file_is_named(tmp_path, change, message):
     path = _write(tmp_path, GOOD.replace(*change))
@@ -134,8 +141,34 @@ def test_grid_bomb_refused_before_expansion(tmp_path, monkeypatch):
     text = GOOD.replace("  payload: [0, 50]", f"  payload: {values}").replace(
         "  bandwidth_hz: {min: 2, max: 8}\n", f"  bandwidth_hz: {values}\n").replace(
         "sampler: {kind: random, n: 2}\n", "")
-    with pytest.raises(StudyError, match=r"study.yaml: parameters: a grid over payload, bandwidth_hz, "
-                                         r"zeta: 3e\+06 cases, more than 1,000,000 .*ROBODYN_MAX_CASES"):
+    with pytest.raises(StudyError, match=r"study.yaml: parameters.payload = 1000 times parameters."
+                                         r"bandwidth_hz = 1000 times parameters.zeta.steps = 3: "
+                                         r"3e\+06 cases, more than 1,000,000 .*ROBODYN_MAX_CASES"):
         read_study(_write(tmp_path, text))
     monkeypatch.setenv("ROBODYN_MAX_CASES", "5000000")  # the limit a deliberate study raises
     assert read_study(_write(tmp_path, text)).varying == ("payload", "bandwidth_hz", "zeta")
+
+
+@pytest.mark.parametrize("field, text", [
+    ("parameters.bandwidth_hz.steps = 1000000000000",
+     "  bandwidth_hz: {min: 2.0, max: 8.0, steps: 1000000000000}\n"),
+    ("parameters.bandwidth_hz.steps = 100000000",
+     "  bandwidth_hz: {min: 2.0, max: 8.0, steps: 100000000}\n"),
+    ("sampler.n = 1000000000000", "  bandwidth_hz: {min: 2.0, max: 8.0}\nsampler: {n: 1000000000000}\n"),
+])
+def test_cli_declared_case_count_refused_before_anything_is_built(tmp_path, capsys, monkeypatch,
+                                                                   field, text):
+    # probe 23: steps: 1e12 exited 1 with "MemoryError ... 7.28 TiB"; the count is now the
+    # product of the declared sizes, refused before any value list or array exists
+    from robodyn.studies import study_file
+
+    def no_values(*args, **kwargs):
+        raise AssertionError("the values were built before the case count was checked")
+
+    monkeypatch.setattr(study_file, "_split_parameters", no_values)
+    path = _write(tmp_path, SIZING + "parameters:\n  payload: [0]\n" + text)
+    assert main(["sweep", str(path), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"study.yaml: {field}: " in err[0]
+    assert "cases, more than 1,000,000 (fewer values or sample points" in err[0]
+    assert not (tmp_path / "out").exists()

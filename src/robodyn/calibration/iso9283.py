@@ -160,7 +160,14 @@ def cube_points(center, size: float = 0.5, *, fraction: float = 0.1, rotation=No
         Distance of P2..P5 from the corners as a fraction of the diagonal (ISO: 0.10 +- 0.02).
     rotation : array_like, shape (3, 3), optional
         Orientation of the cube.
+
+    Raises
+    ------
+    InputError
+        When ``size`` is not a positive finite number, or ``fraction`` is outside 0.08..0.12.
     """
+    if isinstance(size, bool) or not isinstance(size, int | float | np.number) or not 0 < size < np.inf:
+        raise InputError(f"ISO 9283 cube: size must be a positive finite edge length in m, got {size!r}")
     if not 0.08 <= fraction <= 0.12:
         raise InputError(f"ISO 9283 puts P2..P5 at 10 % +- 2 % of the diagonal; got {fraction:.3g}")
     c = cube_corners(center, size, rotation)

@@ -8,16 +8,37 @@ one line and exit code 2.
 from __future__ import annotations
 
 import argparse
+import os
 import warnings
 from pathlib import Path
+from typing import Any
 
 import robodyn as rd
 from robodyn.cli.args import ROBOT_HELP
+from robodyn.robot.errors import InputError
+
+
+def _output_file(text: str) -> Path:
+    """The ``-o`` trajectory file, checked before the design runs (minutes): a folder is refused
+    (exit 2), a missing parent folder is created, as for every command's ``-o``."""
+    out = Path(text)
+    if not text.strip() or out.is_dir() or text.endswith(("/", os.sep)):
+        raise InputError(f"-o {text!r} names a folder, not a file; give the CSV file to write, "
+                         f"e.g. {out / 'excitation.csv'}")
+    if out.parent.exists() and not out.parent.is_dir():
+        raise InputError(f"-o {text}: {out.parent} is a file, not a folder")
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"-o {text}: cannot create its folder {out.parent}: "
+                         f"{exc.strerror or exc}") from None
+    return out
 
 
 def _cmd_excite(args: argparse.Namespace) -> int:
     from robodyn.studies.excitation import excitation_limits
 
+    output = _output_file(args.output)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         robot = rd.load(args.robot)
@@ -26,7 +47,7 @@ def _cmd_excite(args: argparse.Namespace) -> int:
                        duration=args.duration, limits=limits, criterion=args.criterion,
                        starts=args.starts, seed=args.seed, dt=args.dt, gradient=args.gradient,
                        progress=True)
-    path = ex.to_csv(args.output)
+    path = ex.to_csv(output)
     print(f"{robot.name}: {ex.series.harmonics} harmonics at {ex.series.base_frequency:g} Hz, "
           f"{ex.duration:g} s, {len(ex.columns)} base columns")
     print(f"condition number {ex.condition_number:.1f} (starts: "
@@ -36,7 +57,7 @@ def _cmd_excite(args: argparse.Namespace) -> int:
 
 
 def _cmd_testprog(args: argparse.Namespace) -> int:
-    from robodyn.studies.testprog import iso_cube, jointwise
+    from robodyn.studies.testprog import jointwise
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -44,12 +65,26 @@ def _cmd_testprog(args: argparse.Namespace) -> int:
     if args.kind == "jointwise":
         prog = jointwise(robot, speeds=args.speeds, dt=args.dt)
     else:
-        prog = iso_cube(robot, size=args.size, cycles=args.cycles, dt=args.dt)
+        prog = _iso_cube(robot, args)
     traj, segs = prog.to_csv(Path(args.output))
     moves = sum(s.kind == "move" for s in prog.segments)
     print(f"{robot.name}: {prog.name} program, {moves} moves, {prog.duration:.1f} s")
     print(f"wrote {traj} and {segs}")
     return 0
+
+
+def _iso_cube(robot: rd.Robot, args: argparse.Namespace) -> Any:
+    """The ISO 9283 cube program, ``--size`` checked first and named when a test point is out of
+    reach (:class:`~robodyn.simulation.UnreachableError`, bad input: exit 2)."""
+    from robodyn.simulation.ik import UnreachableError
+    from robodyn.studies.testprog import iso_cube
+
+    if not 0 < args.size < float("inf"):
+        raise InputError(f"--size: the cube edge must be a positive number of metres, got {args.size:g}")
+    try:
+        return iso_cube(robot, size=args.size, cycles=args.cycles, dt=args.dt)
+    except UnreachableError as exc:
+        raise InputError(f"--size {args.size:g}: {exc} (choose a smaller cube)") from None
 
 
 def register(sub: argparse._SubParsersAction, fmt: type) -> None:

@@ -344,15 +344,16 @@ def _source_key(source: str) -> str:
 
 
 def _indexed(index: Path) -> Path | None:
-    """The intact cached library an index file names, or None."""
+    """The intact cached library an index file names, or None (also for a name that is not one
+    of the cache's own library names, such as a path: checked before it is used as a name)."""
     try:
         name = index.read_text(encoding="utf-8").strip()
-    except OSError:
+    except (OSError, UnicodeDecodeError):
+        return None
+    if not _OWN_NAME.fullmatch(name) or not name.endswith(".so"):
         return None
     target = index.with_name(name)
-    if not _OWN_NAME.fullmatch(name) or not name.endswith(".so") or not _intact(target):
-        return None
-    return target
+    return target if _intact(target) else None
 
 
 def _write_index(index: Path, target: Path) -> None:

@@ -40,6 +40,7 @@ from robodyn.numeric.model_cache import (
     _import_file,
     _kernels_cached,
     _write_atomic,
+    _write_checked,
     openmp_flags,
 )
 from robodyn.numeric.rollout import rollout, thread_count
@@ -526,7 +527,7 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
 
         def write_py() -> None:
             kset = _kinematic_safe(robot, values, runtime, marker)
-            _write_atomic(path, PythonPrinter().module(kset))
+            _write_checked(path, PythonPrinter().module(kset))
 
         impl = _from_cache((path,), write_py, lambda: _import_file(path, f"robodyn_generated_{key}"))
         sources = (path,)
@@ -578,7 +579,7 @@ def _compile_derivatives(model: Model, names: tuple[str, ...] = DERIVATIVE_KERNE
 
         def write_py() -> None:
             kset = build_kernels(robot, values, names=names, runtime=runtime)
-            _write_atomic(path, PythonPrinter().module(kset))
+            _write_checked(path, PythonPrinter().module(kset))
 
         impl = _from_cache((path,), write_py,
                            lambda: _import_file(path, f"robodyn_generated_{tag}_{key}"))

@@ -122,10 +122,43 @@ def _kernels_cached(robot: Robot, parameters: Mapping[str, float] | None,
     return _KERNEL_MEMO[key]
 
 
+#: The last line of a cached generated module: the SHA-256 of the text above it.
+_CHECK_PREFIX = "# robodyn-sha256: "
+
+
+def _write_checked(path: Path, text: str) -> None:
+    """Write a generated module to the cache with its checksum as the last line (see
+    :func:`_import_file`)."""
+    body = (text if text.endswith("\n") else text + "\n").encode("utf-8")
+    data = body + f"{_CHECK_PREFIX}{hashlib.sha256(body).hexdigest()}\n".encode()
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+    with os.fdopen(fd, "wb") as fh:  # bytes: no newline or encoding translation
+        fh.write(data)
+    os.replace(tmp, path)
+
+
+def _verify_checksum(path: Path) -> None:
+    """Raise ValueError unless ``path`` ends with the checksum line :func:`_write_checked` wrote
+    and the text above it matches it (a truncated, emptied or edited cache file)."""
+    data = path.read_bytes()
+    body, _, last = data.rstrip(b"\n").rpartition(b"\n")
+    digest = hashlib.sha256(body + b"\n").hexdigest()
+    expected = f"{_CHECK_PREFIX}{digest}".encode()
+    if not body or last != expected:
+        raise ValueError(f"{path}: the cached generated module does not match its checksum")
+
+
 def _import_file(path: Path, name: str) -> ModuleType:
-    """Import a generated NumPy module (once per process)."""
+    """Import a generated NumPy module (once per process), written by :func:`_write_checked`.
+
+    Raises
+    ------
+    ValueError
+        When the file does not match its checksum (the caller generates it again).
+    """
     if name in sys.modules:
         return sys.modules[name]
+    _verify_checksum(path)
     spec = importlib.util.spec_from_file_location(name, path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)

@@ -23,8 +23,13 @@ from robodyn.numeric.model import Model
 from robodyn.robot.errors import InputError
 
 
-class UnreachableError(ValueError):
-    """The inverse kinematics found no joint values that reach the target within the limits."""
+class UnreachableError(InputError):
+    """The inverse kinematics found no joint values that reach the target within the limits.
+
+    An :class:`~robodyn.errors.InputError` (so a :class:`~robodyn.errors.RobodynError` and a
+    ``ValueError``): a target out of reach is bad input, which the command line reports in one
+    line with exit code 2.
+    """
 
 
 @dataclass(frozen=True, eq=False)

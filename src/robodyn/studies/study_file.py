@@ -96,6 +96,7 @@ def _range(spec: Mapping[str, Any], where: str) -> Range | list[float]:
     if "steps" not in spec:
         return r
     steps = _int(spec["steps"], f"{where}.steps", 1)
+    check_case_count(steps, f"{where}.steps")  # before its values are built
     # evenly spaced grid values (in log when log: true)
     values = r.scale(np.linspace(0.0, 1.0, steps)) if steps > 1 else np.array([r.low])
     return [int(v) if r.integer else float(v) for v in values]
@@ -117,10 +118,10 @@ def read_study(path: str | Path) -> Study:
     params = data.get("parameters") or {}
     if not isinstance(params, dict) or not params:
         raise StudyError(f"{name}: parameters: expected a mapping of parameter name -> values or range")
-    grid, ranges, fixed = _split_parameters(params, task, name)
     seed = _int(data.get("seed", 0), f"{name}: seed")
     repeat = _int(data.get("repeat", 1), f"{name}: repeat", 1)
-    check_case_count(repeat, f"{name}: repeat")  # before its list of counters is built
+    _check_declared_count(params, data.get("sampler"), repeat, name)
+    grid, ranges, fixed = _split_parameters(params, task, name)
     if repeat > 1:
         grid["repeat"] = list(range(repeat))
     cases = _cases(data.get("sampler"), grid, ranges, fixed, seed, name)
@@ -134,6 +135,40 @@ def read_study(path: str | Path) -> Study:
     if "repeat" in grid and "repeat" not in task.parameters():
         task = _Repeat(task)
     return Study(path, task, cases, seed, batch, varying, plot)
+
+
+def _declared_sizes(params: Mapping[str, Any], sampler: Any, repeat: int) -> dict[str, int]:
+    """The number of values each field declares, by field (``parameters.<name>`` for a list,
+    ``parameters.<name>.steps`` for a range with steps, ``sampler.n`` when a range is sampled,
+    ``repeat``), read from the file without building any of them; a malformed size counts 1
+    (its field's own check reports it)."""
+    sizes: dict[str, int] = {}
+    sampled = False
+    for key, value in params.items():
+        if isinstance(value, list):
+            sizes[f"parameters.{key}"] = len(value)
+        elif isinstance(value, dict) and "steps" in value:
+            steps = value["steps"]
+            if isinstance(steps, int) and not isinstance(steps, bool) and steps > 1:
+                sizes[f"parameters.{key}.steps"] = steps
+        elif isinstance(value, dict):
+            sampled = True
+    n = sampler.get("n") if isinstance(sampler, dict) else None
+    if sampled and isinstance(n, int) and not isinstance(n, bool) and n > 1:
+        sizes["sampler.n"] = n
+    if repeat > 1:
+        sizes["repeat"] = repeat
+    return sizes
+
+
+def _check_declared_count(params: Mapping[str, Any], sampler: Any, repeat: int, name: str) -> None:
+    """Refuse a study whose declared sizes multiply to more cases than the limit, before any
+    list, grid value or sample point is built (``steps: 1e12`` was a 7 TiB allocation)."""
+    sizes = _declared_sizes(params, sampler, repeat)
+    count = math.prod(sizes.values())
+    big = {k: v for k, v in sizes.items() if v > 1}
+    fields = " times ".join(f"{k} = {v}" for k, v in big.items()) or "parameters"
+    check_case_count(count, f"{name}: {fields}")
 
 
 def _load_mapping(path: Path) -> dict[str, Any]:
