@@ -48,6 +48,7 @@ def test_parser_literals_match_their_sources():
     from robodyn.cli import identify as cli_identify
     from robodyn.cli import workflows as cli_workflows
     from robodyn.codegen.build import DEFAULT_CACHE_MAX_MB
+    from robodyn.identification import options
     from robodyn.identification.friction import FRICTION_MODELS
     from robodyn.report.agreement import TOLERANCE
     from robodyn.simulation.simulation import ADAPTIVE, FIXED_STEP, MAX_SAMPLES
@@ -62,6 +63,8 @@ def test_parser_literals_match_their_sources():
     assert cli_workflows.MODELS == tuple(MODELS)
     assert cli_workflows.DEFLECTIONS == tuple(DEFLECTIONS)
     assert cli_identify.FRICTION_MODELS == tuple(FRICTION_MODELS)
+    assert (cli_identify.METHODS, cli_identify.VELOCITIES, cli_identify.SENSORS,
+            cli_identify.SPIKES) == (options.METHODS, options.VELOCITIES, options.SENSORS, options.SPIKES)
     assert cli_cache.DEFAULT_CACHE_MAX_MB == DEFAULT_CACHE_MAX_MB
 
 

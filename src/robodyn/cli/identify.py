@@ -24,10 +24,14 @@ from robodyn.text import err, progress
 
 __all__ = ["register"]
 
-# The --friction choices, kept here so that building the parser does not import the
+# The choice lists of the parser, kept here so that building it does not import the
 # identification package; tests/calibration/test_startup.py checks them against
-# robodyn.identification.friction.FRICTION_MODELS.
+# robodyn.identification.friction.FRICTION_MODELS and robodyn.identification.options.
 FRICTION_MODELS: tuple[str, ...] = ("none", "linear", "stribeck", "load", "polynomial")
+METHODS: tuple[str, ...] = ("ols", "wls", "consistent")
+VELOCITIES: tuple[str, ...] = ("auto", "position", "measured")
+SENSORS: tuple[str, ...] = ("motor", "link")
+SPIKES: tuple[str, ...] = ("keep", "drop")
 
 
 def tqdm(*args: object, **kwargs: object) -> object:
@@ -365,7 +369,7 @@ def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
     p.add_argument("--data", required=True, nargs="+", metavar="FILE",
                    help="identification recordings (CSV, CSV.gz or MCAP)")
     p.add_argument("--validate", nargs="+", metavar="FILE", help="held-out recordings to validate on")
-    p.add_argument("--method", choices=("ols", "wls", "consistent"), default="consistent",
+    p.add_argument("--method", choices=METHODS, default="consistent",
                    help="estimator: ordinary or weighted least squares, or physically consistent "
                         "(pseudo-inertia LMIs) (default: %(default)s)")
     p.add_argument("--gains", type=floats, metavar="K",
@@ -430,7 +434,7 @@ def _prediction_cutoff(text: str) -> float | str:
 
 def _preprocessing(p: argparse.ArgumentParser) -> None:
     """The identification's preprocessing options (rd.identify's keywords of the same names)."""
-    p.add_argument("--velocity", choices=("auto", "position", "measured"), default="auto",
+    p.add_argument("--velocity", choices=VELOCITIES, default="auto",
                    help="joint velocity source: differences of the filtered positions, the "
                         "filtered measured velocity, or auto: chosen by held-out time blocks "
                         "(printed under 'choices') (default: %(default)s)")
@@ -438,7 +442,7 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
                    help="Coulomb dead band in rad/s, in the fit and the prediction alike (below "
                         "it a joint carries only its friction offset), or auto: 0 or 1e-3 chosen "
                         "by held-out time blocks (default: %(default)s)")
-    p.add_argument("--spikes", choices=("keep", "drop"), default="keep",
+    p.add_argument("--spikes", choices=SPIKES, default="keep",
                    help="one-sample glitches (a position or target sample far off the line "
                         "through its neighbours) in the identification recordings: keep them, or "
                         "drop those rows before the fit (default: %(default)s)")
@@ -462,7 +466,7 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
     p.add_argument("--decimate", type=_auto_or(int), default="auto", metavar="K",
                    help="keep every K-th filtered sample for the fit, or auto: about five per "
                         "cut-off period (default: %(default)s)")
-    p.add_argument("--sensor", choices=("motor", "link"), default="motor",
+    p.add_argument("--sensor", choices=SENSORS, default="motor",
                    help="where the effort is measured: motor (current, or a torque that includes "
                         "the drive) or link (a joint torque sensor after the gear: the rotor "
                         "inertia is not identified; --target tau) (default: %(default)s)")

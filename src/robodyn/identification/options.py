@@ -18,10 +18,13 @@ import numpy as np
 from robodyn.identification.friction import FRICTION_MODELS
 from robodyn.robot.errors import IdentificationError
 
-__all__ = ["METHODS", "WEIGHTS", "IdentifyOptions"]
+__all__ = ["METHODS", "SENSORS", "SPIKES", "VELOCITIES", "WEIGHTS", "IdentifyOptions"]
 
 METHODS = ("ols", "wls", "consistent")
 WEIGHTS = ("residual", "state-noise")
+VELOCITIES = ("auto", "position", "measured")
+SENSORS = ("motor", "link")
+SPIKES = ("keep", "drop")
 
 
 @dataclass(frozen=True, eq=False)
@@ -124,15 +127,15 @@ class IdentifyOptions:
         if self.weights == "state-noise" and self.state_noise is None:
             raise IdentificationError("state_noise: weights='state-noise' needs the state noise "
                                       "(s_q, s_qd, s_qdd) in rad, rad/s, rad/s^2")
-        _choice("velocity", self.velocity, ("auto", "position", "measured"))
-        _choice("sensor", self.sensor, ("motor", "link"))
+        _choice("velocity", self.velocity, VELOCITIES)
+        _choice("sensor", self.sensor, SENSORS)
         if not any(self.thermal is v for v in (False, True)) and self.thermal != "auto":
             raise IdentificationError(f"thermal: expected False, True or 'auto', got {self.thermal!r}")
         if isinstance(self.dead_band, str) and self.dead_band != "auto":
             raise IdentificationError(f"dead_band: expected a velocity in rad/s or 'auto', got "
                                       f"{self.dead_band!r}")
         _choice("gains", self.gains, ("auto", "description", "absorbed"))
-        _choice("spikes", self.spikes, ("keep", "drop"))
+        _choice("spikes", self.spikes, SPIKES)
         if not any(self.ripple is v for v in (False, True)) and self.ripple != "auto":
             raise IdentificationError(f"ripple: expected False, True or 'auto', got {self.ripple!r}")
         pc = self.prediction_cutoff
