@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 import robodyn as rd
 from robodyn.cli import cache, excite, identify, record, sweep, underwater, workflows
 from robodyn.cli.args import ROBOT_HELP as _ROBOT_HELP
+from robodyn.cli.args import positive_int
 from robodyn.robot.errors import RobodynError
 from robodyn.text import err as _err
 from robodyn.text import progress as _progress
@@ -307,7 +308,7 @@ def _add_model_parsers(sub: argparse._SubParsersAction, fmt: type) -> None:
                        epilog="examples:\n  robodyn check planar_2r\n"
                               "  robodyn check puma560 --samples 50 --seed 1")
     p.add_argument("robot", metavar="ROBOT", help=_ROBOT_HELP)
-    p.add_argument("--samples", type=_positive, default=20, metavar="N",
+    p.add_argument("--samples", type=positive_int, default=20, metavar="N",
                    help="number of random states (default: %(default)s)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     p.set_defaults(func=_cmd_check)
@@ -359,17 +360,12 @@ def _add_demo_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
                        epilog="example:\n  robodyn demo -o out   # then open out/report.html")
     p.add_argument("-o", "--output", metavar="DIR", default="out",
                    help="output folder, created if missing (default: %(default)s)")
-    p.add_argument("--samples", type=_positive, default=20, metavar="N",
+    p.add_argument("--samples", type=positive_int, default=20, metavar="N",
                    help="number of random states for the agreement check (default: %(default)s)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     p.set_defaults(func=_cmd_demo)
 
 
-def _positive(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text}")
-    return value
 
 
 def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,

@@ -18,6 +18,14 @@ __all__ = ["BACKENDS", "BACKEND_HELP", "ROBOT_HELP", "floats", "resolve_backend"
 ROBOT_HELP = "built-in robot name (see 'robodyn list') or path to a .yaml/.yml/.urdf description"
 
 
+def positive_int(text: str) -> int:
+    """An argparse type: an integer of at least 1 (a count: samples, workers, a batch size)."""
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text}")
+    return value
+
+
 def floats(text: str) -> np.ndarray:
     """A comma-separated list of numbers (``0,0.5,-1``); an argparse type."""
     try:

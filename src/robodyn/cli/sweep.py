@@ -11,15 +11,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from robodyn.cli.args import positive_int
+
 __all__ = ["register"]
-
-
-def _positive(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text}")
-    return value
-
 
 #: ``--ship`` choices and ``sweep(ship=...)``.
 _SHIP = {"auto": None, "always": True, "never": False}
@@ -86,9 +80,9 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder (created)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="address of a running Dask scheduler, e.g. tcp://host:8786")
-    p.add_argument("--workers", type=_positive, metavar="N",
+    p.add_argument("--workers", type=positive_int, metavar="N",
                    help="worker processes of the local cluster (default: the CPU cores)")
-    p.add_argument("--batch", type=_positive, metavar="N",
+    p.add_argument("--batch", type=positive_int, metavar="N",
                    help="cases per Dask task (default: the study file's, else at least 256 tasks, "
                         "4 per worker thread on a bigger cluster)")
     p.add_argument("--ship", choices=tuple(_SHIP), default="auto",
