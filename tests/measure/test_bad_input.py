@@ -208,7 +208,7 @@ def test_gzip_bomb_and_long_files_refused_while_reading(tmp_path, monkeypatch, c
     with pytest.raises(RecordingError, match=r"long.csv: 300001 lines, more than the 1000 read "
                                              r"\(set ROBODYN_MAX_ROWS"):
         rd.read_recording(plain)
-    # short cells under the size limit: refused by their count (5 x 10^7 by default), before parsing
+    # short cells under the size limit: refused by their count (2 x 10^7 by default), before parsing
     monkeypatch.setenv("ROBODYN_MAX_ROWS", "1000000")
     monkeypatch.setenv("ROBODYN_MAX_CELLS", "100000")
     with pytest.raises(RecordingError, match=r"long.csv: 300001 lines of 2 fields, more than the "
@@ -250,3 +250,49 @@ def test_one_corrupt_cell_of_any_field_or_stamp_is_named():
     with pytest.raises(RecordingError, match=r"run.csv: t: a step of 1e\+07 s after row 98 .* split the "
                                              r"recording at the gap"):
         rd.Recording(t=far, q=q, joint_names=("a", "b"), source="run.csv")
+
+
+def test_default_cell_limit_keeps_a_read_under_1_gb():
+    # issue 23: 5 x 10^7 cells of a 7-joint log peaked at 3.4 GB; about 18 bytes a cell besides
+    # the text now, so the default admits 2 x 10^7
+    from robodyn.measure.csv_io import MAX_CELLS, max_cells
+
+    assert MAX_CELLS == max_cells() == 20_000_000
+
+
+def test_estimated_period_of_a_motionless_log_names_the_file(tmp_path):
+    spec = dict(SPEC, time={"column": "time", "unit": "index", "period": "estimate"},
+                velocity={"columns": "vel{k}", "unit": "deg/s"})
+    text = "time,pos1,pos2,vel1,vel2\n" + "".join(f"{k},1,2,0,0\n" for k in range(20))
+    with pytest.raises(RecordingError, match=r"^run.csv: time.period: estimate: cannot estimate the "
+                                             r"sample period: the measured velocity is zero"):
+        _read(tmp_path, text, spec=spec)
+
+
+def test_implausible_cell_is_named_by_its_file_line(tmp_path):
+    # issue 23: "row 99" was the 0-based sample, the value is on line 101 of the file
+    rows = GOOD.splitlines()
+    rows[5] = "4,1e308,0.8"
+    text = "# a comment line\n\n" + "\n".join(rows) + "\n"  # two lines above the header
+    with pytest.raises(RecordingError, match=r"run.csv: q: 1e\+308 at line 8, column 0 \('a'\) is "
+                                             r"not a plausible joint position .* that line of"):
+        _read(tmp_path, text, spec=dict(SPEC, comment="#", position={"columns": "pos{k}",
+                                                                     "unit": "rad"}))
+    native = tmp_path / "own.csv"
+    native.write_text("t,q[a]\n" + "".join(f"{k * 1e-3},{1e308 if k == 3 else 0}\n"
+                                          for k in range(20)))
+    with pytest.raises(RecordingError, match=r"own.csv: q: 1e\+308 at line 5, column 0 \('a'\)"):
+        rd.read_recording(native)
+
+
+@pytest.mark.parametrize("newline", ["\n", "\r\n", "\r"])
+def test_lines_numbered_through_blank_comment_and_cr_lines(tmp_path, newline):
+    rows = GOOD.splitlines()
+    rows[4] = "3,x,0.6"
+    text = newline.join(["# header comment", rows[0], "", *rows[1:3], "  # note", *rows[3:]])
+    with pytest.raises(RecordingError, match=r"column 'pos1' \(position.columns\[0\]\): 'x' is not "
+                                             r"a finite number at line 8 "):
+        _read(tmp_path, text + newline, spec=dict(SPEC, comment="#"))
+    ok = _read(tmp_path, newline.join(["# c", *GOOD.splitlines(), "", ""]),
+               spec=dict(SPEC, comment="#"))
+    assert ok.n_samples == 20 and ok.q[3, 1] == pytest.approx(np.radians(0.6))

@@ -97,7 +97,10 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("-o", "--output", required=True, metavar="FILE.csv", help="trajectory CSV")
     p.add_argument("--harmonics", type=int, default=5, help="harmonics per joint")
     p.add_argument("--frequency", type=float, default=0.1, help="base frequency, Hz")
-    p.add_argument("--duration", type=float, default=None, help="s, whole periods (default one)")
+    p.add_argument("--duration", type=float, default=None,
+                   help="s, whole periods (default one); duration / dt samples of 1 + 3 n values "
+                        "are at most 3e7 values (1.36e6 samples of 7 joints; "
+                        "$ROBODYN_MAX_GRID_SAMPLES sets another bound)")
     p.add_argument("--velocity", type=float, default=None, help="speed limit, rad/s (all joints)")
     p.add_argument("--acceleration", type=float, default=None, help="acceleration limit, rad/s^2")
     p.add_argument("--criterion", choices=("cond", "logdet"), default="cond")
@@ -109,7 +112,8 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
                         "(default: %(default)s)")
     p.add_argument("--starts", type=int, default=6, help="optimiser starts")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--dt", type=float, default=1e-3, help="sample step of the CSV, s")
+    p.add_argument("--dt", type=float, default=1e-3,
+                   help="sample step of the CSV, s (bounded with --duration)")
     p.set_defaults(func=_cmd_excite)
 
     p = sub.add_parser("testprog", help="thesis test programs: one joint at a time, ISO 9283 cube",
@@ -122,6 +126,9 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--speeds", type=float, nargs="+", default=[0.5, 1.0],
                    help="jointwise: speed fractions")
     p.add_argument("--size", type=float, default=0.5, help="iso-cube: cube edge, m")
-    p.add_argument("--cycles", type=int, default=1, help="iso-cube: P1..P5 cycles")
-    p.add_argument("--dt", type=float, default=1e-3, help="sample step, s")
+    p.add_argument("--cycles", type=int, default=1,
+                   help="iso-cube: P1..P5 cycles; the program's samples (1 + 3 n values each) are "
+                        "at most 3e7 values, e.g. about 108 cycles of puma560 at 1 ms "
+                        "($ROBODYN_MAX_GRID_SAMPLES sets another bound)")
+    p.add_argument("--dt", type=float, default=1e-3, help="sample step, s (bounded as for --cycles)")
     p.set_defaults(func=_cmd_testprog)

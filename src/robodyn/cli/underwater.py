@@ -43,11 +43,16 @@ def _cmd_underwater(args: argparse.Namespace) -> int:
     import numpy as np
 
     from robodyn.report.underwater import write_study
-    from robodyn.studies.underwater import effect_series
-    from robodyn.studies.underwater_model_error import model_error_study
+    from robodyn.studies.underwater import check_series_size, effect_series
+    from robodyn.studies.underwater_model_error import OMITTED, model_error_study
     from robodyn.studies.underwater_sensitivity import sensitivity
 
     robot = rd.load(args.robot)
+    # the sample count checked before anything is simulated, named by the options
+    check_series_size(robot.dof, len(EFFECTS), args.move_time, args.hold_time, args.free_time,
+                      args.dt, where="underwater",
+                      names=("--move-time", "--hold-time", "--free-time", "--dt"),
+                      model_error=0 if args.series_only else len(OMITTED))
     args.backend = resolve_backend(args.backend)
     params = dict(args.set or [])
     series = effect_series(
@@ -97,7 +102,10 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p.add_argument("--end", type=float, nargs="+", metavar="Q",
                    help="end of the move (default: start + 0.8 rad / 0.1 m per joint)")
     p.add_argument("--move-time", type=_seconds, default=2.0, metavar="S",
-                   help="duration of the move, s (default: %(default)s)")
+                   help="duration of the move, s (default: %(default)s); the samples of move, "
+                        "hold and free time at --dt are bounded before simulating: about 3.1e5 "
+                        "for a 2-joint arm with --series-only, 1e4 for the whole study "
+                        "($ROBODYN_MAX_GRID_SAMPLES sets another bound)")
     p.add_argument("--hold-time", type=_seconds, default=1.0, metavar="S",
                    help="hold after the move, s (default: %(default)s)")
     p.add_argument("--free-time", type=_seconds, default=3.0, metavar="S",

@@ -15,12 +15,16 @@ is exact.
 
 from __future__ import annotations
 
+import csv
 import gzip
 import io
 import re
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from os import PathLike
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 import pandas as pd
@@ -32,7 +36,7 @@ from robodyn.measure.conversions import (
     unwrap_counter,
     volts_to_current,
 )
-from robodyn.measure.recording import JOINT_FIELDS, Recording
+from robodyn.measure.recording import JOINT_FIELDS, PLAUSIBLE, Recording, check_plausible
 from robodyn.measure.spec import (
     CURRENT_UNITS,
     POSITION_UNITS,
@@ -76,9 +80,11 @@ def max_rows() -> int:
 
 
 #: Most cells (lines x fields) a recording file may hold (``$ROBODYN_MAX_CELLS`` raises it):
-#: 5 x 10^7 numbers are 400 MB once parsed; a text of short cells ("0,0,0,...") under the size
-#: limit would otherwise parse to several gigabytes.
-MAX_CELLS = 50_000_000
+#: reading costs about 18 bytes a cell besides the text (the parsed numbers, pandas' chunks, the
+#: columns used), so 2 x 10^7 cells stay under 1 GB even with 500 MB of text (a 7-joint log of 78
+#: columns: 256,000 samples in 0.6 GB); a text of short cells ("0,0,0,...") under the size limit
+#: would otherwise parse to several gigabytes.
+MAX_CELLS = 20_000_000
 
 
 def max_cells() -> int:
@@ -113,6 +119,72 @@ def read_text_bytes(path: Path, error: type[Exception]) -> bytes:
 #: The ``delimiter`` of a recording spec for fields separated by runs of spaces or tabs.
 WHITESPACE = "whitespace"
 
+_BOM = b"\xef\xbb\xbf"
+
+
+def _scan_lines(raw: bytes | bytearray, name: str, delimiter: str, comment: str | None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The data lines of ``raw``, one line at a time (no decoded copy of the whole text):
+    0-based line numbers, start and end byte offsets of the kept lines (not blank, not a
+    comment) and each kept line's field separators (runs of spaces for ``WHITESPACE``)."""
+    mark = comment.encode() if comment else None
+    sep = delimiter.encode()
+    keep: list[int] = []
+    starts: list[int] = []
+    ends: list[int] = []
+    counts: list[int] = []
+    pos, size, k = (3 if raw[:3] == _BOM else 0), len(raw), 0
+    while pos < size:
+        end = raw.find(b"\n", pos)
+        end = size if end < 0 else end
+        line = raw[pos:end]
+        try:
+            line.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise RecordingError(f"{name}: not UTF-8 text (byte {pos + exc.start})") from None
+        stripped = line.strip()
+        if stripped and not (mark and stripped.startswith(mark)):
+            keep.append(k)
+            starts.append(pos)
+            ends.append(end)
+            counts.append(len(stripped.split()) - 1 if delimiter == WHITESPACE else line.count(sep))
+        pos, k = end + 1, k + 1
+    return tuple(np.asarray(v, dtype=np.int64)  # type: ignore[return-value]
+                 for v in (keep, starts, ends, counts))
+
+
+class _Lines:
+    """The kept lines of a text as a binary file for ``pandas.read_csv``: ``read(size)`` returns
+    whole lines (stripped when ``strip``), so no second copy of the text is made."""
+
+    mode = "rb"
+
+    def __init__(self, raw: bytes | bytearray, starts: np.ndarray, ends: np.ndarray, strip: bool):
+        self.raw, self.starts, self.ends, self.strip, self.k = memoryview(raw), starts, ends, strip, 0
+        # every line kept and none to strip: contiguous slices of the text
+        self.whole = not strip and bool(starts.size) and int(ends[-1] - starts[0]) == \
+            int(np.sum(ends - starts)) + starts.size - 1
+        self.pos = int(starts[0]) if starts.size else 0
+
+    def read(self, size: int = -1) -> bytes:
+        size = len(self.raw) if size is None or size < 0 else max(size, 1)
+        if self.whole:
+            stop = min(self.pos + size, int(self.ends[-1]))
+            out = bytes(self.raw[self.pos:stop])
+            self.pos = stop
+            return out
+        parts, total = [], 0
+        while self.k < self.starts.size and total < size:
+            line = bytes(self.raw[self.starts[self.k]:self.ends[self.k]])
+            line = line.strip() if self.strip else line
+            parts.append(line + b"\n")
+            total += len(line) + 1
+            self.k += 1
+        return b"".join(parts)
+
+    def __iter__(self) -> Any:
+        return iter(lambda: self.read(1 << 16), b"")
+
 
 class _Table:
     """The data rows of a delimited text file, with the file's line number of every row
@@ -133,43 +205,35 @@ class _Table:
         if rows * fields > max_cells():
             raise RecordingError(f"{self.name}: {rows} lines of {fields} fields, more than the "
                                  f"{max_cells():g} cells read (set ROBODYN_MAX_CELLS to read it)")
-        try:
-            text = raw.decode("utf-8-sig")
-        except UnicodeDecodeError as exc:
-            raise RecordingError(f"{self.name}: not UTF-8 text (byte {exc.start})") from None
-        del raw
-        lines = text.splitlines()
-        keep = [k for k, line in enumerate(lines)
-                if line.strip() and not (comment and line.lstrip().startswith(comment))]
-        if not keep:
-            raise RecordingError(f"{self.name}: empty file (no header and no data rows)")
+        if b"\r" in raw and raw.count(b"\r") != raw.count(b"\r\n"):
+            raw = raw.replace(b"\r\n", b"\n").replace(b"\r", b"\n")  # old Mac line ends
         if delimiter is None:
             delimiter = "\t" if ".tsv" in [s.lower() for s in path.suffixes] else ","
-        if header and len(keep) == 1:
+        keep, starts, ends, counts = _scan_lines(raw, self.name, delimiter, comment)
+        if not keep.size:
+            raise RecordingError(f"{self.name}: empty file (no header and no data rows)")
+        if header and keep.size == 1:
             raise RecordingError(f"{self.name}: header only, no data rows (line {keep[0] + 1})")
-        kept = [lines[k] for k in keep]
-        spaces = delimiter == WHITESPACE
-        if spaces:
-            kept = [line.strip() for line in kept]  # a run of spaces or tabs separates fields
         # every row has as many fields as the first (header) row
-        if '"' not in text:
-            counts = np.fromiter((len(line.split()) - 1 if spaces else line.count(delimiter)
-                                  for line in kept), dtype=np.int64, count=len(kept))
-            bad = np.nonzero(counts != counts[0])[0]
-            if bad.size:
-                k = int(bad[0])
-                first = "header" if header else "first row"
-                raise RecordingError(f"{self.name}: line {keep[k] + 1}: {counts[k] + 1} fields, but the "
-                                     f"{first} (line {keep[0] + 1}) has {counts[0] + 1}")
+        bad = np.nonzero(counts != counts[0])[0] if b'"' not in raw else ()
+        if len(bad):
+            k = int(bad[0])
+            first_row = "header" if header else "first row"
+            raise RecordingError(f"{self.name}: line {keep[k] + 1}: {counts[k] + 1} fields, but the "
+                                 f"{first_row} (line {keep[0] + 1}) has {counts[0] + 1}")
+        spaces = delimiter == WHITESPACE
         try:
-            frame = pd.read_csv(io.StringIO("\n".join(kept)), sep=r"\s+" if spaces else delimiter,
-                                header=0 if header else None, skip_blank_lines=False,
-                                engine="c", low_memory=False, keep_default_na=False)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", pd.errors.DtypeWarning)  # columns read in chunks
+                frame = pd.read_csv(_Lines(raw, starts, ends, spaces), sep=r"\s+" if spaces else delimiter,
+                                    header=0 if header else None, skip_blank_lines=False,
+                                    engine="c", keep_default_na=False, encoding="utf-8")
         except (pd.errors.ParserError, ValueError) as exc:
             raise RecordingError(f"{self.name}: cannot parse as delimited text "
                                  f"({' '.join(str(exc).split())})") from None
+        del raw
         self.frame = frame
-        self.line = np.asarray(keep[1:] if header else keep) + 1  # 1-based line of each row
+        self.line = (keep[1:] if header else keep) + 1  # 1-based line of each row
         self.header = header
         self.columns = [str(c) for c in frame.columns] if header else list(range(frame.shape[1]))
 
@@ -334,7 +398,10 @@ def read_csv(path: str | PathLike[str], spec: Any = None, robot: Any = None) -> 
     units = {}
     if sp.time_unit == "index":
         if sp.period == "estimate":
-            period = estimate_period(q, qd)
+            try:
+                period = estimate_period(q, qd)
+            except ValueError as exc:
+                raise RecordingError(f"{table.name}: time.period: estimate: {exc}") from None
             units["sample_period"] = (f"{period:.6g} s, estimated from position increments "
                                       "against measured velocity")
         else:
@@ -356,6 +423,10 @@ def read_csv(path: str | PathLike[str], spec: Any = None, robot: Any = None) -> 
         if "temperature" in ch else None
     tau, current, temperature = (None if a is None or np.isnan(a).all() else a
                                  for a in (tau, current, temperature))
+    for field, value in (("q", q), ("qd", qd), ("tau", tau), ("current", current),
+                         ("temperature", temperature)):
+        if value is not None:  # an implausible cell named by its line of the file
+            check_plausible(f"{table.name}: {field}", field, value, sp.joint_names, table.line)
     rec = Recording(t=t, q=q, qd=qd, tau=tau, current=current, temperature=temperature,
                     joint_names=sp.joint_names, units=units, source=p.name)
     return _select_robot(rec, robot)
@@ -413,6 +484,8 @@ def _read_native(p: Path) -> Recording:
         if bad.any():
             c = int(np.argwhere(bad)[0][1])
             table.fail(f"{field}[{names[c]}]", field, bad[:, c])
+        if field in PLAUSIBLE:
+            check_plausible(f"{p.name}: {field}", field, head, names, table.line)
         arrays[field] = head
     tool: dict[str, Any] = {}
     if "tool_t" in table.columns:
@@ -440,27 +513,48 @@ def write_csv(rec: Recording, path: str | PathLike[str]) -> Path:
     """
     p = Path(path)
     n_rows = max(rec.n_samples, 0 if rec.tool_t is None else rec.tool_t.size)
-    cols: dict[str, np.ndarray] = {}
-
-    def pad(v: np.ndarray) -> np.ndarray:
-        out = np.full(n_rows, np.nan)
-        out[: v.size] = v
-        return out
-
-    cols["t"] = pad(rec.t)
+    cols: dict[str, np.ndarray] = {"t": rec.t}
     for field in JOINT_FIELDS:
         value = getattr(rec, field)
         if value is None or field in rec.estimated:
             continue
         for k, name in enumerate(rec.joint_names):
-            cols[f"{field}[{name}]"] = pad(value[:, k])
+            cols[f"{field}[{name}]"] = value[:, k]
     if rec.tool_t is not None:
-        cols["tool_t"] = pad(rec.tool_t)
+        cols["tool_t"] = rec.tool_t
         for k, axis in enumerate("xyz"):
-            cols[f"tool_{axis}"] = pad(rec.tool_points[:, k])
-    text = pd.DataFrame(cols).to_csv(index=False, float_format="%.17g", na_rep="")
-    data = text.encode("utf-8")
-    if p.suffix.lower() == ".gz":
-        data = gzip.compress(data, mtime=0)
-    p.write_bytes(data)
+            cols[f"tool_{axis}"] = rec.tool_points[:, k]
+    with _text_out(p) as fh:
+        csv.writer(fh, lineterminator="\n").writerow(list(cols))
+        _write_rows(fh, list(cols.values()), n_rows)
     return p
+
+
+#: Rows formatted at a time by :func:`write_csv` (a few MB of text).
+_WRITE_ROWS = 20_000
+
+
+@contextmanager
+def _text_out(p: Path) -> Iterator[IO[str]]:
+    """A text file for writing, gzip-compressed (without a time stamp) when the name ends in .gz."""
+    if p.suffix.lower() != ".gz":
+        with p.open("w", encoding="utf-8", newline="") as fh:
+            yield fh
+        return
+    with p.open("wb") as raw, gzip.GzipFile(filename="", mode="wb", fileobj=raw, mtime=0) as gz, \
+            io.TextIOWrapper(gz, encoding="utf-8", newline="") as fh:
+        yield fh
+
+
+def _write_rows(fh: IO[str], columns: list[np.ndarray], n_rows: int) -> None:
+    """Columns (each at most ``n_rows`` long, the rest of its cells empty) as rows of 17
+    significant digits, a block of rows at a time: no text of the whole file in memory."""
+    line = ",".join(["%.17g"] * len(columns))
+    for start in range(0, n_rows, _WRITE_ROWS):
+        stop = min(start + _WRITE_ROWS, n_rows)
+        block = np.full((stop - start, len(columns)), np.nan)
+        for k, c in enumerate(columns):
+            part = c[start:stop]
+            block[:part.size, k] = part
+        text = "\n".join([line % tuple(row) for row in block.tolist()])
+        fh.write(text.replace("nan", "") + "\n")  # NaN: an empty cell

@@ -22,7 +22,7 @@ from scipy.interpolate import make_interp_spline
 from robodyn.measure.filtering import differentiate, lowpass
 from robodyn.robot.errors import RecordingError, RecordingWarning
 
-__all__ = ["JOINT_FIELDS", "Recording"]
+__all__ = ["JOINT_FIELDS", "Recording", "check_plausible"]
 
 JOINT_FIELDS = ("q", "qd", "qdd", "tau", "current", "temperature")
 # fields whose columns may be entirely NaN: "this joint has no such sensor"
@@ -50,6 +50,39 @@ PLAUSIBLE = {"q": (MAX_POSITION, "joint position (rad or m)"),
              "tau": (1e8, "joint torque (N m or N)"),
              "current": (1e6, "motor current (A)"),
              "temperature": (1e4, "temperature (deg C)")}
+
+
+def check_plausible(where: str, name: str, a: np.ndarray, names: Sequence[str],
+                    lines: np.ndarray | None = None) -> None:
+    """Refuse a value of field ``name`` (``a``, (N, n)) beyond its :data:`PLAUSIBLE` bound: one
+    corrupt cell would set every scale (a duration of 1e304 s, a filter at 1e-302 Hz).
+
+    Parameters
+    ----------
+    where : str
+        The message's start (file and field).
+    name : str
+        A key of :data:`PLAUSIBLE`.
+    a : (N, n) ndarray
+    names : sequence of str
+        The joint names of the columns.
+    lines : (N,) ndarray, optional
+        The 1-based file line of each row: the message names ``line L`` of the file instead of
+        the 0-based ``row``.
+
+    Raises
+    ------
+    RecordingError
+    """
+    bound, what = PLAUSIBLE[name]
+    big = np.abs(a) > bound
+    if not big.any():
+        return
+    row, col = (int(v) for v in np.argwhere(big)[0])
+    at = f"row {row}" if lines is None else f"line {int(lines[row])}"
+    raise RecordingError(f"{where}: {a[row, col]:g} at {at}, column {col} ({names[col]!r}) is not a "
+                         f"plausible {what} (|value| > {bound:g}); check the unit and that "
+                         f"{at.split()[0]} of the file ({int(big.sum())} such value(s) in all)")
 
 
 @dataclass(frozen=True, eq=False)
@@ -145,7 +178,7 @@ class Recording:
                                      f"got {a.shape}")
             self._finite(name, a, names, allow_nan_columns=name in _MAY_LACK_COLUMNS)
             if name in PLAUSIBLE:
-                self._plausible(name, a, names, *PLAUSIBLE[name])
+                check_plausible(self._where(name), name, a, names)
             set_(self, name, _readonly(a))
         self._tool()
         units = dict(DEFAULT_UNITS)
@@ -165,19 +198,6 @@ class Recording:
         where = f"row {row}" + (f", column {col[0]} ({names[col[0]]!r})" if col else "")
         raise RecordingError(f"{self._where(name)}: {value} at {where} "
                              f"({int(bad.sum())} non-finite value(s) in all)")
-
-    def _plausible(self, name: str, a: np.ndarray, names: Sequence[str], bound: float,
-                   what: str) -> None:
-        """Refuse a value beyond ``bound`` (one corrupt cell would set every scale: a duration of
-        1e304 s, a filter at 1e-302 Hz)."""
-        big = np.abs(a) > bound
-        if not big.any():
-            return
-        row, col = (int(v) for v in np.argwhere(big)[0])
-        raise RecordingError(f"{self._where(name)}: {a[row, col]:g} at row {row}, column {col} "
-                             f"({names[col]!r}) is not a plausible {what} (|value| > {bound:g}); "
-                             f"check the unit and that row of the file ({int(big.sum())} such "
-                             "value(s) in all)")
 
     def _tool(self) -> None:
         if (self.tool_t is None) != (self.tool_points is None):

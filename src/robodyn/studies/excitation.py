@@ -69,7 +69,6 @@ from robodyn.studies.excitation_limits import (
     DEFAULT_ACCELERATION,
     DEFAULT_VELOCITY,
     ExcitationLimits,
-    _frozen,
     excitation_limits,
 )
 from robodyn.studies.fourier_trajectory import (
@@ -355,7 +354,9 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
     if not np.isfinite(periods) or periods < 1 - 1e-9 or abs(periods - round(periods)) > 1e-6:
         raise InputError(f"excitation: duration {duration!r} s must be a whole number of periods "
                          f"(1 / base_frequency = {period:g} s)")
-    time_grid_steps(total, dt, "excitation", duration_name="duration (whole periods)")
+    # t, q, qd, qdd evaluated and written: bounded before the design starts
+    time_grid_steps(total, dt, "excitation", duration_name="duration (whole periods)",
+                    values_per_sample=1 + 3 * n)
     if criterion not in ("cond", "logdet"):
         raise InputError(f"excitation: unknown criterion {criterion!r}; choose 'cond' or 'logdet'")
     if starts < 1:
@@ -409,7 +410,9 @@ def excitation(robot: Robot | Model, harmonics: int = 5, base_frequency: float =
     t_d = np.arange(k) * period / k
     cond = condition_number(model, *traj.evaluate(t_d), cols)
     names = parameter_names(n)
-    return Excitation(series=traj, t=_frozen(t), q=_frozen(q), qd=_frozen(qd), qdd=_frozen(qdd),
+    for arr in (t, q, qd, qdd):
+        arr.flags.writeable = False  # read-only in place: no second copy of the samples
+    return Excitation(series=traj, t=t, q=q, qd=qd, qdd=qdd,
                       duration=float(steps * dt), condition_number=cond, criterion=criterion,
                       logdet=_logdet(model, traj, t_d, cols), limits=lim, columns=cols,
                       column_names=tuple(names[c] for c in cols), joint_names=model.robot.joint_names,

@@ -31,6 +31,7 @@ from robodyn.calibration.iso9283 import cube_points
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
+from robodyn.robot.sizes import time_grid_steps
 from robodyn.simulation.ik import UnreachableError, inverse_kinematics
 from robodyn.simulation.trajectory import JointTrajectory, concatenate, trapezoidal
 from robodyn.studies.excitation import excitation_limits, write_trajectory_csv
@@ -210,6 +211,7 @@ def jointwise(robot: Robot | Model, *, speeds: Sequence[float] = (0.5, 1.0), str
     vel = _vector(velocity, lim.velocity, "velocity")
     acc = _vector(acceleration, lim.acceleration, "acceleration")
     fracs = _speeds(speeds)
+    _check_dt(dt, "jointwise")
     if not np.isfinite(stroke) or stroke <= 0:
         raise InputError(f"jointwise: stroke must be a positive angle (rad), got {stroke!r}")
     if dwell < 0:
@@ -232,7 +234,7 @@ def jointwise(robot: Robot | Model, *, speeds: Sequence[float] = (0.5, 1.0), str
 
     def rest(q: np.ndarray) -> None:
         if dwell > 0:
-            add(trapezoidal(q, q, vel, acc, duration=dwell, dt=dt),
+            add(trapezoidal(q, q, vel, acc, duration=dwell, dt=_PLAN),
                 Segment("dwell", 0, 0, None, 0.0, 0, "rest"))
 
     q = q_home.copy()
@@ -244,7 +246,7 @@ def jointwise(robot: Robot | Model, *, speeds: Sequence[float] = (0.5, 1.0), str
         a = q.copy()
         a[i] = start
         if abs(start - q[i]) > 0:
-            add(trapezoidal(q, a, vel, acc, dt=dt), Segment("approach", 0, 0, names[i], 1.0, 0,
+            add(trapezoidal(q, a, vel, acc, dt=_PLAN), Segment("approach", 0, 0, names[i], 1.0, 0,
                                                             f"{names[i]} to start"))
             rest(a)
         b = a.copy()
@@ -253,14 +255,14 @@ def jointwise(robot: Robot | Model, *, speeds: Sequence[float] = (0.5, 1.0), str
             for direction, (p0, p1) in ((1, (a, b)), (-1, (b, a))):
                 sign = "+" if direction > 0 else "-"
                 label = f"{names[i]} {sign}{np.degrees(length):.1f} deg at {100 * s:g} %"
-                add(trapezoidal(p0, p1, s * vel, acc, dt=dt),
+                add(trapezoidal(p0, p1, s * vel, acc, dt=_PLAN),
                     Segment("move", 0, 0, names[i], s, direction, label))
                 rest(p1)
-        add(trapezoidal(a, q_home, vel, acc, dt=dt) if abs(start - q_home[i]) > 0
-            else trapezoidal(a, a, vel, acc, duration=dt, dt=dt),
+        add(trapezoidal(a, q_home, vel, acc, dt=_PLAN) if abs(start - q_home[i]) > 0
+            else trapezoidal(a, a, vel, acc, duration=dt, dt=_PLAN),
             Segment("approach", 0, 0, names[i], 1.0, 0, f"{names[i]} home"))
         q = q_home.copy()
-    traj = concatenate(*parts, dt=dt)
+    traj = _sampled(parts, dt, "jointwise", n)
     return TestProgram("jointwise", traj, tuple(segments), names)
 
 
@@ -325,6 +327,7 @@ def iso_cube(robot: Robot | Model, *, size: float = 0.5, center: Sequence[float]
     vel = _vector(velocity, lim.velocity, "velocity")
     acc = _vector(acceleration, lim.acceleration, "acceleration")
     (s,) = _speeds([speed])
+    _check_dt(dt, "iso_cube")
     if isinstance(cycles, bool) or not isinstance(cycles, int) or not 1 <= cycles <= MAX_CYCLES:
         raise InputError(f"iso_cube: cycles must be an integer in [1, {MAX_CYCLES}] (ISO 9283 "
                          f"uses 30), got {cycles!r}")
@@ -347,20 +350,46 @@ def iso_cube(robot: Robot | Model, *, size: float = 0.5, center: Sequence[float]
     parts: list[JointTrajectory] = []
     segments: list[Segment] = []
     clock = 0.0
-    visits = [q_home] + [poses[k] for _ in range(cycles) for k in range(5)] + [poses[0], q_home]
-    labels = ["home"] + [f"P{k + 1}" for _ in range(cycles) for k in range(5)] + ["P1", "home"]
-    for a, b, label in zip(visits[:-1], visits[1:], labels[1:], strict=True):
-        move = (trapezoidal(a, b, s * vel, acc, dt=dt) if np.any(a != b)
-                else trapezoidal(a, a, vel, acc, duration=dt, dt=dt))
+    # pose indices (-1: home); a move or dwell repeated every cycle is planned once
+    visits = [-1] + [k for _ in range(cycles) for k in range(5)] + [0, -1]
+    pose = {-1: q_home, **{k: poses[k] for k in range(5)}}
+    planned: dict[tuple[int, int], JointTrajectory] = {}
+    for i, j in zip(visits[:-1], visits[1:], strict=True):
+        a, b = pose[i], pose[j]
+        label = "home" if j < 0 else f"P{j + 1}"
+        if (i, j) not in planned:
+            planned[i, j] = (trapezoidal(a, b, s * vel, acc, dt=_PLAN) if np.any(a != b)
+                             else trapezoidal(a, a, vel, acc, duration=dt, dt=_PLAN))
+        move = planned[i, j]
         parts.append(move)
         segments.append(Segment("move", clock, clock + move.duration, None, s, 0, f"to {label}"))
         clock += move.duration
         if dwell > 0 and label != "home":
-            parts.append(trapezoidal(b, b, vel, acc, duration=dwell, dt=dt))
+            if (j, j) not in planned:
+                planned[j, j] = trapezoidal(b, b, vel, acc, duration=dwell, dt=_PLAN)
+            parts.append(planned[j, j])
             segments.append(Segment("dwell", clock, clock + dwell, None, 0.0, 0, label))
             clock += dwell
-    traj = concatenate(*parts, dt=dt)
+    traj = _sampled(parts, dt, f"iso_cube (cycles {cycles})", n)
     return TestProgram("iso-cube", traj, tuple(segments), rob.joint_names, _frozen(points), _frozen(poses))
+
+
+#: Sampling step of the planned parts of a program, s: each is a piecewise polynomial with a few
+#: samples, and :func:`_sampled` samples the whole program once at the user's ``dt``.
+_PLAN = 1e9
+
+
+def _check_dt(dt: float, where: str) -> None:
+    if isinstance(dt, bool) or not isinstance(dt, int | float) or not np.isfinite(dt) or dt <= 0:
+        raise InputError(f"{where}: dt must be a positive number of seconds, got {dt!r}")
+
+
+def _sampled(parts: list[JointTrajectory], dt: float, where: str, n: int) -> JointTrajectory:
+    """The parts one after the other, sampled every ``dt``, after checking the program's sample
+    count (t, q, qd, qdd of ``n`` joints are evaluated and written: :func:`time_grid_steps`)."""
+    time_grid_steps(sum(p.duration for p in parts), dt, where, duration_name="program",
+                    values_per_sample=1 + 3 * n)
+    return concatenate(*parts, dt=dt)
 
 
 def _joint_index(names: tuple[str, ...], name: str) -> int:

@@ -68,6 +68,7 @@ __all__ = [
     "LABELS",
     "EffectRun",
     "EffectSeries",
+    "check_series_size",
     "effect_series",
     "effect_variant",
 ]
@@ -360,10 +361,7 @@ def effect_series(robot: Robot, *, start: Sequence[float] | None = None,
         q0 = _move_vector(start, n, "start")
     if end is not None:
         q1 = _move_vector(end, n, "end")
-    for name, value in (("move_time", move_time), ("hold_time", hold_time), ("free_time", free_time)):
-        time_grid_steps(value, dt, "effect_series", duration_name=name)
-    time_grid_steps(move_time + hold_time + free_time, dt, "effect_series",
-                    duration_name="move_time + hold_time + free_time")
+    check_series_size(n, len(chosen), move_time, hold_time, free_time, dt)
     reference = quintic(q0, q1, move_time, dt=dt)
     duration = move_time + hold_time
     t = dt * np.arange(round(duration / dt) + 1)
@@ -386,6 +384,53 @@ def effect_series(robot: Robot, *, start: Sequence[float] | None = None,
     return EffectSeries(robot=robot.name, runs=tuple(runs), reference=reference, table=table,
                         kp=kp, kd=kd, current=c, lift=lift, move_time=move_time,
                         hold_time=hold_time, free_time=free_time, dt=dt, notes=tuple(notes))
+
+
+#: Cost of one step of a computed-torque run of the model-error study (RK4 with the controller
+#: evaluated in every stage, about 400 us), in values of the grid bound (about 1 us each).
+CONTINUOUS_STEP_VALUES = 400
+
+
+def check_series_size(n: int, variants: int, move_time: float, hold_time: float,
+                      free_time: float, dt: float, *, where: str = "effect_series",
+                      names: tuple[str, str, str, str] = ("move_time", "hold_time", "free_time",
+                                                          "dt"), model_error: int = 0) -> None:
+    """Refuse an effect series whose samples would not fit, before anything is simulated.
+
+    Every variant keeps a tracked run and a free run (t, q, qd, qdd, tau and three energies) and
+    its ideal torques, besides the reference: about ``variants (4 + 5 n) + 1 + 6 n`` values a
+    sample of ``move_time + hold_time + free_time``, bounded by
+    :func:`robodyn.robot.sizes.time_grid_steps` (``$ROBODYN_MAX_GRID_SAMPLES`` raises it).
+
+    Parameters
+    ----------
+    n : int
+        Joints.
+    variants : int
+        Effect variants simulated.
+    move_time, hold_time, free_time, dt : float
+        s, each positive.
+    where : str
+        The function or command, for the message.
+    names : tuple of str
+        The names the user gave the three durations and the step (the command line's options).
+    model_error : int
+        Computed-torque runs of the model-error study to come (``robodyn underwater`` without
+        ``--series-only``): each adds :data:`CONTINUOUS_STEP_VALUES` a sample, so that the whole
+        study ends in about a minute.
+
+    Raises
+    ------
+    InputError
+        A non-positive duration or step, or too many samples.
+    """
+    move, hold, free, step = names
+    for name, value in ((move, move_time), (hold, hold_time), (free, free_time)):
+        time_grid_steps(value, dt, where, duration_name=name, dt_name=step)
+    time_grid_steps(move_time + hold_time + free_time, dt, where,
+                    duration_name=f"{move} + {hold} + {free}", dt_name=step,
+                    values_per_sample=variants * (4 + 5 * n) + 1 + 6 * n
+                    + model_error * CONTINUOUS_STEP_VALUES)
 
 
 def _move_vector(v: Sequence[float], n: int, name: str) -> np.ndarray:
