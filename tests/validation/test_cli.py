@@ -171,6 +171,22 @@ def test_identify_prints_and_reports_the_friction_and_ripple_choices(files, tmp_
     assert "--ripple: expected auto, on or off, got 'maybe'" in capsys.readouterr().err
 
 
+def test_identify_prints_and_reports_the_prediction_cutoff_choice(files, tmp_path, capsys):
+    train, _ = files
+    rc = main(["identify", "puma560", "--data", str(train), "--prediction-cutoff", "auto",
+               "--ripple", "off", "-o", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert rc == 0 and "prediction cut-off" in out and "raw target of the identification" in out
+    page = (tmp_path / "report.html").read_text(encoding="utf-8")
+    assert "Prediction cut-off <b>" in page
+    for bad, message in (("wide", "expected fit, auto or a frequency in Hz, got 'wide'"),
+                         ("-2", "expected a positive frequency in Hz, got '-2'")):
+        with pytest.raises(SystemExit) as exc:
+            main(["identify", "puma560", "--data", str(train), "--prediction-cutoff", bad,
+                  "-o", str(tmp_path)])
+        assert exc.value.code == 2 and message in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("option, value", [("--cutoff", "fast"), ("--regularization", "inf"),
                                            ("--dead-band", "wide"), ("--decimate", "2.5")])
 def test_identify_bad_preprocessing_option_is_refused(files, tmp_path, capsys, option, value):

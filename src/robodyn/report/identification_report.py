@@ -181,6 +181,11 @@ def _choices_html(ident: Any) -> str:
         laws += (f"<p>Position ripple (a sin q + b cos q per joint) <b>{kept}</b> (held-out "
                  f"blocks of the model's residual: "
                  f"{html.escape(scores)}).</p>\n")
+    if ch.prediction_cutoff is not None:
+        scores = ", ".join(f"{k} {v:.4f}" for k, v in ch.prediction_scores)
+        laws += (f"<p>Prediction cut-off <b>{ch.prediction_cutoff:g} Hz</b> (relative error "
+                 f"against the raw target of the identification recordings: "
+                 f"{html.escape(scores)}).</p>\n")
     return (f"<h2>Choices</h2>\n<p>Velocity <b>{html.escape(ch.velocity)}</b>, Coulomb dead band "
             f"<b>{ch.dead_band:g} rad/s</b>, cut-off {_cutoff(ident)}, Tikhonov weight "
             f"{ch.regularization:.3g}{', thermal friction' if ch.thermal else ''}: "
