@@ -184,6 +184,7 @@ def test_circle_file_whose_readings_do_not_follow_the_arc_says_what_to_do(tmp_pa
     assert len([line for line in err.splitlines() if line.startswith("robodyn: error:")]) == 1
 
 
+@pytest.mark.slow
 def test_nongeometric_terms_cross_validated_and_the_description_alone_stated(data, tmp_path, capsys):
     # the data are geometric errors only (perturbed_robot): terms cannot help on held-out poses
     assert main(["calibrate", "puma560", "--data", str(data / "si.csv"), "--targets", "2",

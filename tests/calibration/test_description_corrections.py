@@ -81,6 +81,7 @@ def test_jacobian_is_with_respect_to_the_readings(puma, tmp_path):
     assert np.abs(rigid - jac).max() > 1e-6
 
 
+@pytest.mark.slow
 def test_identified_payload_and_its_compliances_carried(tmp_path):
     r = robot("puma560")
     true = perturbed_robot(r, 7, base=TRACKER, target=(0.0, 0.0, 0.0))

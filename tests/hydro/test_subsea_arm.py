@@ -98,6 +98,7 @@ def test_gravity_with_buoyancy_is_the_gradient_of_an_independent_potential(seed:
         np.testing.assert_allclose(model.gravity(q), grad, rtol=0, atol=1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rho", [RHO, 0.0])
 def test_net_weight_torques_at_the_zero_pose_by_hand(rho: float) -> None:
     # q = 0: every link frame is parallel to the base (the elbow's yaw 3.14159 ~ pi turns x into

@@ -82,6 +82,7 @@ def test_held_out_current_error_beats_the_readme_baseline(gen3):
 # 0.272 / 0.156, 0.271 / 0.185 and 0.298 / 0.181, noise floors 0.246, 0.243, 0.274). With the earlier default
 # (WLS with a Tikhonov weight toward the description) the two short runs were not (0.353 / 0.269
 # and 0.351 / 0.283).
+@pytest.mark.slow
 @data
 @pytest.mark.parametrize("run", [0, 1, 2], ids=WHOLE_ARM)
 def test_each_whole_arm_run_held_out(gen3, default_fit, run):

@@ -42,6 +42,7 @@ def test_noise_free_data_recover_the_base_parameters(compiled):
                                rtol=0, atol=1e-9 * np.abs(rec.tau).max())
 
 
+@pytest.mark.slow
 def test_identified_robot_reproduces_the_prediction(compiled):
     """ident.robot (a Robot) compiled anew gives the identified model's torques."""
     robot, model = compiled
@@ -70,6 +71,7 @@ def test_base_relations_hold_for_the_full_regressor(compiled):
 PIN_ORDER = [INERTIAL_NAMES.index(k) for k in ("M", "MX", "MY", "MZ", "XX", "XY", "YY", "XZ", "YZ", "ZZ")]
 
 
+@pytest.mark.slow
 @pytest.mark.oracle("pinocchio")
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_rigid_body_columns_and_base_count_match_pinocchio(tmp_path, seed):

@@ -42,6 +42,7 @@ def _fd_regressor(model, q, qd, qdd, h=1e-6):
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["planar", "puma"])
 @pytest.mark.parametrize("count", [1, 7, 17])
 def test_regressor_derivatives_match_central_differences(request, name, count):

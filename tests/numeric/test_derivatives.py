@@ -67,6 +67,7 @@ def random_state(n, seed):
     return q, qd, qdd
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("backend", ["c", "numpy"])
 @pytest.mark.parametrize("name", ["planar_2r", "puma560"])
 def test_inverse_dynamics_derivatives_match_central_differences(name, backend):

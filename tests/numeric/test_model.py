@@ -168,6 +168,7 @@ def test_published_puma560_values_from_the_compiled_model():
                                atol=5e-5)
 
 
+@pytest.mark.slow
 @pytest.mark.oracle("pinocchio")
 @pytest.mark.parametrize("seed", range(4))
 def test_random_chains_match_pinocchio(tmp_path, seed):

@@ -137,6 +137,7 @@ def test_identify_gains_set_the_drives_and_are_checked(files, tmp_path, capsys):
     assert "--gains: expected 1 or 6" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_identify_preprocessing_options_and_no_report(files, tmp_path, capsys):
     train, _ = files
     rc = main(["identify", "puma560", "--data", str(train), "--method", "ols", "--velocity", "position",
@@ -153,6 +154,7 @@ def test_identify_preprocessing_options_and_no_report(files, tmp_path, capsys):
     assert "Ia" not in {r["name"][:2] for r in _rows(tmp_path / "parameters.csv")}
 
 
+@pytest.mark.slow
 def test_identify_prints_and_reports_the_friction_and_ripple_choices(files, tmp_path, capsys):
     train, _ = files
     rc = main(["identify", "puma560", "--data", str(train), "--cutoff", "none", "-o", str(tmp_path)])
@@ -171,6 +173,7 @@ def test_identify_prints_and_reports_the_friction_and_ripple_choices(files, tmp_
     assert "--ripple: expected auto, on or off, got 'maybe'" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_identify_prints_and_reports_the_prediction_cutoff_choice(files, tmp_path, capsys):
     train, _ = files
     rc = main(["identify", "puma560", "--data", str(train), "--prediction-cutoff", "auto",
