@@ -43,8 +43,8 @@ from typing import Any
 
 import numpy as np
 
-from robodyn.identification.estimate import FOLDS
-from robodyn.identification.preprocess import Samples, preprocess, target_signal
+from robodyn.identification.estimate import FOLDS, paired_se
+from robodyn.identification.preprocess import Samples, preprocess, slowest_rate, target_signal
 from robodyn.identification.thermal import temperatures
 from robodyn.robot.errors import IdentificationError
 
@@ -110,7 +110,7 @@ def choose_prediction_cutoff(ident: Any, recordings: Sequence[Any], payloads: Se
         The chosen cut-off, Hz, and for each candidate (``"<f> Hz"``) its relative error
         against the raw target ``sqrt(sum e^2 / sum y^2)``.
     """
-    rate = min(1.0 / float(np.median(np.diff(np.asarray(r.t, float)))) for r in recordings)
+    rate = slowest_rate(recordings)
     cands = prediction_candidates(ident.preprocess.cutoff, rate)
     total = sum(int(np.asarray(r.t).size) for r in recordings)
     stride = max(1, total // SCORED_SAMPLES)
@@ -122,8 +122,7 @@ def choose_prediction_cutoff(ident: Any, recordings: Sequence[Any], payloads: Se
     for i in range(1, len(cands)):
         # paired block differences against the current choice, and their standard error
         d = errs[i] - errs[best]
-        se = float(np.std(d, ddof=1) * np.sqrt(d.size)) if d.size > 1 else 0.0
-        if d.sum() < -se:
+        if d.sum() < -paired_se(d):
             best = i
     scores = {f"{c:g} Hz": float(np.sqrt(e.sum() / max(y2, 1e-300))) for c, e in zip(cands, errs,
                                                                                        strict=True)}
@@ -135,7 +134,7 @@ def check_prediction_cutoff(recordings: Sequence[Any], option: float | str) -> N
     (before any fitting), naming the option."""
     if isinstance(option, str):
         return
-    rate = min(1.0 / float(np.median(np.diff(np.asarray(r.t, float)))) for r in recordings)
+    rate = slowest_rate(recordings)
     if not 0.0 < float(option) < 0.5 * rate:
         raise IdentificationError(f"prediction_cutoff: must lie in (0, {0.5 * rate:g}) Hz (the "
                                   f"Nyquist frequency of the slowest recording), got {option:g}")

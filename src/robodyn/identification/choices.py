@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from robodyn.identification.estimate import LAMBDA_GRID, candidate_cv_errors
+from robodyn.identification.estimate import LAMBDA_GRID, candidate_cv_errors, paired_se
 
 __all__ = ["Candidate", "Choices", "Problem", "candidates", "choose"]
 
@@ -249,7 +249,6 @@ def choose(cands: Sequence[Candidate], stacked: Callable[[Candidate], Problem]
     for i in range(1, len(scored)):
         # paired difference of the block errors against the plain candidate, and its SE
         d = blocks_err[i] - blocks_err[0]
-        se = float(np.std(d, ddof=1) * np.sqrt(d.size)) if d.size > 1 else 0.0
-        if d.sum() < -se and scored[i].score < scored[best].score:
+        if d.sum() < -paired_se(d) and scored[i].score < scored[best].score:
             best = i
     return scored[best], problems[best], scored

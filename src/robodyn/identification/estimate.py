@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["FOLDS", "LAMBDA_GRID", "RANK_RTOL", "LinearFit", "candidate_cv_errors", "cv_weight", "fit_linear",
-           "thin_svd", "truncated_lstsq"]
+           "paired_se", "thin_svd", "truncated_lstsq"]
 
 RANK_RTOL = 1e-9
 #: Eigenvalues of a Gram matrix below this fraction of the largest are dropped (:func:`_gram_cv`).
@@ -140,6 +140,12 @@ def _cv_block_errors(a: np.ndarray, b: np.ndarray, z0: np.ndarray, blocks: np.nd
     return np.array(out).reshape(-1, LAMBDA_GRID.size)
 
 
+def paired_se(d: np.ndarray) -> float:
+    """Standard error of the sum of paired block differences ``d`` (K,): ``std(d) sqrt(K)``, 0
+    for a single block; the yardstick of every "better by more than one standard error" choice."""
+    return float(np.std(d, ddof=1) * np.sqrt(d.size)) if d.size > 1 else 0.0
+
+
 def cv_weight(block_errors: np.ndarray) -> float:
     """The weight of the module docstring's rule from held-out block errors.
 
@@ -158,8 +164,7 @@ def cv_weight(block_errors: np.ndarray) -> float:
     best = int(np.argmin(total))
     for i in range(best):
         d = block_errors[:, i] - block_errors[:, best]  # paired differences to the best weight
-        se = float(np.std(d, ddof=1) * np.sqrt(d.size)) if d.size > 1 else 0.0
-        if d.sum() <= se:
+        if d.sum() <= paired_se(d):
             return float(LAMBDA_GRID[i])
     return float(LAMBDA_GRID[best])
 

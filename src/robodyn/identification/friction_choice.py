@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
-from robodyn.identification.estimate import FOLDS
+from robodyn.identification.estimate import FOLDS, paired_se
 from robodyn.identification.friction import _law, _start, without_friction
 from robodyn.identification.preprocess import Samples
 from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
@@ -81,7 +81,6 @@ def choose_friction_law(ident: Any, samples: Sequence[Samples], y_full: Sequence
     total = max(float(np.sum(r**2)), 1e-300)
     scores = {law: float(np.sqrt(e.sum() / total)) for law, e in per_block.items()}
     d = per_block["stribeck"] - per_block["linear"]
-    se = float(np.std(d, ddof=1) * np.sqrt(d.size))
     # better by more than one standard error, and by more than MIN_GAIN of the linear error
-    chosen = "stribeck" if d.sum() < -max(se, MIN_GAIN * per_block["linear"].sum()) else "linear"
+    chosen = "stribeck" if d.sum() < -max(paired_se(d), MIN_GAIN * per_block["linear"].sum()) else "linear"
     return chosen, scores

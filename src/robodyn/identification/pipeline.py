@@ -45,6 +45,7 @@ from robodyn.identification.preprocess import (
     preprocess,
     regressor_rows,
     resolve_preprocess,
+    slowest_rate,
 )
 from robodyn.identification.prior import joint_prior
 from robodyn.identification.result import BaseParameters, Identification
@@ -339,7 +340,7 @@ def _cutoff_candidates(recs: list[Any], cutoff: float | str | None) -> tuple[flo
     if cutoff != "auto":
         return (cutoff,)
     rule = resolve_preprocess(recs, "auto", "auto").cutoff
-    fs = min(1.0 / float(np.median(np.diff(np.asarray(r.t, float)))) for r in recs)
+    fs = slowest_rate(recs)
     wide = min(CUTOFF_WIDER * rule, 0.2 * fs)
     return ("auto", wide) if wide > 1.01 * rule else ("auto",)
 

@@ -38,6 +38,7 @@ largest integer not above ``fs / (5 cutoff)``, i.e. about five samples per cut-o
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -49,7 +50,7 @@ from robodyn.robot.errors import IdentificationError
 
 __all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "DEAD_BAND", "MID_RATE", "Preprocess", "Samples",
            "coulomb_dead_band", "evaluation_step", "filtered_rows", "prediction_rows", "preprocess",
-           "regressor_rows", "resolve_preprocess"]
+           "regressor_rows", "resolve_preprocess", "slowest_rate"]
 
 AUTO_MIN_HZ = 2.0
 AUTO_MAX_HZ = 5.0
@@ -116,6 +117,11 @@ def target_signal(rec: Any, target: str) -> np.ndarray | None:
     return getattr(rec, target, None)
 
 
+def slowest_rate(recordings: Sequence[Any]) -> float:
+    """The sampling rate of the slowest recording, Hz (from its median stamp step)."""
+    return min(1.0 / float(np.median(np.diff(np.asarray(r.t, float)))) for r in recordings)
+
+
 def resolve_preprocess(recordings: list[Any], cutoff: float | str | None, decimate: int | str,
                        velocity: str = "position", order: int = 4,
                        dead_band: float = DEAD_BAND) -> Preprocess:
@@ -124,7 +130,7 @@ def resolve_preprocess(recordings: list[Any], cutoff: float | str | None, decima
         raise IdentificationError(f"velocity: expected 'position' or 'measured', got {velocity!r}")
     if not (isinstance(dead_band, (int, float)) and np.isfinite(dead_band) and 0 <= dead_band < 1e3):
         raise IdentificationError(f"dead_band: expected a velocity in [0, 1000) rad/s, got {dead_band!r}")
-    fs = min(1.0 / float(np.median(np.diff(np.asarray(r.t, float)))) for r in recordings)
+    fs = slowest_rate(recordings)
     if isinstance(cutoff, str):
         if cutoff != "auto":
             raise IdentificationError(f"cutoff: expected a frequency in Hz, None or 'auto', got {cutoff!r}")

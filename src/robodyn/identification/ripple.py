@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from robodyn.identification.estimate import FOLDS
+from robodyn.identification.estimate import FOLDS, paired_se
 from robodyn.identification.friction_choice import MIN_GAIN
 from robodyn.identification.preprocess import Preprocess, Samples, evaluation_step, filtered_rows
 
@@ -209,8 +209,7 @@ def choose_ripple(residual: np.ndarray, rows: np.ndarray, blocks: np.ndarray, re
     total = max(float(np.sum(none)), 1e-300)
     scores = {"none": float(np.sqrt(none.sum() / total)), "ripple": float(np.sqrt(with_.sum() / total))}
     d = with_ - none
-    se = float(np.std(d, ddof=1) * np.sqrt(d.size))
-    return bool(d.sum() < -max(se, MIN_GAIN * none.sum())), scores
+    return bool(d.sum() < -max(paired_se(d), MIN_GAIN * none.sum())), scores
 
 
 def block_of(samples: Sequence[Samples]) -> np.ndarray:
