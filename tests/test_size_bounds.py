@@ -17,9 +17,13 @@ from robodyn.robot.sizes import MAX_GRID_SAMPLES, MAX_GRID_VALUES, max_grid_samp
     (["underwater", "underwater_2r", "--dt", "1e-12"], "underwater: --move-time 2 s at --dt 1e-12 s"),
     (["underwater", "underwater_2r", "--move-time", "1e9"], r"underwater: --move-time 1e\+09 s"),
     (["testprog", "planar_2r", "--kind", "iso-cube", "--cycles", "100000000"],
-     r"iso_cube: cycles must be an integer in \[1, 10000\]"),
+     r"--cycles: must be an integer in \[1, 10000\]"),
+    (["testprog", "planar_2r", "--kind", "iso-cube", "--dt", "0"],
+     "--dt: the sample step must be a positive number of seconds, got 0"),
+    (["testprog", "planar_2r", "--kind", "jointwise", "--dt", "nan"],
+     "--dt: the sample step must be a positive number of seconds, got nan"),
     (["testprog", "planar_2r", "--kind", "jointwise", "--speeds", "1e-9"],
-     r"speeds must be fractions in \[0.001, 1\]"),
+     r"--speeds: each must be a fraction in \[0.001, 1\] of the velocity limit, got 1e-09"),
 ])
 def test_time_bombs_exit_2_with_one_line(args, why, tmp_path, capsys):
     assert main([*args, "-o", str(tmp_path / "out")]) == 2

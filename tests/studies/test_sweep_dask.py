@@ -155,3 +155,16 @@ def test_case_that_kills_its_worker_is_recorded_and_the_sweep_goes_on(threads, b
     assert "the worker running this case died 2 times" in frame.loc[5, "error"]
     ok = frame.drop(index=5)
     assert (ok["y"] == ok.index.to_numpy(float) ** 2).all()
+
+
+@pytest.mark.slow
+def test_own_cluster_leaves_nothing_in_the_temporary_folder(tmp_path, monkeypatch):
+    # issue 23: the cluster a sweep starts kept Dask's dask-scratch-space (lock files) in the
+    # system's temporary folder after it closed
+    import tempfile
+
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
+    monkeypatch.setattr(tempfile, "tempdir", None)
+    table = sweep(noisy_square, {"x": [1, 2]}, workers=1, seed=0)
+    assert list(table["y"]) == [1.0, 4.0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == []

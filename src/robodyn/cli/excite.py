@@ -56,9 +56,29 @@ def _cmd_excite(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_testprog_options(args: argparse.Namespace) -> None:
+    """The numeric options of ``testprog``, refused by their option names before anything runs."""
+    from robodyn.studies.testprog import MAX_CYCLES, MIN_SPEED
+
+    if not 0 < args.dt < float("inf"):
+        raise InputError(f"--dt: the sample step must be a positive number of seconds, got {args.dt:g}")
+    if args.kind == "jointwise":
+        bad = [s for s in args.speeds if not MIN_SPEED <= s <= 1.0]
+        if bad:
+            raise InputError(f"--speeds: each must be a fraction in [{MIN_SPEED:g}, 1] of the velocity "
+                             f"limit, got {', '.join(f'{s:g}' for s in bad)}")
+        return
+    if not 0 < args.size < float("inf"):
+        raise InputError(f"--size: the cube edge must be a positive number of metres, got {args.size:g}")
+    if not 1 <= args.cycles <= MAX_CYCLES:
+        raise InputError(f"--cycles: must be an integer in [1, {MAX_CYCLES}] (ISO 9283 uses 30), "
+                         f"got {args.cycles}")
+
+
 def _cmd_testprog(args: argparse.Namespace) -> int:
     from robodyn.studies.testprog import jointwise
 
+    _check_testprog_options(args)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         robot = rd.load(args.robot)
@@ -74,13 +94,11 @@ def _cmd_testprog(args: argparse.Namespace) -> int:
 
 
 def _iso_cube(robot: rd.Robot, args: argparse.Namespace) -> Any:
-    """The ISO 9283 cube program, ``--size`` checked first and named when a test point is out of
-    reach (:class:`~robodyn.simulation.UnreachableError`, bad input: exit 2)."""
+    """The ISO 9283 cube program, ``--size`` named when a test point is out of reach
+    (:class:`~robodyn.simulation.UnreachableError`, bad input: exit 2)."""
     from robodyn.simulation.ik import UnreachableError
     from robodyn.studies.testprog import iso_cube
 
-    if not 0 < args.size < float("inf"):
-        raise InputError(f"--size: the cube edge must be a positive number of metres, got {args.size:g}")
     try:
         return iso_cube(robot, size=args.size, cycles=args.cycles, dt=args.dt)
     except UnreachableError as exc:

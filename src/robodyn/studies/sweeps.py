@@ -28,6 +28,7 @@ import contextlib
 import logging
 import math
 import os
+import tempfile
 import uuid
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
@@ -242,11 +243,13 @@ def _connect(client: Any, scheduler: str | None, workers: int | None, timeout: f
         finally:
             own.close()
         return
-    with local_cluster(workers) as cluster, Client(cluster, set_as_default=False) as own:
+    # the workers' scratch folder (Dask's lock files and spilled data) lives and dies with the run
+    with (tempfile.TemporaryDirectory(prefix="robodyn-dask-") as scratch,
+          local_cluster(workers, scratch) as cluster, Client(cluster, set_as_default=False) as own):
         yield own
 
 
-def local_cluster(workers: int | None = None) -> Any:
+def local_cluster(workers: int | None = None, scratch: str | None = None) -> Any:
     """The default cluster: single-threaded worker processes on 127.0.0.1, no dashboard.
 
     Dask's nanny starts workers with ``MALLOC_TRIM_THRESHOLD_=65536`` (to hand memory back to
@@ -260,6 +263,9 @@ def local_cluster(workers: int | None = None) -> Any:
     ----------
     workers : int, optional
         Worker processes (default: the usable CPU cores).
+    scratch : str, optional
+        Folder for the scheduler's and workers' scratch space (Dask's default:
+        ``dask-scratch-space`` in the system's temporary folder, which outlives the cluster).
 
     Returns
     -------
@@ -270,7 +276,10 @@ def local_cluster(workers: int | None = None) -> Any:
 
     environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
                if k != "MALLOC_TRIM_THRESHOLD_"}
-    with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
+    settings: dict[str, Any] = {"distributed.nanny.pre-spawn-environ": environ}
+    if scratch is not None:  # the scheduler's folder too, not only the workers'
+        settings["temporary-directory"] = scratch
+    with dask.config.set(settings):
         return LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1,
                             processes=True, host="127.0.0.1", dashboard_address=None,
                             silence_logs=logging.ERROR)
