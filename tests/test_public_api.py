@@ -41,6 +41,35 @@ def test_import_robodyn_x_always_gives_a_module():
     assert not packages & set(rd.__all__), packages & set(rd.__all__)
 
 
+def test_no_package_rebinds_a_submodule_name():
+    # `from robodyn.simulation.linearize import linearize` in simulation/__init__.py made
+    # `import robodyn.simulation.linearize as m` bind the function (the attribute wins): every
+    # name a package's __init__ binds must differ from its submodules' names, unless it is that
+    # submodule (read from the source, nothing imported)
+    import ast
+    from pathlib import Path
+
+    root = Path(rd.__file__).parent
+    traps = []
+    for init in root.rglob("__init__.py"):
+        package = ".".join(init.parent.relative_to(root.parent).parts)
+        subs = {p.stem for p in init.parent.glob("*.py") if p.stem != "__init__"}
+        subs |= {p.name for p in init.parent.iterdir() if (p / "__init__.py").exists()}
+        for node in ast.parse(init.read_text()).body:  # module-level bindings
+            if isinstance(node, ast.ImportFrom):
+                source = node.module or ""
+                for alias in node.names:
+                    name = alias.asname or alias.name
+                    if name in subs and f"{source}.{alias.name}" != f"{package}.{name}":
+                        traps.append(f"{package}.{name}")
+            elif isinstance(node, (ast.FunctionDef, ast.ClassDef)) and node.name in subs:
+                traps.append(f"{package}.{node.name}")
+            elif isinstance(node, ast.Assign):
+                traps += [f"{package}.{t.id}" for t in node.targets
+                          if isinstance(t, ast.Name) and t.id in subs]
+    assert traps == []
+
+
 def test_import_is_light():
     # `import robodyn` (and so the command line's start-up) pulls in none of the heavy stacks
     code = ("import sys, robodyn; heavy = [m for m in ('sympy', 'scipy', 'cvxpy', 'dask', 'pandas',"

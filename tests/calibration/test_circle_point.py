@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from robodyn.calibration import calibrate, circle_point, robot_geometry, validate
-from robodyn.calibration.circle_point import fit_circle, fit_line, joint_axis
+from robodyn.calibration.joint_axes import fit_circle, fit_line, joint_axis
 from robodyn.calibration.kinematics import rot, trans
 from robodyn.studies.calibration_study import HOME, circle_sets, perturbed_robot, robot_positions
 from tests.calibration.helpers import TARGET, TRACKER, poses, robot
@@ -155,7 +155,7 @@ def test_registration_places_nominal_axes_on_measured_ones():
     r = robot("puma560")
     g = robot_geometry(r)
     x = trans(1.0, 2.0, -0.5) @ rot("z", 1.0) @ rot("y", 0.2)
-    from robodyn.calibration.circle_point import register_lines
+    from robodyn.calibration.joint_axes import register_lines
 
     pts = g.points @ x[:3, :3].T + x[:3, 3]
     dirs = g.directions @ x[:3, :3].T

@@ -11,10 +11,10 @@ Modules: :mod:`~.models` (DH, Hayati, S-model, POE), :mod:`~.nominal` (geometry 
 :mod:`~.iso9283`, :mod:`~.io` (CSV in, YAML/URDF/report out), :mod:`~.simulate_study`.
 """
 
-from robodyn.calibration.circle_point import CirclePointResult, circle_point
 from robodyn.calibration.compensation import compensate
 from robodyn.calibration.held_out import validate
 from robodyn.calibration.identifiability import Observability, Unidentifiable, observability, select_poses
+from robodyn.calibration.joint_axes import CirclePointResult, circle_point
 from robodyn.calibration.models import MODELS, ErrorModel, build_model
 from robodyn.calibration.nominal import robot_geometry
 from robodyn.calibration.options import CalibrateOptions

@@ -8,7 +8,7 @@ Steps (each a function of its own module):
    target offset), refined by least squares on those 6 + 3 parameters only. Its residuals are
    the "before" errors;
 3. the initial estimate: the nominal model so placed, or circle-point analysis
-   (:mod:`~robodyn.calibration.circle_point`);
+   (:mod:`~robodyn.calibration.joint_axes`);
 4. identifiability (:mod:`~robodyn.calibration.identifiability`): the parameters no pose set can
    identify (found on random poses at the initial estimate), then those this pose set cannot;
 5. weighted Levenberg-Marquardt on all poses (:mod:`~robodyn.calibration.solve`);
@@ -25,7 +25,6 @@ from typing import Any
 
 import numpy as np
 
-from robodyn.calibration.circle_point import CirclePointResult, circle_point
 from robodyn.calibration.data_checks import check_data, check_magnitude, convert_units
 from robodyn.calibration.identifiability import (
     Unidentifiable,
@@ -34,6 +33,7 @@ from robodyn.calibration.identifiability import (
     independent_columns,
     observability,
 )
+from robodyn.calibration.joint_axes import CirclePointResult, circle_point
 from robodyn.calibration.kinematics import hom, inv
 from robodyn.calibration.models import ErrorModel, build_model, extend_model, model_frames
 from robodyn.calibration.nominal import RobotGeometry, default_frame0, robot_geometry
@@ -254,7 +254,7 @@ def calibrate(
         Likewise.
     circle_data : sequence of (q, points), optional
         One data set per joint that moves only that joint (see
-        :func:`robodyn.calibration.circle_point.circle_point`); used for the initial estimate only
+        :func:`robodyn.calibration.circle_point`); used for the initial estimate only
         (``initial="circle-point"``).
     orientations : array_like, shape (N, 3, 3), optional
         Measured target orientations in the instrument frame (then the target's orientation is

@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robodyn.calibration.circle_point import CirclePointResult
 from robodyn.calibration.identifiability import Observability, Unidentifiable
+from robodyn.calibration.joint_axes import CirclePointResult
 from robodyn.calibration.models import ErrorModel, model_frames
 from robodyn.calibration.options import CalibrateOptions
 from robodyn.robot.model import Robot

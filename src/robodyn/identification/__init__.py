@@ -5,7 +5,7 @@ Public entry point: :func:`identify` (``rd.identify``), returning an :class:`Ide
 
 from robodyn.identification.base import BaseRelations, base_relations
 from robodyn.identification.friction import FrictionFit, fit_friction
-from robodyn.identification.friction_table import friction_table
+from robodyn.identification.friction_comparison import friction_table
 from robodyn.identification.jointwise import JointIdentification, identify_joint
 from robodyn.identification.options import IdentifyOptions
 from robodyn.identification.payload import Payload

@@ -255,7 +255,7 @@ def kinova_section(out: Path, data_dir: Path | None = None, method: str = "wls",
             ident = identify(robot, train, target="current", method=method)
         friction_html = ""
         if friction_models:
-            from robodyn.identification.friction_table import friction_table
+            from robodyn.identification.friction_comparison import friction_table
 
             with progress(f"Kinova Gen3: held-out error of {len(friction_models)} friction models"):
                 ft = friction_table(robot, train, test, models=friction_models, target="current",
@@ -415,7 +415,7 @@ def _joint_row(j: int, robot: Any, ident: Any, held_id: Sequence[Validation],
 
 
 def _friction_html(ft: Any, names: Sequence[str]) -> str:
-    """The friction-model table (``robodyn.identification.friction_table.friction_table``) as HTML."""
+    """The friction-model table (``robodyn.identification.friction_comparison.friction_table``) as HTML."""
     rows = [[r["model"], f"{r['relative_error']:.3f}", f"{r['relative_error_filtered']:.3f}",
              f"{r['noise_floor']:.3f}", *(f"{r[f'relative_error_{n}']:.3f}" for n in names)]
             for _, r in ft.iterrows()]
@@ -423,7 +423,7 @@ def _friction_html(ft: Any, names: Sequence[str]) -> str:
                *names)
     return f"""<h3>What friction adds (held-out current error by friction model)</h3>
 <p>Each friction model identified anew on the same 70 % and evaluated on the same held-out 30 %
-(<code>robodyn.identification.friction_table.friction_table</code>; "against filtered" and the noise floor
+(<code>robodyn.identification.friction_table</code>; "against filtered" and the noise floor
 use the identification's own low-pass cut-off). "none" is the rigid-body and drive model
 alone: the difference to the other rows is what friction is worth here.</p>
 {html_table(headers, rows)}"""

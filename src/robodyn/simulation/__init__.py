@@ -13,7 +13,7 @@ The AA300 design study and the double-pendulum balance are in
 from robodyn.simulation.controllers import LQR, PD, PID, ComputedTorque, Controller, GravityCompensation
 from robodyn.simulation.energy import frame_origins, potential_energy
 from robodyn.simulation.ik import IKResult, UnreachableError, inverse_kinematics
-from robodyn.simulation.linearize import Linearization, linearize
+from robodyn.simulation.linearization import Linearization, linearize
 from robodyn.simulation.options import SimulateOptions
 from robodyn.simulation.simulation import ADAPTIVE, FIXED_STEP, Trajectory, simulate
 from robodyn.simulation.trajectory import (

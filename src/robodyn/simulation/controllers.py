@@ -29,7 +29,7 @@ from robodyn.codegen.fixed_step import LAW_MODES
 from robodyn.codegen.fixed_step import law as sampled_law
 from robodyn.numeric.model import Model
 from robodyn.robot.errors import InputError
-from robodyn.simulation.linearize import Linearization, linearize
+from robodyn.simulation.linearization import Linearization, linearize
 from robodyn.simulation.trajectory import JointTrajectory
 
 Reference = np.ndarray | JointTrajectory
