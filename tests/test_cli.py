@@ -349,7 +349,8 @@ def test_every_command_group_registers_itself_the_same_way():
     import robodyn.cli as cli
 
     groups = [m.name for m in pkgutil.iter_modules(cli.__path__) if m.name not in ("args", "__main__")]
-    assert len(groups) == 7
+    assert len(groups) == 8
+    registered = []
     for name in groups:
         parser = argparse.ArgumentParser()
         sub = parser.add_subparsers()
@@ -357,3 +358,7 @@ def test_every_command_group_registers_itself_the_same_way():
         assert sub.choices, name
         for command in sub.choices.values():
             assert command.format_help()
+        registered += list(sub.choices)
+    # every command of `robodyn` comes from one group, none from robodyn.cli itself
+    everything = cli._parser()._subparsers._group_actions[0].choices
+    assert sorted(registered) == sorted(everything)

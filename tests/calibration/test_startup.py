@@ -41,10 +41,10 @@ def test_loading_a_builtin_robot_does_not_import_the_urdf_loader():
 
 
 def test_parser_literals_match_their_sources():
-    from robodyn import cli
     from robodyn.calibration.models import MODELS
     from robodyn.calibration.nongeometric import DEFLECTIONS
     from robodyn.cli import cache as cli_cache
+    from robodyn.cli import equations as cli
     from robodyn.cli import identify as cli_identify
     from robodyn.cli import workflows as cli_workflows
     from robodyn.codegen.build import DEFAULT_CACHE_MAX_MB
