@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import re
 
 import pytest
@@ -73,6 +74,6 @@ def test_the_user_data_is_not_modified() -> None:
     before = repr(data)
     robot = load_yaml_text(yaml.safe_dump(data), source="w.yaml")
     assert repr(data) == before
-    with pytest.raises(TypeError):
-        robot.fluid["density"] = 1  # type: ignore[index]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        robot.fluid.density = 1  # type: ignore[misc]
     assert re.fullmatch(r"[0-9a-f]{64}", robot.description_hash)

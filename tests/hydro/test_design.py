@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import sympy as sp
 
 import robodyn as rd
 from robodyn.robot.errors import StudyError
@@ -86,8 +87,8 @@ def test_more_drag_gives_a_smaller_free_swing() -> None:
     still, flowing = cur["free_mean"].to_numpy()
     assert np.pi / 2 < flowing < still < np.pi
     assert np.sin(flowing) > np.sin(still) + 0.01
-    assert with_drag_coefficient(pendulum, 2.0).links[0].hydro["drag"] == 2.0
-    assert pendulum.links[0].hydro["drag"] == "Cd"  # the input is not modified
+    assert with_drag_coefficient(pendulum, 2.0).links[0].hydro.drag == 2.0
+    assert pendulum.links[0].hydro.drag == sp.Symbol("Cd", real=True)  # the input is not modified
 
 
 def test_bad_sweep_values_are_refused() -> None:

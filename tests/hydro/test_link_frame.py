@@ -88,9 +88,8 @@ def _world_functions(robot: rd.Robot) -> list:
     out = []
     for link, lk in enumerate(robot.links):
         t = kin.links[link]
-        for cyl in lk.hydro["cylinders"]:
-            a = sp.Matrix(cyl["axis"]) / sp.sqrt(sum(x**2 for x in cyl["axis"]))
-            pt = S.translation(t) + S.rotation(t) * (sp.Matrix(cyl["start"]) + xi * a)
+        for cyl in lk.hydro.cylinders:
+            pt = S.translation(t) + S.rotation(t) * (cyl.start + xi * cyl.axis)
             out.append((link, cyl, sp.lambdify([q], S.rotation(t)),
                         sp.lambdify([q, xi], point_jacobian(robot, kin, pt, link + 1)[:3, :])))
     return out
@@ -103,8 +102,8 @@ def _world_reference(functions: list, qv: np.ndarray, qdv: np.ndarray) -> tuple[
               dict(cd=1.0, cl=0.0, cf=0.0, cax=0.0)]
     m_a, tau = np.zeros((3, 3)), np.zeros(3)
     for link, cyl, rot_fn, jac_fn in functions:
-        a = np.array(cyl["axis"], float) / np.linalg.norm(cyl["axis"])
-        r, length = cyl["radius"], cyl["length"]
+        a = np.array(cyl.axis, float).ravel()  # unit axis (normalised when the file was read)
+        r, length = float(cyl.radius), float(cyl.length)
         c = coeffs[link]
         e = np.array(rot_fn(qv), float) @ a
         p = np.eye(3) - np.outer(e, e)
@@ -132,8 +131,8 @@ def _added_energy(functions: list, qv: np.ndarray, qdv: np.ndarray,
     cax = (0.0, 0.2, 0.0)
     energy, momentum = 0.0, np.zeros(3)
     for link, cyl, rot_fn, jac_fn in functions:
-        a = np.array(cyl["axis"], float) / np.linalg.norm(cyl["axis"])
-        r, length = cyl["radius"], cyl["length"]
+        a = np.array(cyl.axis, float).ravel()  # unit axis (normalised when the file was read)
+        r, length = float(cyl.radius), float(cyl.length)
         e = np.array(rot_fn(qv), float) @ a
         p = np.eye(3) - np.outer(e, e)
         m_n = 1025.0 * np.pi * r**2

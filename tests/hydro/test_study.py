@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+import sympy as sp
 
 import robodyn as rd
 from robodyn.report.underwater import study_section, write_study
@@ -141,9 +142,10 @@ def test_variants_are_new_robots_and_the_input_is_untouched() -> None:
     dry = effect_variant(robot, "dry")
     assert dry.fluid is None and all(lk.hydro is None for lk in dry.links)
     wet = effect_variant(robot, "drag")
-    assert wet.links[0].hydro["lift"] == 0.0 and wet.links[0].hydro["drag"] == "Cd"
-    assert wet.fluid["current"] == [0.0, 0.0, 0.0]
-    assert robot.links[0].hydro["lift"] == "CL"
+    cd, cl = sp.Symbol("Cd", real=True), sp.Symbol("CL", real=True)
+    assert wet.links[0].hydro.lift == 0.0 and wet.links[0].hydro.drag == cd
+    assert wet.fluid.current == sp.ImmutableMatrix([0.0, 0.0, 0.0])
+    assert robot.links[0].hydro.lift == cl
 
 
 def test_robot_without_hydro_blocks_is_refused_by_name() -> None:

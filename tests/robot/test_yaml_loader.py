@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import dataclasses
 import re
 import textwrap
 import warnings
@@ -94,8 +95,14 @@ def test_two_link_arm_loads(tmp_path: Path) -> None:
     assert up.com == sp.ImmutableMatrix([-l1 / 2, 0, 0])
     assert up.inertia == sp.ImmutableMatrix(sp.diag(0, m1 * l1**2 / 12, m1 * l1**2 / 12))
     assert fore.inertia[1, 1] == m2 * l2**2 / 12
-    assert dict(fore.hydro) == {
-        "cylinders": [{"radius": 0.05, "length": "l2", "axis": [1, 0, 0], "start": ["-l2", 0, 0]}]}
+    # the hydro block, parsed: expressions over the parameters, the defaults filled in
+    (cyl,) = fore.hydro.cylinders
+    assert (cyl.radius, cyl.length) == (sp.Float(0.05), l2)
+    assert cyl.axis == sp.ImmutableMatrix([1, 0, 0]) and cyl.start == sp.ImmutableMatrix([-l2, 0, 0])
+    assert (fore.hydro.added_mass, fore.hydro.drag, fore.hydro.lift) == (1.0, 1.2, 0.0)
+    assert sp.simplify(fore.hydro.volume - sp.pi * sp.Float(0.05) ** 2 * l2) == 0
+    assert sp.simplify(fore.hydro.center_of_buoyancy - sp.ImmutableMatrix([-l2 / 2, 0, 0])) == sp.zeros(3, 1)
+    assert robot.fluid is None and fore.hydro.quadrature == 6
     j1 = robot.joints[0]
     assert j1.lower == -sp.pi and j1.upper == sp.pi
     assert j1.velocity_limit == 2 and j1.effort_limit == 50
@@ -137,8 +144,8 @@ def test_user_data_is_not_mutated(tmp_path: Path) -> None:
     before = copy.deepcopy(data)
     robot = load_yaml_text(yaml.safe_dump(data), source="mem")
     assert data == before
-    with pytest.raises(TypeError):
-        robot.links[1].hydro["drag"] = 2.0  # type: ignore[index]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        robot.links[1].hydro.drag = 2.0  # type: ignore[misc]
 
 
 def test_exact_pi_over_2_folding() -> None:

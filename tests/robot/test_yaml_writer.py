@@ -16,6 +16,7 @@ from robodyn import spatial as S
 from robodyn.robot import placement, yaml_loader
 from robodyn.robot.chain import ChainElement, assemble
 from robodyn.robot.errors import DescriptionWarning
+from robodyn.robot.hydro import parse_hydro
 from robodyn.robot.model import Drive, Friction, Link, Robot
 from robodyn.robot.yaml_writer import dump_yaml, matrix_to_rpy
 
@@ -237,13 +238,19 @@ def test_header_description_and_yaml_floats() -> None:
     assert isinstance(data["joints"][0]["drive"]["rotor_inertia"], float)
 
 
-def test_hydro_is_written_verbatim_or_refused() -> None:
-    hydro = {"cylinders": [{"radius": 0.05, "length": 0.4, "axis": [0, 0, 1]}], "drag": 1.2}
+def test_hydro_is_written_field_by_field_or_refused() -> None:
+    block = {"cylinders": [{"radius": 0.05, "length": 0.4, "axis": [0, 0, 2]}], "drag": 1.3}
+    hydro = parse_hydro(block, {}, {}, where="test")
     pre, axis, post = placement.from_origin([0, 0, sp.Float(0.1)], [0, 0, 0], [0, 0, 1])
     link = Link("l0", sp.Integer(1), sp.ImmutableMatrix([0, 0, 0]), sp.ImmutableMatrix(sp.eye(3)),
                 hydro=hydro)
     robot = assemble("wet", [ChainElement("j0", "revolute", pre, axis, post, link)])
-    assert dict(reload(robot).links[0].hydro) == hydro
+    back = reload(robot).links[0].hydro
+    # what the block gave, and the defaults, read back exactly; the volume pi r^2 L within rounding
+    assert back.cylinders == hydro.cylinders and back.cylinders[0].axis == sp.ImmutableMatrix([0, 0, 1])
+    assert (back.drag, back.added_mass, back.lift, back.quadrature) == (1.3, 1.0, 0.0, 6)
+    assert back.center_of_buoyancy == sp.ImmutableMatrix([0, 0, 0.2])
+    assert float(back.volume) == pytest.approx(np.pi * 0.05**2 * 0.4, rel=1e-14)
     pre, axis, post = placement.from_dh("revolute", sp.Float(0.3), 0, 0, 0)
     robot = assemble("wet_dh", [ChainElement("j0", "revolute", pre, axis, post, link)])
     with pytest.raises(ValueError, match="hydro"):

@@ -1,9 +1,10 @@
 """The ``fluid`` and ``hydro`` blocks of a description, read into frozen data.
 
-A robot description keeps both blocks verbatim (``Robot.fluid``, ``Link.hydro``: plain YAML
-data); this module reads them, strictly, into :class:`Fluid` and :class:`LinkHydro` whose
-numeric fields are SymPy expressions over the robot's named parameters, exactly like every other
-description quantity. The YAML loader calls the same functions to reject bad blocks at load time.
+The YAML loader reads both blocks once, strictly, with :func:`parse_fluid` and
+:func:`parse_hydro` into :class:`Fluid` (``Robot.fluid``) and :class:`LinkHydro`
+(``Link.hydro``), frozen data whose numeric fields are SymPy expressions over the robot's named
+parameters, exactly like every other description quantity. A variant (another drag coefficient,
+no current) is ``dataclasses.replace`` of them.
 
 Schema (lengths m, density kg/m^3, velocity m/s, coefficients dimensionless)::
 
@@ -25,16 +26,19 @@ Schema (lengths m, density kg/m^3, velocity m/s, coefficients dimensionless)::
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import sympy as sp
 
 from robodyn.robot.errors import DescriptionError
 from robodyn.robot.expressions import parse_value
-from robodyn.robot.model import Robot
 from robodyn.robot.validation import evaluate
+
+if TYPE_CHECKING:
+    from robodyn.robot.model import Robot
 
 __all__ = [
     "CYLINDER_KEYS",
@@ -48,6 +52,9 @@ __all__ = [
     "hydro_of",
     "parse_fluid",
     "parse_hydro",
+    "still_water",
+    "with_current",
+    "with_values",
 ]
 
 FLUID_KEYS = ("density", "current")
@@ -198,10 +205,11 @@ def parse_fluid(data: Any, symbols: Mapping[str, sp.Symbol], defaults: Mapping[s
     """
     f = _Fields(where, symbols, defaults)
     m = f.mapping(data, "", FLUID_KEYS)
+    still = still_water()
     density = (f.bounded(m["density"], ".density", "density", positive=True)
-               if "density" in m else sp.Integer(1000))
-    current = f.vector(m["current"], ".current")[0] if "current" in m else [sp.Integer(0)] * 3
-    return Fluid(density=density, current=sp.ImmutableMatrix(current))
+               if "density" in m else still.density)
+    current = sp.ImmutableMatrix(f.vector(m["current"], ".current")[0]) if "current" in m else still.current
+    return Fluid(density=density, current=current)
 
 
 def parse_hydro(data: Any, symbols: Mapping[str, sp.Symbol], defaults: Mapping[str, float], *,
@@ -281,25 +289,37 @@ def _cylinder(f: _Fields, value: Any, path: str) -> Cylinder:
                     start=sp.ImmutableMatrix(start))
 
 
+def still_water() -> Fluid:
+    """Still fresh water: density 1000 kg/m^3, no current (a ``fluid`` block's defaults)."""
+    return Fluid(density=sp.Integer(1000), current=sp.ImmutableMatrix([sp.Integer(0)] * 3))
+
+
 def fluid_of(robot: Robot) -> Fluid | None:
     """The robot's :class:`Fluid`; None when it has neither a ``fluid`` nor any ``hydro`` block.
 
-    A robot with hydro data and no ``fluid`` block works in still fresh water (the defaults:
-    density 1000 kg/m^3, no current).
+    A robot with hydro data and no ``fluid`` block works in still fresh water
+    (:func:`still_water`).
     """
-    data = getattr(robot, "fluid", None)
-    if data is None:
-        if all(link.hydro is None for link in robot.links):
-            return None
-        data = {}
-    return parse_fluid(data, robot.symbols, robot.parameters, where=f"{robot.source}: fluid")
+    if robot.fluid is not None:
+        return robot.fluid
+    return None if all(link.hydro is None for link in robot.links) else still_water()
 
 
 def hydro_of(robot: Robot) -> tuple[LinkHydro | None, ...]:
     """Each link's :class:`LinkHydro` (None for a link without a ``hydro`` block), length n."""
-    return tuple(
-        None if link.hydro is None else parse_hydro(
-            link.hydro, robot.symbols, robot.parameters,
-            where=f"{robot.source}: link {link.name!r} hydro")
-        for link in robot.links
-    )
+    return tuple(link.hydro for link in robot.links)
+
+
+def with_values(hydro: LinkHydro, values: Mapping[str, float]) -> LinkHydro:
+    """``hydro`` (not modified) with coefficients or the volume set to numbers, as a ``hydro``
+    block giving them would read (``{"drag": 0.8}``, ``{"volume": 0.0}``)."""
+    unknown = [k for k in values if k not in (*HYDRO_DEFAULTS, "volume")]
+    if unknown:
+        raise DescriptionError(f"hydro values: unknown {', '.join(map(repr, unknown))} (allowed: "
+                               f"{', '.join((*HYDRO_DEFAULTS, 'volume'))})")
+    return dataclasses.replace(hydro, **{k: sp.Float(float(v)) for k, v in values.items()})
+
+
+def with_current(fluid: Fluid, current: Sequence[float]) -> Fluid:
+    """``fluid`` (not modified) with the current velocity ``current`` (3,), m/s, base frame."""
+    return dataclasses.replace(fluid, current=sp.ImmutableMatrix([sp.Float(float(c)) for c in current]))

@@ -19,17 +19,21 @@ is a unit 3-vector in the frame reached after ``pre_i``. Standard DH gives ``pre
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import sympy as sp
 
 from robodyn.robot.corrections import JointCorrections
 from robodyn.robot.errors import InputError
+
+if TYPE_CHECKING:  # parsed by robodyn.robot.hydro, which reads this module's Robot
+    from robodyn.robot.hydro import Fluid, LinkHydro
 
 JointType = Literal["revolute", "prismatic"]
 
@@ -105,15 +109,16 @@ class Link:
         Centre of mass in the link frame, m.
     inertia : sympy.ImmutableMatrix, shape (3, 3)
         Inertia tensor about the centre of mass, in the link frame axes, kg m^2.
-    hydro : Mapping or None
-        Optional per-link hydrodynamic shape data (used by the underwater stage), kept verbatim.
+    hydro : LinkHydro or None
+        The link's hydrodynamic data (cylinders, coefficients, buoyancy), read from its ``hydro``
+        block by :func:`robodyn.robot.hydro.parse_hydro`; None for a dry link.
     """
 
     name: str
     mass: sp.Expr
     com: sp.ImmutableMatrix
     inertia: sp.ImmutableMatrix
-    hydro: Mapping[str, Any] | None = None
+    hydro: LinkHydro | None = None
 
     @property
     def first_moment(self) -> sp.ImmutableMatrix:
@@ -190,9 +195,10 @@ class Robot:
         Default values of the named symbolic parameters the description declares.
     source : str
         Where the description came from (file path or ``builtin:NAME``).
-    fluid : Mapping or None
-        The description's ``fluid`` block (density, current), kept verbatim like ``Link.hydro``;
-        read by :func:`robodyn.robot.hydro.fluid_of`.
+    fluid : Fluid or None
+        The description's ``fluid`` block (density, current) read by
+        :func:`robodyn.robot.hydro.parse_fluid`; None without one (a robot with wet links then
+        works in still fresh water: :func:`robodyn.robot.hydro.fluid_of`).
     corrections : JointCorrections or None
         Joint-reading corrections of a kinematic calibration (compliance, transmission errors),
         honoured by forward kinematics (:mod:`robodyn.robot.corrections`); None for a rigid,
@@ -208,7 +214,7 @@ class Robot:
     parameters: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
     source: str = "<memory>"
     description_hash: str = ""
-    fluid: Mapping[str, Any] | None = None
+    fluid: Fluid | None = None
     corrections: JointCorrections | None = None
 
     def __post_init__(self) -> None:
@@ -249,8 +255,8 @@ class Robot:
 def _canonical_text(robot: Robot) -> str:
     """A deterministic text of everything that defines the robot (for hashing).
 
-    JSON with sorted keys: mappings kept verbatim (``hydro``) hash the same whatever their key
-    order; expressions and matrices enter as their SymPy text.
+    JSON with sorted keys; expressions and matrices enter as their SymPy text, the hydro and
+    fluid data field by field.
     """
     joints = [
         {"name": j.name, "type": j.type, "pre": str(j.pre), "axis": str(j.axis),
@@ -277,7 +283,10 @@ def _canonical_text(robot: Robot) -> str:
 
 
 def _plain(value: Any) -> Any:
-    """Verbatim data as JSON-ready values: text keys, lists for sequences."""
+    """Hydro and fluid data as JSON-ready values: dataclasses field by field, lists for
+    sequences, expressions as text (:func:`_json_default`)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
     if isinstance(value, Mapping):
         return {str(k): _plain(v) for k, v in value.items()}
     if isinstance(value, list | tuple):

@@ -9,7 +9,6 @@ physically impossible values are rejected with a :class:`DescriptionError` whose
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import math
 from collections.abc import Mapping, Sequence
@@ -203,7 +202,8 @@ class _Reader:
         return [self.expr(v, f"{path}[{k}]") for k, v in enumerate(value)]
 
     def plain(self, value: Any, path: str) -> None:
-        """Data kept verbatim (``hydro``): text-keyed mappings, lists, text, numbers, booleans."""
+        """Plain data before it is parsed (``hydro``, ``fluid``): text-keyed mappings, lists,
+        text, numbers, booleans."""
         if isinstance(value, Mapping):
             for key, item in value.items():
                 if not isinstance(key, str):
@@ -240,8 +240,7 @@ class _Reader:
         fluid = None
         if "fluid" in top:
             self.plain(top["fluid"], "fluid")
-            parse_fluid(top["fluid"], self.symbols, self.defaults, where=f"{self.source}: fluid")
-            fluid = MappingProxyType(copy.deepcopy(dict(top["fluid"])))
+            fluid = parse_fluid(top["fluid"], self.symbols, self.defaults, where=f"{self.source}: fluid")
         tool = self.pose(top["tool"], "tool") if "tool" in top else None
 
         joints = top["joints"]
@@ -479,8 +478,8 @@ class _Reader:
             if not isinstance(m["hydro"], Mapping):
                 raise self.error(f"{path}.hydro", f"expected a mapping, got {_kind(m['hydro'])}")
             self.plain(m["hydro"], f"{path}.hydro")
-            parse_hydro(m["hydro"], self.symbols, self.defaults, where=f"{self.source}: {path}.hydro")
-            hydro = MappingProxyType(copy.deepcopy(dict(m["hydro"])))
+            hydro = parse_hydro(m["hydro"], self.symbols, self.defaults,
+                                where=f"{self.source}: {path}.hydro")
         link = Link(
             name=name, mass=mass, com=sp.ImmutableMatrix(com),
             inertia=sp.ImmutableMatrix(inertia), hydro=hydro,

@@ -15,7 +15,8 @@ the ``origin`` form, so it is moved:
 The written description therefore has the same forward kinematics (every moving frame
 before each ``post_i`` and the tool frame coincide) and the same masses, centres of mass and
 inertia tensors in world terms; only the link frames of joints with a ``post`` transform
-change, to the frame before ``post``. Link ``hydro`` data are written verbatim, which is only
+change, to the frame before ``post``. Link ``hydro`` data are written field by field in the
+link frame (every coefficient, the volume and the centre of buoyancy given), which is only
 right in an unchanged link frame: a link with hydro data after a joint with a non-identity
 ``post`` raises :class:`ValueError`.
 
@@ -42,6 +43,7 @@ from sympy.printing.str import StrPrinter
 from robodyn import spatial as S
 from robodyn.robot.errors import DescriptionError, InputError
 from robodyn.robot.expressions import parse_value
+from robodyn.robot.hydro import HYDRO_DEFAULTS, LinkHydro
 from robodyn.robot.model import IDENTITY4, Joint, Link, Robot
 
 __all__ = ["dump_yaml", "matrix_to_rpy", "origin_form"]
@@ -266,20 +268,20 @@ class _Scalars:
         return f"{{xyz: {self.seq(xyz, where + '.xyz')}, rpy: {self.seq(rpy, where + '.rpy')}}}"
 
 
-def _plain_data(value: Any) -> Any:
-    """Hydro data as plain YAML-safe Python values."""
-    if isinstance(value, Mapping):
-        return {str(k): _plain_data(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_plain_data(v) for v in value]
-    if isinstance(value, sp.Basic):
-        e = sp.sympify(value)
-        if e.is_Integer:
-            return int(e)
-        if e.is_Float:
-            return float(e)
-        return _PRINTER.doprint(e)
-    return value
+def _hydro_text(h: LinkHydro, value: _Scalars, where: str) -> str:
+    """A link's hydro data as a flow mapping with every field given (volume and centre of
+    buoyancy too: they read back as given, equal to the cylinders' when derived from them)."""
+    cylinders = ", ".join(
+        f"{{radius: {value(c.radius, f'{where}.cylinders[{k}].radius')}, "
+        f"length: {value(c.length, f'{where}.cylinders[{k}].length')}, "
+        f"axis: {value.seq(list(c.axis), f'{where}.cylinders[{k}].axis')}, "
+        f"start: {value.seq(list(c.start), f'{where}.cylinders[{k}].start')}}}"
+        for k, c in enumerate(h.cylinders))
+    coefficients = {key: getattr(h, key) for key in HYDRO_DEFAULTS}
+    return (f"{{cylinders: [{cylinders}], {value.mapping(coefficients, where)[1:-1]}, "
+            f"volume: {value(h.volume, where + '.volume')}, "
+            f"center_of_buoyancy: {value.seq(list(h.center_of_buoyancy), where + '.center_of_buoyancy')}, "
+            f"quadrature: {h.quadrature}}}")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -326,8 +328,9 @@ def dump_yaml(robot: Robot) -> str:
     lines.append(f"base: {value.pose(*_xyz_rpy(robot.base), 'base')}")
     lines.append(f"tool: {value.pose(*_xyz_rpy(tool), 'tool')}")
     if robot.fluid is not None:
-        text = yaml.safe_dump(_plain_data(robot.fluid), default_flow_style=True, width=10**6)
-        lines.append(f"fluid: {text.strip()}")
+        f = robot.fluid
+        lines.append(f"fluid: {{density: {value(f.density, 'fluid.density')}, "
+                     f"current: {value.seq(list(f.current), 'fluid.current')}}}")
     if robot.corrections is not None:  # floats as repr: read back bit for bit
         block = yaml.safe_dump({"corrections": robot.corrections.as_plain(robot.joint_names)},
                                default_flow_style=None, sort_keys=False, width=10**6)
@@ -389,7 +392,6 @@ def _joint_lines(
         f"      com: {value.seq(list(link.com), lw + '.com')}",
         f"      inertia: {value.mapping(inertia, lw + '.inertia')}",
     ]
-    if link.hydro:
-        text = yaml.safe_dump(_plain_data(link.hydro), default_flow_style=True, width=10**6)
-        lines.append(f"      hydro: {text.strip()}")
+    if link.hydro is not None:
+        lines.append(f"      hydro: {_hydro_text(link.hydro, value, lw + '.hydro')}")
     return lines

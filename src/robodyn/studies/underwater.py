@@ -43,7 +43,6 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -51,7 +50,7 @@ from tqdm import tqdm
 
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import StudyError
-from robodyn.robot.hydro import fluid_of
+from robodyn.robot.hydro import fluid_of, with_current, with_values
 from robodyn.robot.model import Robot
 from robodyn.robot.overrides import checked_parameter_values
 from robodyn.robot.sizes import time_grid_steps
@@ -217,19 +216,19 @@ def effect_variant(robot: Robot, effect: str, *, current: Sequence[float] | None
         if lk.hydro is None:
             links.append(lk)
             continue
-        block: dict[str, Any] = dict(lk.hydro)
+        values: dict[str, float] = {}
         for name, keys in _COEFFICIENTS.items():
             for key in keys:
                 if level < EFFECTS.index(name):
-                    block[key] = 0.0
+                    values[key] = 0.0
                 elif key == "lift" and lift is not None:
-                    block[key] = float(lift)
-        links.append(dataclasses.replace(lk, hydro=block))
-    fluid: dict[str, Any] = dict(robot.fluid or {})
+                    values[key] = float(lift)
+        links.append(dataclasses.replace(lk, hydro=with_values(lk.hydro, values)))
+    fluid = fluid_of(robot)
     if level < EFFECTS.index("current"):
-        fluid["current"] = [0.0, 0.0, 0.0]
+        fluid = with_current(fluid, [0.0, 0.0, 0.0])
     elif current is not None:
-        fluid["current"] = [float(c) for c in current]
+        fluid = with_current(fluid, current)
     return dataclasses.replace(robot, links=tuple(links), fluid=fluid, description_hash="")
 
 

@@ -29,6 +29,7 @@ from tqdm import tqdm
 
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import StudyError
+from robodyn.robot.hydro import fluid_of, with_current, with_values
 from robodyn.robot.model import Robot
 from robodyn.simulation.controllers import ComputedTorque
 from robodyn.simulation.simulation import Trajectory, simulate
@@ -90,10 +91,10 @@ def model_without(full: Robot, effect: str) -> Robot:
     if effect == "everything":
         return effect_variant(full, "dry")
     if effect == "current":
-        fluid = {**(full.fluid or {}), "current": [0.0, 0.0, 0.0]}
+        fluid = with_current(fluid_of(full), [0.0, 0.0, 0.0])
         return dataclasses.replace(full, fluid=fluid, description_hash="")
     links = tuple(lk if lk.hydro is None else dataclasses.replace(
-        lk, hydro={**lk.hydro, **dict.fromkeys(_KEYS[effect], 0.0)}) for lk in full.links)
+        lk, hydro=with_values(lk.hydro, dict.fromkeys(_KEYS[effect], 0.0))) for lk in full.links)
     return dataclasses.replace(full, links=links, description_hash="")
 
 

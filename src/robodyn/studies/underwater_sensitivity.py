@@ -32,6 +32,7 @@ from tqdm import tqdm
 
 from robodyn.numeric.model import compile_model
 from robodyn.robot.errors import StudyError
+from robodyn.robot.hydro import with_values
 from robodyn.robot.model import Robot
 from robodyn.simulation.simulation import Trajectory, simulate
 from robodyn.simulation.trajectory import JointTrajectory
@@ -75,7 +76,8 @@ def with_drag_coefficient(robot: Robot, cd: float) -> Robot:
     """``robot`` (not modified) with every wet link's normal drag coefficient set to ``cd``."""
     if not np.isfinite(cd) or cd < 0:
         raise StudyError(f"drag coefficient must be a finite number >= 0, got {cd!r}")
-    links = tuple(lk if lk.hydro is None else dataclasses.replace(lk, hydro={**lk.hydro, "drag": cd})
+    links = tuple(lk if lk.hydro is None
+                  else dataclasses.replace(lk, hydro=with_values(lk.hydro, {"drag": cd}))
                   for lk in robot.links)
     return dataclasses.replace(robot, links=links, description_hash="")
 
