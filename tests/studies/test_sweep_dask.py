@@ -145,7 +145,10 @@ def test_case_that_kills_its_worker_is_recorded_and_the_sweep_goes_on(threads, b
 
     from tests.studies.tasks import crashing_square
 
-    with dask.config.set({"distributed.scheduler.allowed-failures": 1}), \
+    # a cluster whose nanny cannot restart the worker (seen once under load) fails the tasks
+    # after a minute instead of leaving the sweep waiting for ever
+    with dask.config.set({"distributed.scheduler.allowed-failures": 1,
+                          "distributed.scheduler.no-workers-timeout": "60s"}), \
             LocalCluster(n_workers=1, threads_per_worker=threads, processes=True, host="127.0.0.1",
                          dashboard_address=None, silence_logs=logging.CRITICAL) as cluster, \
             Client(cluster, set_as_default=False) as one:
@@ -168,3 +171,23 @@ def test_own_cluster_leaves_nothing_in_the_temporary_folder(tmp_path, monkeypatc
     table = sweep(noisy_square, {"x": [1, 2]}, workers=1, seed=0)
     assert list(table["y"]) == [1.0, 4.0]
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_a_cluster_without_workers_stops_the_sweep_with_a_clear_error():
+    # issue 23: a sweep on a cluster that has lost every worker waited for ever
+    import dask
+    from distributed import Client, LocalCluster
+
+    with dask.config.set({"distributed.scheduler.no-workers-timeout": "1s"}), \
+            LocalCluster(n_workers=0, processes=True, host="127.0.0.1", dashboard_address=None,
+                         silence_logs=logging.CRITICAL) as cluster, \
+            Client(cluster, set_as_default=False) as empty:
+        with pytest.raises(StudyError, match="the cluster had no worker for its tasks"):
+            sweep(noisy_square, {"x": [1, 2]}, client=empty, seed=0)
+
+
+def test_the_sweeps_own_cluster_has_a_no_worker_timeout():
+    from robodyn.studies.sweeps import NO_WORKER_TIMEOUT, local_cluster
+
+    with local_cluster(1) as cluster:
+        assert cluster.scheduler.no_workers_timeout == NO_WORKER_TIMEOUT

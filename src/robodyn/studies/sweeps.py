@@ -80,6 +80,12 @@ def default_workers() -> int:
 #: scheduler, and ``adapt`` sees the whole study's work when it decides how many workers to ask for.
 MIN_BATCHES = 256
 
+#: Seconds the tasks of a sweep wait with no worker at all on the cluster the sweep starts itself
+#: before the sweep stops with :class:`StudyError` (its workers died and the nannies could not
+#: start new ones). Dask's ``distributed.scheduler.no-workers-timeout``; a cluster the user gives
+#: keeps its own setting (an adaptive cluster may legitimately wait longer for workers).
+NO_WORKER_TIMEOUT = 60.0
+
 
 def default_batch(n_cases: int, threads: int) -> int:
     """Cases per Dask task when ``batch`` is not given.
@@ -267,6 +273,9 @@ def local_cluster(workers: int | None = None, scratch: str | None = None) -> Any
         Folder for the scheduler's and workers' scratch space (Dask's default:
         ``dask-scratch-space`` in the system's temporary folder, which outlives the cluster).
 
+    Tasks that wait :data:`NO_WORKER_TIMEOUT` seconds with no worker on the cluster fail (the
+    sweep then stops with a :class:`StudyError`) instead of waiting for ever.
+
     Returns
     -------
     distributed.LocalCluster
@@ -276,7 +285,8 @@ def local_cluster(workers: int | None = None, scratch: str | None = None) -> Any
 
     environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
                if k != "MALLOC_TRIM_THRESHOLD_"}
-    settings: dict[str, Any] = {"distributed.nanny.pre-spawn-environ": environ}
+    settings: dict[str, Any] = {"distributed.nanny.pre-spawn-environ": environ,
+                                "distributed.scheduler.no-workers-timeout": f"{NO_WORKER_TIMEOUT:g}s"}
     if scratch is not None:  # the scheduler's folder too, not only the workers'
         settings["temporary-directory"] = scratch
     with dask.config.set(settings):
@@ -453,6 +463,7 @@ class _Run:
         recorded as failed, with the reason, the others give their rows.
         """
         from distributed import KilledWorker
+        from distributed.scheduler import NoValidWorkerError, NoWorkerError
 
         part = self.part_of.pop(fut.key)
         rows: list[Row] = []
@@ -460,6 +471,10 @@ class _Run:
             rows = fut.result()
         else:
             exc = fut.exception()
+            if isinstance(exc, NoWorkerError | NoValidWorkerError):
+                raise StudyError(f"the cluster had no worker for its tasks ({exc}): its workers "
+                                 "died and were not restarted, or none joined; the cases finished "
+                                 "so far went to on_batch") from exc
             if not isinstance(exc, KilledWorker) or self.on_error != "record":
                 raise exc
             if fut.key == self.alone:
