@@ -211,6 +211,9 @@ def test_thermal_friction_recovered_and_predicted_at_another_temperature(planar)
     np.testing.assert_allclose(fit.viscous, cv, atol=1e-9)
     np.testing.assert_allclose(fit.coulomb, cc, atol=1e-9)
     assert ident.choices.thermal
+    # friction="auto" (the default) keeps the linear law that the thermal terms extend
+    assert ident.choices.friction == "linear" and ident.choices.friction_scores == ()
+    assert "friction law linear (with the thermal friction" in ident.choices.summary()
     # a third run at 32 deg C: predicted exactly, and not without the thermal term
     rec, tau = _thermal_run(model, 13, 32.0, cv, cc, t_ref)
     np.testing.assert_allclose(ident.predict(rec), tau, rtol=0, atol=1e-8 * np.abs(tau).max())
@@ -352,15 +355,22 @@ def test_friction_law_chosen_by_held_out_blocks(planar):
     # a strong Stribeck hump (Fs = 3 Fc at low speed), written out with the library's law
     stribeck = np.column_stack([_law("stribeck", np.array([1.0, 3.0, 0.08, 0.4, 0.2]), qd[:, j],
                                      rigid[:, j]) for j in range(2)])
+    # a plain Coulomb step (1 N m) with viscous friction, which the Stribeck law can only
+    # round off near zero velocity
+    step = 1.0 * np.sign(qd) + 0.4 * qd
     noise = 0.01 * rng.standard_normal(q.shape)
-    for tau, expected in ((rigid + stribeck + noise, "stribeck"),
-                          (model.inverse_dynamics(q, qd, qdd) + noise, "linear")):
+    frictionless = model.inverse_dynamics(q, qd, qdd) + noise  # planar_2r has no friction
+    for tau, expected in ((rigid + stribeck + noise, "stribeck"), (rigid + step + noise, "linear"),
+                          (frictionless, "linear")):
         rec = _recording(model, t, q, qd, qdd, tau, expected)
         ident = rd.identify(robot, rec, cutoff=None, model=model)  # friction="auto" by default
         assert ident.choices.friction == expected, ident.choices.summary()
         assert (ident.friction_fit is not None) == (expected == "stribeck")
         scores = dict(ident.choices.friction_scores)
         assert set(scores) == {"linear", "stribeck"}
+    # without friction the laws tie and the plain one, linear, is kept: it predicts no more
+    # friction than the noise level
+    assert np.abs(ident.predict(rec) - (frictionless - noise)).max() < 0.05
 
 
 def _without_friction_truth(robot):

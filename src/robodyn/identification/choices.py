@@ -108,7 +108,8 @@ class Choices:
         The friction law chosen by ``friction="auto"`` (:mod:`robodyn.identification.friction_choice`),
         else None.
     friction_scores : tuple of (str, float)
-        Each law's relative held-out error of the friction residual (``friction="auto"``).
+        Each law's relative held-out error of the friction residual (``friction="auto"``;
+        empty when thermal friction, which extends the linear law, keeps it).
     ripple : bool or None
         Whether ``ripple="auto"`` kept the position ripple (:mod:`robodyn.identification.ripple`),
         else None.
@@ -137,6 +138,14 @@ class Choices:
     prediction_cutoff: float | None = None
     prediction_scores: tuple[tuple[str, float], ...] = ()
 
+    @property
+    def friction_reason(self) -> str:
+        """Why the friction law: its held-out scores, or the thermal friction that extends it."""
+        if not self.friction_scores:
+            return "with the thermal friction, which extends it"
+        scores = ", ".join(f"{law} {score:.4f}" for law, score in self.friction_scores)
+        return f"held-out blocks of the friction residual: {scores}"
+
     def summary(self) -> str:
         """A few lines for the terminal and the report."""
         cut = "none" if self.cutoff is None else f"{self.cutoff:g} Hz"
@@ -144,9 +153,7 @@ class Choices:
                  f"{cut}, regularization {self.regularization:g}"
                  + (", thermal friction" if self.thermal else "") + f": {self.reason}"]
         if self.friction is not None:
-            scores = ", ".join(f"{law} {score:.4f}" for law, score in self.friction_scores)
-            lines.append(f"  friction law {self.friction} (held-out blocks of the friction "
-                         f"residual: {scores})")
+            lines.append(f"  friction law {self.friction} ({self.friction_reason})")
         if self.ripple is not None:
             scores = ", ".join(f"{k} {v:.4f}" for k, v in self.ripple_scores)
             lines.append(f"  position ripple {'kept' if self.ripple else 'not kept'} (held-out "

@@ -210,7 +210,9 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
                      thermal_fit=thermal_fit)
     law = opts.friction
     if opts.friction == "auto":
-        law, scores = choose_friction_law(result, data.samples, data.y_full)
+        # thermal friction scales the linear law's columns: with it the linear law stays
+        law, scores = (("linear", {}) if thermal_fit is not None
+                       else choose_friction_law(result, data.samples, data.y_full))
         result = replace(result, choices=replace(result.choices, friction=law,
                                                  friction_scores=tuple(scores.items())))
     if law in NONLINEAR:

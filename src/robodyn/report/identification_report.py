@@ -172,9 +172,8 @@ def _choices_html(ident: Any) -> str:
              if len(ch.candidates) > 1 else "")
     laws = ""
     if ch.friction is not None:
-        scores = ", ".join(f"{k} {v:.4f}" for k, v in ch.friction_scores)
-        laws += (f"<p>Friction law <b>{html.escape(ch.friction)}</b> (held-out blocks of the "
-                 f"friction residual: {html.escape(scores)}).</p>\n")
+        laws += (f"<p>Friction law <b>{html.escape(ch.friction)}</b> "
+                 f"({html.escape(ch.friction_reason)}).</p>\n")
     if ch.ripple is not None:
         scores = ", ".join(f"{k} {v:.4f}" for k, v in ch.ripple_scores)
         kept = "kept" if ch.ripple else "not kept"
