@@ -13,8 +13,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from markupsafe import Markup
 
-from robodyn.report.html import figure, html_table, page
+from robodyn.report.html import figure, html_table, page, render
 from robodyn.validation.validation import Validation
 
 __all__ = ["KINOVA_CONTROLLER_GAINS", "combined_relative", "identification_html",
@@ -160,35 +161,19 @@ def validation_html(val: Validation, out: Path, name: str = "validation.html") -
 
 
 def _choices_html(ident: Any) -> str:
-    """The preprocessing chosen from the data and every candidate's held-out score."""
+    """The preprocessing chosen from the data and every candidate's held-out score
+    (``templates/choices.html.j2``)."""
     ch = getattr(ident, "choices", None)
     if ch is None:
         return ""
     chosen = None if ch.chosen is None else ch.chosen.key
-    rows = "".join(f"<tr><td>{html.escape(c.label)}</td><td>{c.score:.4f}</td><td>{c.lam:g}</td>"
-                   f"<td>{'chosen' if c.key == chosen else ''}</td></tr>" for c in ch.candidates)
-    table = ("<table><tr><th>candidate</th><th>held-out blocks, relative</th><th>best weight</th>"
-             "<th></th></tr>" + rows + "</table>"
-             if len(ch.candidates) > 1 else "")
-    laws = ""
-    if ch.friction is not None:
-        laws += (f"<p>Friction law <b>{html.escape(ch.friction)}</b> "
-                 f"({html.escape(ch.friction_reason)}).</p>\n")
-    if ch.ripple is not None:
-        scores = ", ".join(f"{k} {v:.4f}" for k, v in ch.ripple_scores)
-        kept = "kept" if ch.ripple else "not kept"
-        laws += (f"<p>Position ripple (a sin q + b cos q per joint) <b>{kept}</b> (held-out "
-                 f"blocks of the model's residual: "
-                 f"{html.escape(scores)}).</p>\n")
-    if ch.prediction_cutoff is not None:
-        scores = ", ".join(f"{k} {v:.4f}" for k, v in ch.prediction_scores)
-        laws += (f"<p>Prediction cut-off <b>{ch.prediction_cutoff:g} Hz</b> (relative error "
-                 f"against the raw target of the identification recordings: "
-                 f"{html.escape(scores)}).</p>\n")
-    return (f"<h2>Choices</h2>\n<p>Velocity <b>{html.escape(ch.velocity)}</b>, Coulomb dead band "
-            f"<b>{ch.dead_band:g} rad/s</b>, cut-off {_cutoff(ident)}, Tikhonov weight "
-            f"{ch.regularization:.3g}{', thermal friction' if ch.thermal else ''}: "
-            f"{html.escape(ch.reason)}.</p>\n{laws}{table}")
+    table = ""
+    if len(ch.candidates) > 1:
+        table = html_table(["candidate", "held-out blocks, relative", "best weight", ""],
+                           [(c.label, f"{c.score:.4f}", f"{c.lam:g}", "chosen" if c.key == chosen else "")
+                            for c in ch.candidates])
+    return render("choices.html.j2", ch=ch, cutoff=_cutoff(ident), table=Markup(table),
+                  scores=lambda pairs: ", ".join(f"{k} {v:.4f}" for k, v in pairs))
 
 
 def _cutoff(ident: Any) -> str:
