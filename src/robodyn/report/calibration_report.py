@@ -7,9 +7,10 @@ import math
 from pathlib import Path
 
 import numpy as np
+from markupsafe import Markup
 
 from robodyn.calibration.result import Calibration, ErrorStats
-from robodyn.report.html import figure, html_table, page
+from robodyn.report.html import figure, html_table, page, render
 from robodyn.studies.calibration_study import StudyResult
 
 __all__ = ["calibration_figure", "calibration_html", "study_section"]
@@ -99,28 +100,13 @@ def calibration_html(cal: Calibration, path: Path, *, source: str = "",
         scale, unit = (1e3, "mm") if p.unit == "m" else (180 / math.pi, "deg")
         params.append([p.name, f"{p.initial * scale:.6f}", f"{p.value * scale:.6f}",
                        f"{p.std * scale:.3g}", unit])
-    unid = "".join(f"<li><code>{html.escape(u.name)}</code> [{html.escape(u.kind)}]: "
-                   f"{html.escape(u.reason)}</li>" for u in cal.unidentifiable)
     obs = ", ".join(f"{k} {v:.4g}" for k, v in cal.observability.as_dict().items())
-    verdict = ('<span class="ok">converged</span>' if cal.converged
-               else '<span class="bad">not converged</span>')
-    body = f"""<h1>Kinematic calibration: {html.escape(cal.robot.name)}</h1>
-<p class="meta">Error model <b>{html.escape(cal.model.name)}</b>, {html.escape(cal.initial)}
-initial estimate, {html.escape(cal.loss)} loss, measurement sigma {cal.sigma * 1e3:.4g} mm,
-{cal.pose_count} poses{', data ' + html.escape(source) if source else ''}. Solver: {verdict}
-({html.escape(cal.message)}); variance factor {cal.variance_factor:.4g} (about 1 when sigma is
-right).</p>
-<h2>Position errors</h2>
-<p>"Before" is the nominal kinematics with only the instrument placement and the target offset
-fitted.</p>
-{html_table(_STATS_HEADERS, _stats_rows(stats))}
-{figure(fig, "errors before and after")}
-<h2>Identified parameters</h2>
-{html_table(("parameter", "initial", "estimate", "std", "unit"), params)}
-<h2>Not identifiable</h2>
-{f"<ul>{unid}</ul>" if unid else "<p>None: every parameter of the model was identified.</p>"}
-<p>Observability indices of the pose set: {html.escape(obs)}.</p>
-"""
+    # templates/calibration.html.j2; the tables and the figure are trusted fragments
+    body = render("calibration.html.j2", cal=cal, source=source or "", observability=obs,
+                  stats_table=Markup(html_table(_STATS_HEADERS, _stats_rows(stats))),
+                  figure=Markup(figure(fig, "errors before and after")),
+                  parameter_table=Markup(html_table(("parameter", "initial", "estimate", "std",
+                                                     "unit"), params)))
     path.write_text(page(f"robodyn calibration: {cal.robot.name}", body), encoding="utf-8")
     return path
 
