@@ -22,10 +22,12 @@ import argparse
 import json
 import re
 import sys
-import textwrap
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import render_common as rc  # noqa: E402 - sibling module of a script folder
 
 ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "README.md"
@@ -33,17 +35,6 @@ MARKER = re.compile(r"<!-- results:(?P<name>[\w-]+) (?P<path>\S+) -->\n(?P<body>
                     r"<!-- /results:(?P=name) -->", re.S)
 LIBRARIES = {"robodyn": "robodyn, no friction", "robodyn (friction)": "robodyn, PUMA friction",
              "pinocchio native": "Pinocchio native", "pinocchio wheel": "Pinocchio wheel"}
-
-
-def _wrap(text: str, bullet: bool = False) -> list[str]:
-    """Lines of at most 100 characters, as the README's prose (bullets with a hanging indent)."""
-    return textwrap.wrap(text, 100, initial_indent="* " if bullet else "",
-                         subsequent_indent="  " if bullet else "", break_long_words=False,
-                         break_on_hyphens=False)
-
-
-def _fmt(x: float) -> str:
-    return f"{x:.0f}" if x >= 100 else f"{x:.1f}"
 
 
 def _ratio_cell(ratios: list[dict[str, Any]], kernel: str, library: str) -> tuple[str, str]:
@@ -75,7 +66,7 @@ def render_kernels(data: dict[str, Any]) -> str:
     """
     m, e = data["machine"], data["benchmarks"]["kernels"]
     simd = "AVX-512F" if "avx512f" in m.get("simd", []) else "/".join(m.get("simd", [])).upper()
-    lines = _wrap(
+    lines = rc.wrap(
         f"PUMA 560 kernels against Pinocchio (`{e['command']}`, {e['states']:,} random states, one "
         f"thread, ns per state, min / median of {e['repeats']} rounds in which the libraries take "
         f"turns; {m['cpu_model']}, "
@@ -97,7 +88,7 @@ def render_kernels(data: dict[str, Any]) -> str:
             "(has friction)" if err is None else f"{err:.1e}")
         ns = row["ns_per_state"]
         lines.append(f"| {row['kernel']} | {LIBRARIES.get(row['library'], row['library'])} | "
-                     f"{_fmt(ns['min'])} | {_fmt(ns['median'])} | {speed} | {target} | {err_text} |")
+                     f"{rc.fmt(ns['min'])} | {rc.fmt(ns['median'])} | {speed} | {target} | {err_text} |")
     if e.get("skipped"):
         lines += ["", e["skipped"]]
     bullets = [f"{LIBRARIES.get(k, k)}: {v}." for k, v in e["peers"].items()]
@@ -111,54 +102,17 @@ def render_kernels(data: dict[str, Any]) -> str:
         bullets.append(f"Pinocchio native built by {n['compiler']} with `{' '.join(n['flags'])}` "
                        f"against the {n['headers']}, {n['linked']}.")
     bullets.append("The wheel's derivative loop without the Python loop's own cost: "
-                   f"{_fmt(e['wheel']['derivatives_minus_loop_ns']['min'])} ns per state (min).")
+                   f"{rc.fmt(e['wheel']['derivatives_minus_loop_ns']['min'])} ns per state (min).")
     lines += ["", "What each row is and differs in:", ""]
     for b in bullets:
-        lines += _wrap(b, bullet=True)
+        lines += rc.wrap(b, bullet=True)
     return "\n".join(lines) + "\n"
-
-
-def _machine(m: dict[str, Any]) -> str:
-    """``"<CPU>, <n> logical CPUs, <SIMD>"`` of the machine record."""
-    simd = "AVX-512F" if "avx512f" in m.get("simd", []) else "/".join(m.get("simd", [])).upper()
-    return f"{m['cpu_model']}, {m['logical_cpus']} logical CPUs, {simd or 'no AVX'}"
-
-
-def _run(data: dict[str, Any], e: dict[str, Any], what: str) -> str:
-    """The sentence opening a section: what ran, the command, the machine, load and date."""
-    quick = " (quick mode)" if "--quick" in e["command"] else ""
-    return (f"{what} (`{e['command']}`{quick}; {_machine(data['machine'])}; load average "
-            f"{' '.join(map(str, e['load_average_at_start']))} at the start and "
-            f"{' '.join(map(str, e['load_average_at_end']))} at the end; {e['date']}).")
-
-
-def _sig(x: float) -> str:
-    """About three significant digits, without exponent (1234, 123, 12.3, 1.23, 0.123)."""
-    return f"{x:.0f}" if x >= 100 else f"{x:.1f}" if x >= 10 else f"{x:.2f}" if x >= 1 else f"{x:.3f}"
-
-
-def _mm(s: dict[str, float]) -> tuple[str, str]:
-    """Min and median cells."""
-    return _sig(s["min"]), _sig(s["median"])
-
-
-def _x(r: dict[str, float], digits: int = 1) -> str:
-    """``"min / median"`` of a ratio."""
-    return f"{r['min']:.{digits}f}x / {r['median']:.{digits}f}x"
-
-
-def _table(header: list[str], rows: list[list[str]], text_last: bool = True) -> list[str]:
-    """A Markdown table: first column left-aligned, the others right-aligned (but the last,
-    with ``text_last``)."""
-    align = ["---"] + ["---:"] * (len(header) - 1 - text_last) + ["---"] * text_last
-    return ([f"| {' | '.join(header)} |", f"|{'|'.join(align)}|"]
-            + [f"| {' | '.join(r)} |" for r in rows])
 
 
 def render_casadi(data: dict[str, Any]) -> str:
     """Markdown of the ``casadi`` entry (and of ``threads`` when the file has it)."""
     e = data["benchmarks"]["casadi"]
-    lines = _wrap(_run(data, e, (
+    lines = rc.wrap(rc.run(data, e, (
         f"PUMA 560 inverse dynamics against CasADi {e['casadi_version']}-generated C of the same "
         f"program, {e['states']:,} random states, ns per state, min / median of {e['repeats']} "
         "rounds in which the rows take turns")) + (
@@ -170,14 +124,14 @@ def render_casadi(data: dict[str, Any]) -> str:
     rows = []
     for r in e["rows"]:
         err = r["max_rel_error"]
-        speed = _x(ratio[r["library"]]) if r["library"] in ratio else ""
-        rows.append([r["library"], str(r["threads"]), *_mm(r["ns_per_state"]), speed,
+        speed = rc.x(ratio[r["library"]]) if r["library"] in ratio else ""
+        rows.append([r["library"], str(r["threads"]), *rc.mm(r["ns_per_state"]), speed,
                      "reference" if err is None else f"{err:.1e}", r["note"]])
-    lines += [""] + _table(["evaluation", "threads", "min", "median",
+    lines += [""] + rc.table(["evaluation", "threads", "min", "median",
                             "robodyn's speed-up (min / median)", "max rel. error", "what differs"],
                            rows)
     if "threads" in data["benchmarks"]:
-        lines += [""] + _wrap(_threads_text(data))
+        lines += [""] + rc.wrap(_threads_text(data))
     return "\n".join(lines) + "\n"
 
 
@@ -186,32 +140,32 @@ def _threads_text(data: dict[str, Any]) -> str:
     t = data["benchmarks"]["threads"]
     ns, eff, m = t["ns_per_state"], t["efficiency"], t["mass_matrix_vs_crba"]
     effs = "; ".join(f"{k} {v:.2f}" for k, v in eff.items())
-    return (_run(data, t, f"Two threads and the mass matrix, {t['states']:,} states, min of "
+    return (rc.run(data, t, f"Two threads and the mass matrix, {t['states']:,} states, min of "
                           f"{t['repeats']} rounds") +
             f" Two-thread efficiency t1 / (2 t2): {effs} (robodyn: {t['peers']['robodyn']}; "
             f"Pinocchio: {t['peers']['pinocchio wheel']}; the logical CPUs may be shared with "
             f"other jobs, which the two-thread figures feel first). Mass matrix: robodyn "
-            f"{_fmt(ns['robodyn M 1']['min'])} ns per state against `crba` from a Python loop "
-            f"{_fmt(ns['crba loop']['min'])} ns ({m['with_loop']:.1f}x), of which the loop "
-            f"itself {_fmt(ns['python loop']['min'])} ns ({m['minus_loop']:.1f}x without it).")
+            f"{rc.fmt(ns['robodyn M 1']['min'])} ns per state against `crba` from a Python loop "
+            f"{rc.fmt(ns['crba loop']['min'])} ns ({m['with_loop']:.1f}x), of which the loop "
+            f"itself {rc.fmt(ns['python loop']['min'])} ns ({m['minus_loop']:.1f}x without it).")
 
 
 def render_ensemble(data: dict[str, Any]) -> str:
     """Markdown of the ``ensemble`` entry."""
     e = data["benchmarks"]["ensemble"]
-    lines = _wrap(_run(data, e, (
+    lines = rc.wrap(rc.run(data, e, (
         f"Ensemble RK4: {e['trajectories']:,} trolley double-pendulum trajectories of "
         f"{e['steps'] * e['dt']:g} s at {e['dt'] * 1e3:g} ms, ms per trajectory, min / median of "
         f"{e['repeats']} rounds in which the rows take turns")) + (
         " Ratio = the row's time / robodyn's ensemble on as many threads; MuJoCo and robodyn "
         f"agree to {e['mujoco_agreement_rad']:.1e} rad over all trajectories and steps."))
-    rows = [[r["library"], str(r["threads"]), *_mm(r["ms_per_trajectory"]),
-             _x(r["vs_ensemble"], 2)] for r in e["rows"]]
-    lines += [""] + _table(["run", "threads", "min", "median", "ratio (min / median)"], rows,
+    rows = [[r["library"], str(r["threads"]), *rc.mm(r["ms_per_trajectory"]),
+             rc.x(r["vs_ensemble"], 2)] for r in e["rows"]]
+    lines += [""] + rc.table(["run", "threads", "min", "median", "ratio (min / median)"], rows,
                            text_last=False)
     lines += ["", "What each row is and differs in:", ""]
     for k, v in e["peers"].items():
-        lines += _wrap(f"{k}: {v}.", bullet=True)
+        lines += rc.wrap(f"{k}: {v}.", bullet=True)
     return "\n".join(lines) + "\n"
 
 
@@ -219,7 +173,7 @@ def _sweeps_text(sweeps: dict[str, dict[str, Any]]) -> str:
     """One sentence per SciPy sweep: rtol, error and time of each trial (one run each)."""
     parts = []
     for label, s in sweeps.items():
-        trials = ", ".join(f"{t['rtol']:.0e}: {t['max_error']:.1e} in {_fmt(t['ms'])} ms"
+        trials = ", ".join(f"{t['rtol']:.0e}: {t['max_error']:.1e} in {rc.fmt(t['ms'])} ms"
                            for t in s["trials"])
         parts.append(f"{label} (rtol: max error in one run) {trials}")
         if s["matched"] is None:
@@ -236,20 +190,20 @@ def _route_table(rows: list[dict[str, Any]], key: str, targets: dict[str, float]
     out = []
     for r in rows:
         cells = [r["label"], f"{r['ms']['min']:.{digits}f}", f"{r['ms']['median']:.{digits}f}",
-                 f"{r['max_error']:.1e}", _x(r[key])]
+                 f"{r['max_error']:.1e}", rc.x(r[key])]
         if targets:
             goal = targets.get(r["label"])
             met = goal is not None and r[key]["min"] >= goal
             cells.append("" if goal is None else f">= {goal:g}x: {'met' if met else 'not met'}")
         out.append([*cells, r["settings"]])
-    return _table(header, out)
+    return rc.table(header, out)
 
 
 def render_simulation(data: dict[str, Any]) -> str:
     """Markdown of the ``simulation`` entry: trolley, PUMA kernels, generation time."""
     e = data["benchmarks"]["simulation"]
     t = e["trolley"]
-    lines = _wrap(_run(data, e, (
+    lines = rc.wrap(rc.run(data, e, (
         f"The thesis' trolley double pendulum, {t['steps'] * t['dt']:g} s of motion, ms per run, "
         f"min / median of {t['repeats']} rounds in which the rows take turns")) + (
         f" Max error: over the whole state and every 1 ms against {t['reference']} (which "
@@ -258,26 +212,26 @@ def render_simulation(data: dict[str, Any]) -> str:
         f"whose error is within {t['match_factor']:g}x robodyn's ({t['robodyn_error']:.1e}). "
         "Ratio = the row's time / `Model.integrate`'s; targets judged on the minima."))
     lines += [""] + _route_table(t["rows"], "vs_integrate", t["targets"], 3)
-    lines += [""] + _wrap(_sweeps_text(t["sweeps"]))
+    lines += [""] + rc.wrap(_sweeps_text(t["sweeps"]))
     p = e["puma"]
-    lines += [""] + _wrap(
+    lines += [""] + rc.wrap(
         f"PUMA 560 kernels against Pinocchio's wheel called from Python ({p['states']:,} states, "
         f"ns per state, minima of {p['repeats']} rounds; ratios of minima; the Python loop "
-        f"alone costs {_fmt(p['python_loop_ns']['min'])} ns per call). {p['settings']}.")
+        f"alone costs {rc.fmt(p['python_loop_ns']['min'])} ns per call). {p['settings']}.")
     th = p["threads"]
     rows = []
     for r in p["rows"]:
-        cells = [r["kernel"], _fmt(r["robodyn"]["min"]), _fmt(r["pinocchio_loop"]["min"]),
+        cells = [r["kernel"], rc.fmt(r["robodyn"]["min"]), rc.fmt(r["pinocchio_loop"]["min"]),
                  f"{r['loop_ratio']['min']:.1f}x", f"{r['minus_loop_ratio']['min']:.1f}x"]
         for key in ("one_thread", "all_threads"):
-            cells += ([_fmt(r[key]["min"]), f"{r[key + '_ratio']['min']:.1f}x"] if key in r
+            cells += ([rc.fmt(r[key]["min"]), f"{r[key + '_ratio']['min']:.1f}x"] if key in r
                       else ["", ""])
         rows.append(cells)
-    lines += [""] + _table(["kernel", "robodyn", "Pinocchio loop", "ratio", "minus the loop",
+    lines += [""] + rc.table(["kernel", "robodyn", "Pinocchio loop", "ratio", "minus the loop",
                             "*InParallel 1 thread", "ratio", f"{th} threads", "ratio"], rows,
                            text_last=False)
     c = e["compile"]
-    lines += [""] + _wrap(
+    lines += [""] + rc.wrap(
         f"Generating and compiling the PUMA 560 model in a fresh process with an empty cache "
         f"(one run): {c['first_s']:.2f} s; from the cache: {c['cached_s']:.2f} s.")
     return "\n".join(lines) + "\n"
@@ -286,28 +240,28 @@ def render_simulation(data: dict[str, Any]) -> str:
 def render_hydro(data: dict[str, Any]) -> str:
     """Markdown of the ``hydro`` entry: wet/dry cost, drag against strip sums, simulation."""
     e = data["benchmarks"]["hydro"]
-    lines = _wrap(_run(data, e, "The underwater two-link arm `underwater_2r`"))
+    lines = rc.wrap(rc.run(data, e, "The underwater two-link arm `underwater_2r`"))
     if "wet_dry" in e:
         w = e["wet_dry"]
         ns, r = w["ns_per_state"], w["ratio"]
-        lines += [""] + _wrap(
+        lines += [""] + rc.wrap(
             f"Compiled inverse dynamics with every hydrodynamic term against the same arm dry "
             f"({w['states']:,} states, min / median of {w['repeats']} rounds): "
-            f"{_fmt(ns['ID wet']['min'])} against {_fmt(ns['ID dry']['min'])} ns per state, "
-            f"{_x(r['ID'], 2)} the cost (target at most {w['target']:g}x: "
+            f"{rc.fmt(ns['ID wet']['min'])} against {rc.fmt(ns['ID dry']['min'])} ns per state, "
+            f"{rc.x(r['ID'], 2)} the cost (target at most {w['target']:g}x: "
             f"{'met' if r['ID']['min'] <= w['target'] else 'not met'}); forward dynamics "
-            f"{_x(r['FD'], 2)}.")
+            f"{rc.x(r['FD'], 2)}.")
     if "drag" in e:
         d = e["drag"]
-        lines += [""] + _wrap(
+        lines += [""] + rc.wrap(
             f"Drag with a {d['current_m_s']:g} m/s current, {d['states']:,} states, min / median "
             f"of {d['repeats']} rounds: {d['settings']}.")
-        rows = [[r["label"], *_mm(r["ns_per_state"]), f"{r['max_error']:.1e}", _x(r["vs_robodyn"])]
+        rows = [[r["label"], *rc.mm(r["ns_per_state"]), f"{r['max_error']:.1e}", rc.x(r["vs_robodyn"])]
                 for r in d["rows"]]
-        lines += [""] + _table(["drag by", "min ns", "median ns", "max error", "time / robodyn"],
+        lines += [""] + rc.table(["drag by", "min ns", "median ns", "max error", "time / robodyn"],
                                rows, text_last=False)
     s = e["simulation"]
-    lines += [""] + _wrap(
+    lines += [""] + rc.wrap(
         f"{s['steps'] * s['dt']:g} s released from rest, every effect on, min / median of "
         f"{s['repeats']} rounds in which the rows take turns; max error over the whole state "
         f"against {s['reference']} (which differs from SciPy DOP853 at rtol 1e-12 by "
@@ -315,7 +269,7 @@ def render_hydro(data: dict[str, Any]) -> str:
         f"whose error is within 2x robodyn's ({s['robodyn_error']:.1e}). Ratio = the row's "
         "time / `rd.simulate`'s.")
     lines += [""] + _route_table(s["rows"], "vs_simulate", {})
-    lines += [""] + _wrap(_sweeps_text(s["sweeps"]))
+    lines += [""] + rc.wrap(_sweeps_text(s["sweeps"]))
     return "\n".join(lines) + "\n"
 
 
@@ -325,23 +279,23 @@ def render_roofline(data: dict[str, Any]) -> str:
     p, b, i, r = e["peak"], e["triad"], e["inverse_dynamics"], e["roofline"]
     met = "met" if r["times_compute_floor"] <= r["target_times_floor"] else "not met"
     text = (
-        f"{_run(data, e, 'The roofline of one core')} Peak FP64 rate measured by "
+        f"{rc.run(data, e, 'The roofline of one core')} Peak FP64 rate measured by "
         f"{p['chains']} fused multiply-add chains on {p['vector_doubles']}-double vectors with "
-        f"robodyn's compiler flags: {_sig(p['gflops'])} GFLOP/s (median {_sig(p['median_gflops'])}); "
-        f"STREAM triad over 3 x {b['array_mib']} MiB: {_sig(b['gbs'])} GB/s (median "
-        f"{_sig(b['median_gbs'])}). PUMA 560 inverse dynamics with its friction, "
-        f"{i['states']:,} states on one thread: {_sig(i['ns_per_state']['min'])} ns per state "
-        f"(median {_sig(i['ns_per_state']['median'])}) for {r['flops_per_state']} flops: the "
+        f"robodyn's compiler flags: {rc.sig(p['gflops'])} GFLOP/s (median {rc.sig(p['median_gflops'])}); "
+        f"STREAM triad over 3 x {b['array_mib']} MiB: {rc.sig(b['gbs'])} GB/s (median "
+        f"{rc.sig(b['median_gbs'])}). PUMA 560 inverse dynamics with its friction, "
+        f"{i['states']:,} states on one thread: {rc.sig(i['ns_per_state']['min'])} ns per state "
+        f"(median {rc.sig(i['ns_per_state']['median'])}) for {r['flops_per_state']} flops: the "
         f"generated program's {i['multiplications']} multiplications and {i['additions']} "
         f"additions, and {i['sincos_flops_per_angle']} for the sine and cosine of each of its "
-        f"{i['sincos_angles']} angles; {_sig(r['achieved_gflops'])} GFLOP/s = "
+        f"{i['sincos_angles']} angles; {rc.sig(r['achieved_gflops'])} GFLOP/s = "
         f"{100 * r['fraction_of_peak']:.0f} % of the peak: {r['times_compute_floor']:.2f}x the "
-        f"floor of {_sig(r['compute_floor_ns'])} ns that its op count sets at the peak rate "
+        f"floor of {rc.sig(r['compute_floor_ns'])} ns that its op count sets at the peak rate "
         f"(target at most {r['target_times_floor']:g}x: {met}). A streaming batch moves "
-        f"{i['bytes_per_state']} bytes per state, {_sig(r['memory_floor_ns'])} ns at the triad "
+        f"{i['bytes_per_state']} bytes per state, {rc.sig(r['memory_floor_ns'])} ns at the triad "
         f"rate: by its two floors the kernel is "
         f"{'compute' if r['compute_floor_ns'] >= r['memory_floor_ns'] else 'memory'}-bound.")
-    return "\n".join(_wrap(text)) + "\n"
+    return "\n".join(rc.wrap(text)) + "\n"
 
 
 RENDERERS: dict[str, Callable[[dict[str, Any]], str]] = {
