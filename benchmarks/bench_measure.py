@@ -9,22 +9,43 @@ the same run:
   2. the straightforward pipeline: ``pandas.read_csv`` + ``numpy.gradient`` twice (velocity and
      acceleration from positions, no filter, no checks, period assumed 1 ms);
 
-and prints the totals and the ratio, plus the agreement of each velocity with the measured one.
+and prints the totals (min / median over rounds in which the two take turns) and the ratio, plus
+the agreement of each velocity from positions with the measured one.
 
-Run: ``.venv/bin/python benchmarks/bench_measure.py [--repeat N]``.
+Full runs merge the figures into ``benchmarks/results/<machine>.json`` (benchmark ``measure``).
+Run: ``.venv/bin/python benchmarks/bench_measure.py [--quick] [--results PATH | --no-results]``
+(``--quick``: 3 rounds instead of 5; written only with ``--results``).
 """
 
 from __future__ import annotations
 
 import argparse
-import time
+import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 import robodyn as rd
 from robodyn.measure.filtering import differentiate
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import results  # noqa: E402
+import timing  # noqa: E402
+
+REPEATS = 5
+ROBODYN = "robodyn"
+PLAIN = "pandas + numpy"
+#: What each pipeline does (the rows' differences).
+PIPELINES = {
+    ROBODYN: "rd.read_recording(path, spec='kinova_gen3'): line and field-count checks, every cell "
+             "validated, period estimated from the time column, velocity read from the file, "
+             "acceleration by zero-phase Butterworth differentiation at the bandwidth cut-off; "
+             "plus a velocity from positions by the same filtered differentiation for the "
+             "comparison",
+    PLAIN: "pandas.read_csv, then numpy.gradient twice (velocity and acceleration from "
+           "positions): no checks, no filter, period assumed 1 ms"}
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "kinova-gen3"
 if not DATA.is_dir():
@@ -52,42 +73,58 @@ def _plain(paths):
     return out
 
 
-def _best(fn, paths, repeat):
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        result = fn(paths)
-        times.append(time.perf_counter() - start)
-    return min(times), result
-
-
-def _agreement(results):
+def _agreement(outputs):
+    """Per file: RMS(velocity from position - measured velocity) / RMS(measured), moving joints."""
     errs = []
-    for meas, v, _ in results:
+    for meas, v, _ in outputs:
         moving = np.ptp(meas, axis=0) > 0.05
-        errs.append(np.sqrt(np.mean((v - meas)[:, moving] ** 2)) / np.sqrt(np.mean(meas[:, moving] ** 2)))
-    return min(errs), max(errs)
+        errs.append(float(np.sqrt(np.mean((v - meas)[:, moving] ** 2))
+                          / np.sqrt(np.mean(meas[:, moving] ** 2))))
+    return errs
 
 
 def main() -> None:
+    """Command line: time both pipelines in turns, compare velocities, merge the figures."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--quick", action="store_true", help="3 rounds instead of 5")
+    results.add_options(parser)
     args = parser.parse_args()
+    path = results.target(args)
+    repeats = 3 if args.quick else REPEATS
+    entry: dict[str, Any] = {
+        "command": "python benchmarks/bench_measure.py" + (" --quick" if args.quick else ""),
+        "load_average_at_start": results.load_average()}
     paths = sorted(DATA.glob("*/*.csv.gz"))
     if not paths:
         raise SystemExit(f"no Kinova files under {DATA}")
     rows = sum(len(pd.read_csv(p, usecols=["Time"])) for p in paths)
-    t_rd, r_rd = _best(_robodyn, paths, args.repeat)
-    t_pl, r_pl = _best(_plain, paths, args.repeat)
-    print(f"{len(paths)} Kinova Gen3 files, {rows} rows x 78 columns; best of {args.repeat}")
-    print(f"  robodyn read_recording + filtered differentiation : {t_rd:7.3f} s")
-    print(f"  pandas.read_csv + numpy.gradient (no checks)      : {t_pl:7.3f} s")
-    print(f"  ratio robodyn / plain                             : {t_rd / t_pl:7.2f}")
-    lo, hi = _agreement(r_rd)
-    print(f"  velocity from position vs measured velocity (RMS / RMS, moving joints): "
-          f"robodyn {lo:.3f}-{hi:.3f}", end="")
-    lo, hi = _agreement(r_pl)
-    print(f", numpy.gradient {lo:.3f}-{hi:.3f}")
+    out = {}
+    times = timing.interleaved({label: (lambda fn=fn, k=label: out.__setitem__(k, fn(paths)))
+                                for label, fn in ((ROBODYN, _robodyn), (PLAIN, _plain))}, repeats)
+    errors = {label: _agreement(r) for label, r in out.items()}
+    entry.update({
+        "files": len(paths), "rows": rows, "columns": 78, "repeats": repeats,
+        "seconds": {k: results.summary(v, 1.0, 3) for k, v in times.items()},
+        "ratio": results.ratio(times[ROBODYN], times[PLAIN]),
+        "velocity_error": {k: [round(e, 4) for e in v] for k, v in errors.items()},
+        "error_ratio": [round(p / r, 2) for p, r in zip(errors[PLAIN], errors[ROBODYN],
+                                                          strict=True)],
+        "pipelines": PIPELINES})
+    sec, ratio = entry["seconds"], entry["ratio"]
+    print(f"{len(paths)} Kinova Gen3 files, {rows} rows x 78 columns; min / median of {repeats} "
+          "rounds in which the pipelines take turns")
+    print(f"  robodyn read_recording + filtered differentiation : {sec[ROBODYN]['min']:7.3f} / "
+          f"{sec[ROBODYN]['median']:.3f} s")
+    print(f"  pandas.read_csv + numpy.gradient (no checks)      : {sec[PLAIN]['min']:7.3f} / "
+          f"{sec[PLAIN]['median']:.3f} s")
+    print(f"  ratio robodyn / plain                             : {ratio['min']:7.2f} / "
+          f"{ratio['median']:.2f}")
+    rd_err, pl_err, er = errors[ROBODYN], errors[PLAIN], entry["error_ratio"]
+    print(f"  velocity from position vs measured velocity (RMS / RMS, moving joints): robodyn "
+          f"{min(rd_err):.3f}-{max(rd_err):.3f}, numpy.gradient {min(pl_err):.3f}-"
+          f"{max(pl_err):.3f} (numpy.gradient / robodyn per file {min(er):.2f}-{max(er):.2f}x)")
+    if path is not None:
+        print(f"figures written to {results.merge(path, 'measure', entry)}")
 
 
 if __name__ == "__main__":

@@ -19,6 +19,7 @@ Standard library only; nothing here times anything.
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import re
 import sys
@@ -298,9 +299,40 @@ def render_roofline(data: dict[str, Any]) -> str:
     return "\n".join(rc.wrap(text)) + "\n"
 
 
+def render_block_width(data: dict[str, Any]) -> str:
+    """Markdown of the ``block_width`` entry: ID and FD at each width, for both flag sets."""
+    e = data["benchmarks"]["block_width"]
+    lines = rc.wrap(rc.run(data, e, (
+        f"Block width of the generated kernels: PUMA 560 inverse and forward dynamics with its "
+        f"friction, {e['states']:,} random states, one thread, ns per state, min / median of "
+        f"{e['passes'] * e['calls_per_pass']} calls in {e['passes']} passes in which the "
+        "builds take turns")) + (
+        " Each width is generated and compiled in its own process; every width's results equal "
+        f"scalar code's to {e['max_deviation_from_scalar']:.1e} (relative)."))
+    chosen = {isa: v["ID"]["chosen_width"] for isa, v in e["verdict"].items()}
+    rows = [[r["isa"], str(r["width"]), *rc.mm(r["ID"]), *rc.mm(r["FD"]),
+             "robodyn's choice" if chosen[r["isa"]] == r["width"] else ""] for r in e["rows"]]
+    lines += [""] + rc.table(["code", "width", "ID min", "ID median", "FD min", "FD median", ""],
+                             rows)
+    verdicts = "; ".join(
+        f"{isa} {kernel}: fastest at width {v['best_width']}, robodyn's {v['chosen_width']} "
+        f"takes {v['chosen_over_best']:.2f}x its time"
+        for isa, kernels in e["verdict"].items() for kernel, v in kernels.items())
+    lines += [""] + rc.wrap(f"Code: {'; '.join(f'{k}: {v}' for k, v in e['isas'].items())}. "
+                            f"By the minima: {verdicts}.")
+    return "\n".join(lines) + "\n"
+
+
 RENDERERS: dict[str, Callable[[dict[str, Any]], str]] = {
     "kernels": render_kernels, "casadi": render_casadi, "ensemble": render_ensemble,
-    "simulation": render_simulation, "hydro": render_hydro, "roofline": render_roofline}
+    "simulation": render_simulation, "hydro": render_hydro, "roofline": render_roofline,
+    "block_width": render_block_width}
+
+#: Modules beside this script whose ``RENDERERS`` (section name -> function) are added to the
+#: ones above: one module per group of benchmarks, each importing :mod:`render_common`.
+RENDERER_MODULES = ("render_dynamics", "render_design", "render_workflows", "render_quality")
+for _module in RENDERER_MODULES:
+    RENDERERS.update(importlib.import_module(_module).RENDERERS)
 
 
 def render(text: str, root: Path = ROOT, results: str | None = None) -> str:

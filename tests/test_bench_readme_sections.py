@@ -1,4 +1,4 @@
-"""The README's CasADi, ensemble, simulation, hydro and roofline figures are those of its results file.
+"""Every README benchmark section but the kernels' shows the figures of its results file.
 
 Issue 22, items 1c-1e and 2: each benchmark merges its figures into
 ``benchmarks/results/<machine>.json`` and ``benchmarks/render_readme.py`` renders one marked
@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 import importlib.util
 import json
+import re
 from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
@@ -19,7 +20,11 @@ from typing import Any
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-SECTIONS = ("casadi", "ensemble", "simulation", "hydro", "roofline")
+#: Every marked section of the README but ``kernels`` (tests/test_readme_results.py covers it):
+#: a section added to the README is checked here without a change to this file.
+SECTIONS = tuple(sorted({m.group(1) for m in re.finditer(r"<!-- results:([\w-]+) ",
+                                                          (ROOT / "README.md").read_text())}
+                        - {"kernels"}))
 
 
 @pytest.fixture(scope="module")
@@ -165,3 +170,22 @@ def test_roofline_figures_follow_from_the_measurements(sections):
     assert r["times_compute_floor"] == pytest.approx(ns / r["compute_floor_ns"], rel=0.01)
     assert r["memory_floor_ns"] == pytest.approx(i["bytes_per_state"] / e["triad"]["gbs"], rel=0.01)
     assert 0 < r["fraction_of_peak"] <= 1 and e["peak"]["median_gflops"] <= e["peak"]["gflops"]
+
+
+def test_block_width_verdict_follows_from_the_rows(sections):
+    e = _data(sections, "block_width")["benchmarks"]["block_width"]
+    assert e["max_deviation_from_scalar"] <= 1e-12
+    for isa, kernels in e["verdict"].items():
+        rows = {r["width"]: r for r in e["rows"] if r["isa"] == isa}
+        assert {1, 8, 16} <= rows.keys()
+        for kernel, v in kernels.items():
+            fastest = min(rows, key=lambda w: rows[w][kernel]["min"])
+            assert v["best_width"] == fastest
+            assert v["chosen_over_best"] == pytest.approx(
+                rows[v["chosen_width"]][kernel]["min"] / rows[fastest][kernel]["min"], abs=2e-3)
+    # the widths robodyn's rule gives the machine's own flags and AVX2 code
+    from robodyn.codegen.cpu import default_block_width
+
+    simd = frozenset(_data(sections, "block_width")["machine"]["simd"])
+    assert e["verdict"]["native"]["ID"]["chosen_width"] == default_block_width(simd)
+    assert e["verdict"]["avx2"]["ID"]["chosen_width"] == default_block_width(simd - {"avx512f"})

@@ -31,7 +31,7 @@ from pathlib import Path
 
 from robodyn.robot.errors import InputError
 
-__all__ = ["BLOCK", "WIDTHS", "block_width", "cpu_flags"]
+__all__ = ["BLOCK", "WIDTHS", "block_width", "cpu_flags", "default_block_width"]
 
 #: Block widths the generator accepts.
 WIDTHS = (1, 2, 4, 8, 16, 32)
@@ -62,7 +62,13 @@ def block_width() -> int:
             raise InputError(f"ROBODYN_BLOCK={text!r}: the block width of the generated kernels "
                              f"must be one of {', '.join(map(str, WIDTHS))} (1: scalar code)")
         return int(text)
-    return 16 if "avx512f" in cpu_flags() else 8
+    return default_block_width()
+
+
+def default_block_width(flags: frozenset[str] | None = None) -> int:
+    """The width for a processor with feature ``flags`` (default: this one's): 16 with AVX-512
+    (two 8-double registers per quantity), else 8."""
+    return 16 if "avx512f" in (cpu_flags() if flags is None else flags) else 8
 
 
 #: States per block of the generated batch functions in this process (:func:`block_width` at
