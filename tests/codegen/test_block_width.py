@@ -1,7 +1,9 @@
 """The generated kernels' block width: chosen from the processor, overridden by ROBODYN_BLOCK.
 
-The kernels themselves are checked at other widths by the CI, which runs the kernel tests with
-ROBODYN_BLOCK=1 (scalar code) and with the width this processor does not get by default."""
+The kernels themselves are checked at other widths by the CI, which reruns the whole suite with
+ROBODYN_BLOCK=1 (scalar code) and with the width this processor does not get by default; each
+width has its own compiled-model cache entries (checked here), so those reruns test their own
+width's code and not kernels generated for another."""
 
 from __future__ import annotations
 
@@ -32,3 +34,30 @@ def test_a_bad_width_names_the_variable(monkeypatch, text: str) -> None:
     monkeypatch.setenv("ROBODYN_BLOCK", text)
     with pytest.raises(InputError, match=r"ROBODYN_BLOCK=.*one of 1, 2, 4, 8, 16, 32"):
         cpu.block_width()
+
+
+_SOURCE_OF_A_MODEL = """
+import json
+import robodyn as rd
+model = rd.compile_model(rd.load("planar_2r"))
+source = next(p for p in model.sources if p.suffix == ".c")
+print(json.dumps({"path": str(source), "text": source.read_text()}))
+"""
+
+
+def test_each_width_has_its_own_cache_entry(tmp_path) -> None:
+    # one cache folder for both widths, as in a CI job that reruns the suite at another width:
+    # the second process must generate its own width's source, not load the first one's
+    import json
+    import os
+    import subprocess
+    import sys
+
+    found = {}
+    for width in (4, 8):
+        env = {**os.environ, "ROBODYN_BLOCK": str(width), "ROBODYN_CACHE": str(tmp_path)}
+        out = subprocess.run([sys.executable, "-c", _SOURCE_OF_A_MODEL], env=env, check=True,
+                             capture_output=True, text=True)
+        found[width] = json.loads(out.stdout.splitlines()[-1])
+        assert f"m_ <= {width} states" in found[width]["text"]
+    assert found[4]["path"] != found[8]["path"]

@@ -21,6 +21,7 @@ from types import ModuleType
 from typing import Any
 
 from robodyn.codegen.build import CFLAGS, CompilerNotFoundError, find_compiler
+from robodyn.codegen.cpu import BLOCK
 from robodyn.codegen.kernels import KernelSet, build_kernels
 from robodyn.robot.model import Robot
 
@@ -80,7 +81,7 @@ def _touch(*paths: Path) -> None:
 
 @functools.cache
 def _generator_hash() -> str:
-    """Hash of the source files that decide what is generated (cache invalidation).
+    """Hash of what decides what is generated: the generator's source files and the block width.
 
     Taken once per process, when this module is imported (with the generator's modules): a
     process that loaded the generator before its files were edited must not store what it
@@ -95,6 +96,9 @@ def _generator_hash() -> str:
     for pkg in (codegen_pkg, hydro_pkg, symbolic_pkg):
         for path in sorted(Path(pkg.__file__).parent.glob("*.py")):
             digest.update(path.read_bytes())
+    # the block width is written into the C source (robodyn.codegen.cpu): each width has its own
+    # cache entries, so that ROBODYN_BLOCK=w never loads kernels generated for another width
+    digest.update(f"block width {BLOCK}".encode())
     return digest.hexdigest()
 
 
