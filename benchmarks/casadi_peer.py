@@ -35,6 +35,8 @@ import numpy as np
 import sympy as sp
 
 import robodyn as rd
+from robodyn.codegen.build import CFLAGS, compile_library
+from robodyn.numeric.model_cache import _kernels_cached
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from results import load_average, summary  # noqa: E402
@@ -44,19 +46,9 @@ from timing import interleaved  # noqa: E402
 BLOCK = 16
 
 
-def robodyn_internals() -> Any:
-    """The module that defines :func:`robodyn.compile_model` (found through the public name).
-
-    It holds what the peer needs beside the public API: the compiler flags ``CFLAGS``,
-    ``compile_library`` (robodyn's cached C build) and ``_kernels_cached`` (the recorded
-    programs); found through ``rd.compile_model`` so that a renamed package does not break it.
-    """
-    return sys.modules[rd.compile_model.__module__]
-
-
 def compiler_flags() -> tuple[str, ...]:
     """robodyn's C compiler flags (without the OpenMP flag its threaded models add)."""
-    return tuple(robodyn_internals().CFLAGS)
+    return tuple(CFLAGS)
 
 
 def casadi_function(robot: rd.Robot, sincos: bool = False) -> Any:
@@ -82,7 +74,7 @@ def casadi_function(robot: rd.Robot, sincos: bool = False) -> Any:
     """
     import casadi as ca
 
-    kernel = robodyn_internals()._kernels_cached(robot, robot.parameters)["inverse_dynamics"]
+    kernel = _kernels_cached(robot, robot.parameters)["inverse_dynamics"]
     n = robot.dof
     names = ("s", "c", "qd", "qdd") if sincos else ("q", "qd", "qdd")
     syms = [ca.SX.sym(s, n) for s in names]
@@ -198,8 +190,7 @@ def compile_strategy(f: Any, mode: str, count: int, threads: int = 1) -> Callabl
     driver = _DRIVER.format(sz_arg=max(fn.sz_arg(), 1), sz_res=max(fn.sz_res(), 1),
                             sz_iw=max(fn.sz_iw(), 1), sz_w=max(fn.sz_w(), 1), block=block,
                             n_in=f.n_in(), n=n, name=fn.name())
-    internals = robodyn_internals()
-    lib = internals.compile_library(gen.dump() + driver,
+    lib = compile_library(gen.dump() + driver,
                                     "int cs_batch(long, const double **, double *);",
                                     flags=compiler_flags())
     ffi = lib.ffi

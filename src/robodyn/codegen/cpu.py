@@ -18,7 +18,11 @@ width      AVX-512 ID / FD    AVX2 ID / FD
 
 (the spread within a cell is the machine's load: runs of the same build differed by up to 2x in
 forward dynamics). Wider than 16 is slower everywhere; between 8 and 16 the difference is
-within that noise on AVX-512 and about 8 % in favour of 8 for AVX2's inverse dynamics. The
+within that noise on AVX-512 and about 8 % in favour of 8 for AVX2's inverse dynamics.
+``benchmarks/bench_block_width.py`` repeats the sweep on the machine it runs on (the README's
+``results:block_width`` section); on an AMD EPYC with AVX-512 (2 shared cores), two runs put
+width 16 within 0-15 % of the fastest width (8 or 16) for both kernels, and every width from 4
+up 2-3x faster than scalar code: not a difference that would justify another rule. The
 environment variable ``ROBODYN_BLOCK`` (1, 2, 4, 8, 16 or 32) overrides the choice: 1 gives
 scalar code (one state per loop), which the CI runs the kernel tests with too. The width is
 part of the generated source, so each width has its own entry in the compiled-model cache.
