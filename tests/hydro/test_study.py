@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -55,6 +56,15 @@ def test_series_runs_every_variant_and_fills_the_table(series) -> None:
     np.testing.assert_array_equal(table[table.effect == "drag"]["peak_tau"].to_numpy(),
                                   np.abs(run.tracked.tau).max(axis=0))
     assert "| + added mass | added_mass | q2 |" in series.markdown()
+
+
+def test_section_escapes_the_robot_name_and_keeps_the_settings(series) -> None:
+    # the section is a Jinja2 template (report/templates/underwater.html.j2): text from the
+    # description is escaped, the numbers are those of the run
+    html = study_section(dataclasses.replace(series, robot="arm <b>&"))
+    assert "Underwater effect series: arm &lt;b&gt;&amp;</h2>" in html
+    assert f"RK4 at {series.dt:g} s" in html and "lift coefficient: the description's" in html
+    assert html.count("<tr>") == len(series.table) + 1
 
 
 def test_lift_row_is_dropped_with_the_reason_where_lift_cannot_act(series) -> None:

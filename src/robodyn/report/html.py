@@ -22,7 +22,7 @@ from markupsafe import Markup
 from robodyn.robot.errors import InputError
 from robodyn.text import is_number
 
-__all__ = ["CSS", "data_uri", "figure", "html_table", "page", "render"]
+__all__ = ["CSS", "data_uri", "figure", "html_table", "page", "render", "render_macro"]
 
 #: Media types of the figure files a report embeds, by suffix.
 _MEDIA_TYPES = {".png": "image/png", ".gif": "image/gif", ".svg": "image/svg+xml",
@@ -32,12 +32,21 @@ _MEDIA_TYPES = {".png": "image/png", ".gif": "image/gif", ".svg": "image/svg+xml
 @cache
 def _environment() -> jinja2.Environment:
     """The template environment: package templates, autoescaping, undefined names are errors."""
-    return jinja2.Environment(
+    env = jinja2.Environment(
         loader=jinja2.PackageLoader("robodyn.report", "templates"),
         autoescape=jinja2.select_autoescape(enabled_extensions=("html", "j2"), default=True),
         undefined=jinja2.StrictUndefined,
         keep_trailing_newline=True,
     )
+    env.filters["g_list"] = _general_list
+    return env
+
+
+def _general_list(values: Sequence[float], digits: int | None = None) -> str:
+    """Template filter ``g_list``: numbers (a list or an array) in ``%g`` format (``digits``
+    significant digits), joined by ", "."""
+    spec = "g" if digits is None else f".{digits}g"
+    return ", ".join(format(float(v), spec) for v in values)
 
 
 def render(template: str, **context: object) -> str:
@@ -46,6 +55,12 @@ def render(template: str, **context: object) -> str:
     Strings in ``context`` are escaped; wrap trusted HTML fragments in :class:`markupsafe.Markup`.
     """
     return _environment().get_template(template).render(**context)
+
+
+def render_macro(template: str, name: str, **arguments: object) -> str:
+    """Call the macro ``name`` of the package template ``template`` with ``arguments`` (escaped
+    as in :func:`render`) and return its HTML."""
+    return str(getattr(_environment().get_template(template).module, name)(**arguments))
 
 
 #: The shared style sheet (``templates/style.css``).

@@ -19,13 +19,13 @@ figures without pyplot: the user's backend is left alone).
 
 from __future__ import annotations
 
-import html
 from pathlib import Path
 
 import numpy as np
+from markupsafe import Markup
 from matplotlib.figure import Figure
 
-from robodyn.report.html import figure, html_table, page
+from robodyn.report.html import figure, html_table, page, render_macro
 from robodyn.studies.underwater import EffectSeries
 from robodyn.studies.underwater_model_error import ModelErrorStudy
 from robodyn.studies.underwater_sensitivity import Sensitivity
@@ -81,25 +81,18 @@ def study_figures(series: EffectSeries, out: str | Path) -> tuple[Path, ...]:
 
 
 def study_section(series: EffectSeries, figures: tuple[Path, ...] = ()) -> str:
-    """An HTML fragment: settings, the table and the (embedded) figures."""
-    table = series.table
+    """An HTML fragment: settings, the table and the (embedded) figures
+    (``templates/underwater.html.j2``)."""
     rows = [[f"{v:.4g}" if isinstance(v, float) else v for v in row]
-            for row in table[list(_SHOWN)].itertuples(index=False)]
-    current = ", ".join(f"{c:g}" for c in series.current)
-    lift = "the description's" if series.lift is None else f"{series.lift:g}"
-    intro = (
-        f"<h2>Underwater effect series: {series.robot}</h2>"
-        f"<p>Each variant adds one effect to the one before "
-        f"({', '.join(r.label for r in series.runs)}). Tracked: a {series.move_time:g} s "
-        f"quintic move held for {series.hold_time:g} s under the same PD controller (kp = "
-        f"{', '.join(f'{k:.4g}' for k in series.kp)}; kd = {', '.join(f'{k:.4g}' for k in series.kd)}), "
-        f"which knows nothing of the water. Free: released at rest for {series.free_time:g} s. "
-        f"RK4 at {series.dt:g} s. Current of the last variant ({current}) m/s in the base frame; "
-        f"lift coefficient: {lift}. Torques N m (N), positions rad (m), times s; "
-        f"effect_peak_tau is the torque this effect adds to the inverse dynamics of the plan.</p>")
-    figs = "".join(figure(p, p.stem.replace("_", " ")) for p in figures)
-    notes = "".join(f"<p>{html.escape(note)}</p>" for note in series.notes)
-    return intro + html_table(list(_SHOWN), rows) + notes + figs
+            for row in series.table[list(_SHOWN)].itertuples(index=False)]
+    return render_macro("underwater.html.j2", "series_section", s=series,
+                        table=Markup(html_table(list(_SHOWN), rows)), notes=series.notes,
+                        figures=_figures(figures))
+
+
+def _figures(paths: tuple[Path, ...]) -> Markup:
+    """The embedded figures of ``paths``, each captioned by its file name."""
+    return Markup("".join(figure(p, p.stem.replace("_", " ")) for p in paths))
 
 
 def _rows(table, digits: int = 4) -> list[list]:
@@ -141,17 +134,9 @@ def sensitivity_figure(sens: Sensitivity, path: Path) -> Path:
 
 def sensitivity_section(sens: Sensitivity, figures: tuple[Path, ...] = ()) -> str:
     """An HTML fragment: what was swept, the table and the figure."""
-    direction = ", ".join(f"{c:.3g}" for c in sens.direction)
-    intro = (
-        "<h3>Sensitivity to the drag coefficient and the current speed</h3>"
-        "<p>Every effect on. First sweep: every wet link's C_d set to each value, still water. "
-        f"Second: the current set to each speed along ({direction}) in the base frame. "
-        "added_peak_tau / added_rms_tau: the torque the fluid adds to the inverse dynamics of the "
-        "planned move (wet minus dry), N m. free_amplitude, free_mean, free_rms_speed: the second "
-        "half of the free run released at rest (rad, rad/s).</p>")
-    cols = list(sens.table.columns)
-    figs = "".join(figure(p, p.stem.replace("_", " ")) for p in figures)
-    return intro + html_table(cols, _rows(sens.table)) + figs
+    table = Markup(html_table(list(sens.table.columns), _rows(sens.table)))
+    return render_macro("underwater.html.j2", "sensitivity_section", direction=sens.direction,
+                        table=table, figures=_figures(figures))
 
 
 def model_error_figure(study: ModelErrorStudy, path: Path) -> Path:
@@ -178,20 +163,9 @@ def model_error_figure(study: ModelErrorStudy, path: Path) -> Path:
 
 def model_error_section(study: ModelErrorStudy, figures: tuple[Path, ...] = ()) -> str:
     """An HTML fragment: the controller-design question, its table and figure."""
-    current = ", ".join(f"{c:g}" for c in study.current)
-    pred = ", ".join(f"{e:.4g}" for e in study.predicted_error)
-    intro = (
-        "<h3>Which effects must the controller's model keep?</h3>"
-        "<p>The plant has every effect (current "
-        f"{current} m/s). A computed-torque controller (Kp = {study.kp[0]:.4g} 1/s^2, "
-        f"Kd = {study.kd[0]:.4g} 1/s, evaluated at every RK4 stage) tracks the move with a model "
-        "that omits one effect (nothing: the exact model; everything: the dry arm). Errors "
-        "q_ref - q in rad; steady_error at the end of the hold. Omitting buoyancy leaves the "
-        f"steady error Kp^-1 M^-1 g_B = ({pred}) rad predicted.</p>")
-    cols = list(study.table.columns)
-    figs = "".join(figure(p, p.stem.replace("_", " ")) for p in figures)
-    notes = "".join(f"<p>{html.escape(note)}</p>" for note in study.notes)
-    return intro + html_table(cols, _rows(study.table)) + notes + figs
+    table = Markup(html_table(list(study.table.columns), _rows(study.table)))
+    return render_macro("underwater.html.j2", "model_error_section", st=study, table=table,
+                        figures=_figures(figures))
 
 
 def write_study(series: EffectSeries, out: str | Path, sensitivity: Sensitivity | None = None,
