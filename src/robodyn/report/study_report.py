@@ -7,14 +7,14 @@ and a histogram of the result over the cases (the Monte-Carlo view).
 
 from __future__ import annotations
 
-import html
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from markupsafe import Markup
 
-from robodyn.report.html import figure, html_table
+from robodyn.report.html import figure, html_table, render
 
 __all__ = ["result_columns", "study_figures", "study_section"]
 
@@ -116,23 +116,18 @@ def study_section(table: pd.DataFrame, *, title: str, varying: Sequence[str],
         The study file (shown).
     """
     failed = table[table["error"].notna()] if "error" in table else table.iloc[:0]
-    parts = [f"<section class='study'><h2>{html.escape(title)}</h2>"]
-    where = f" from <code>{html.escape(source)}</code>" if source else ""
-    parts.append(f"<p>{len(table)} cases{where}; {len(failed)} failed; varying: "
-                 f"{html.escape(', '.join(varying) or 'only the seed')}.</p>")
     rows = []
     ok = table.drop(index=failed.index)
     for col in result_columns(table, varying):
         v = ok[col].to_numpy(dtype=float)
         if v.size:
             rows.append([col, f"{np.min(v):.4g}", f"{np.median(v):.4g}", f"{np.max(v):.4g}"])
-    if rows:
-        parts.append(html_table(["result", "min", "median", "max"], rows))
+    results = Markup(html_table(["result", "min", "median", "max"], rows)) if rows else ""
+    failures = ""
     if len(failed):
         shown = [[int(i), str(m)] for i, m in failed["error"].head(10).items()]
-        parts.append(f"<h3>Failed cases ({len(failed)})</h3>")
-        parts.append(html_table(["case", "error"], shown))
-    for path in figures:
-        parts.append(figure(path, Path(path).stem.replace("_", " ")))
-    parts.append("</section>")
-    return "\n".join(parts)
+        failures = Markup(html_table(["case", "error"], shown))
+    return render("study.html.j2", title=title, cases=len(table), source=source,
+                  failed=len(failed), varying=list(varying), results=results, failures=failures,
+                  figures=[Markup(figure(p, Path(p).stem.replace("_", " "))) for p in figures],
+                  ).rstrip("\n")
