@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from markupsafe import Markup
 
-from robodyn.report.html import figure, html_table, page, render
+from robodyn.report.html import figure, html_table, page, render, render_macro
 from robodyn.validation.validation import Validation
 
 __all__ = ["KINOVA_CONTROLLER_GAINS", "combined_relative", "identification_html",
@@ -78,7 +78,6 @@ def validation_section(val: Validation, out: Path, folder: str, stem: str, headi
     for kind in kinds:
         path = draw[kind](val, out / folder / f"{stem}_{kind}.png")
         imgs.append(figure(path, kind))
-    notes = "".join(f"<li>{html.escape(n)}</li>" for n in val.notes)
     sim = ""
     if val.simulation is not None:
         s = val.simulation
@@ -87,18 +86,15 @@ def validation_section(val: Validation, out: Path, folder: str, stem: str, headi
                f"|q<sub>sim</sub> &minus; q<sub>meas</sub>| at the end of a window, beside the "
                f"drift of a constant-velocity guess" + (f"; {s.failed} windows failed" if s.failed
                                                         else "") + ".")
-    est = (f" Estimated from positions: {html.escape(', '.join(sorted(val.estimated)))}."
-           if val.estimated else "")
-    return f"""<h{level}>{html.escape(heading)}</h{level}>
-<p>{html.escape(val.robot)} against <code>{html.escape(val.source)}</code>, target
-{html.escape(val.target)} ({html.escape(val.unit)}), {len(val.t)} samples over
-{val.t[-1] - val.t[0]:.3g} s. Whole arm: relative error <b>{val.prediction.total_relative:.3f}</b>
-against the raw target, {val.prediction_filtered.total_relative:.3f} against the filtered target;
-<b>noise floor {val.noise.total_relative:.3f}</b> (raw minus zero-phase {val.noise.cutoff:g} Hz
-low-pass: the error a perfect model of the filtered signal would still show).{sim}{est}</p>
-{html_table(val.table_headers(), val.table_rows())}
-{f"<ul>{notes}</ul>" if notes else ""}
-{"".join(imgs)}"""
+    table = html_table(val.table_headers(), val.table_rows())
+    return _macro("validation_section", val=val, heading=heading, level=level,
+                  samples=len(val.t), span=val.t[-1] - val.t[0], simulation=Markup(sim),
+                  table=Markup(table), figures=Markup("".join(imgs)))
+
+
+def _macro(name: str, **arguments: object) -> str:
+    """The fragment ``name`` of ``templates/identification.html.j2``."""
+    return render_macro("identification.html.j2", name, **arguments)
 
 
 def parameter_table(ident: Any) -> str:
@@ -131,20 +127,10 @@ def identification_html(ident: Any, validations: Sequence[tuple[str, Validation]
     """
     sections = "\n".join(validation_section(v, out, "figures", f"val{i}_{_slug(v.source)}", head)
                          for i, (head, v) in enumerate(validations))
-    gains = ", ".join(f"{g:.4g}" for g in ident.gains)
-    body = f"""<h1>Identification of {html.escape(ident.robot.name)}</h1>
-<p class="meta">Method <b>{html.escape(ident.method)}</b>, target {html.escape(ident.target)},
-{ident.samples} samples from {html.escape(", ".join(sources))}. Condition number
-{ident.condition:.3g}; Tikhonov weight toward the description {ident.regularization:.3g};
-drive gains ({html.escape(ident.gains_source)}): {gains} N m/A; filter cut-off
-{_cutoff(ident)}.</p>
-{_choices_html(ident)}
-<h2>Base parameters</h2>
-<p>Standard deviations from the residual variance; parameters the data do not excite keep the
-description's value (std inf).</p>
-{parameter_table(ident)}
-<h2>Validation</h2>
-{sections}"""
+    body = _macro("identification_body", ident=ident, sources=list(sources),
+                  cutoff=_cutoff(ident), gains=", ".join(f"{g:.4g}" for g in ident.gains),
+                  choices=Markup(_choices_html(ident)), parameters=Markup(parameter_table(ident)),
+                  sections=Markup(sections))
     path = out / name
     path.write_text(page(f"robodyn identification: {ident.robot.name}", body), encoding="utf-8")
     return path
@@ -223,12 +209,10 @@ def kinova_section(out: Path, data_dir: Path | None = None, method: str = "wls",
     from robodyn.text import progress
 
     data_dir = Path(data_dir) if data_dir is not None else _default_data_dir()
-    head = "<h2>Validation against measurements: Kinova Gen3 (chapter 5)</h2>"
     runs = sorted((data_dir / "identification_data").glob("*.csv.gz"))
     jointwise = sorted((data_dir / "jointwise_motion").glob("joint_*_trapez.csv.gz"))
     if not runs:
-        return (f"{head}\n<p>The Kinova Gen3 recordings were not found in "
-                f"<code>{html.escape(str(data_dir))}</code>; this section is skipped.</p>", True)
+        return _macro("kinova_missing", data_dir=str(data_dir)), True
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the URDF's plausibility notes are shown by 'robodyn show'
         robot = load("kinova_gen3")
@@ -266,35 +250,14 @@ def kinova_section(out: Path, data_dir: Path | None = None, method: str = "wls",
             f"{noise:.4f}; README baseline {base_raw} ({base_filt} filtered)")
     (folder / "summary.txt").write_text(line + "\n", encoding="utf-8")
     print(line)
-    section = f"""{head}
-<p>Real recordings of a Kinova Gen3 (<code>{html.escape(str(data_dir))}</code>; see its README:
-the <code>Torque</code> columns are a model output, so the target is the measured motor current).
-Identification: <code>rd.identify(robot, runs, target="current", method="{method}")</code> on the
-first 70 % of each whole-arm run ({", ".join(html.escape(p.name) for p in runs)}); condition number
-{ident.condition:.3g}, Tikhonov weight {ident.regularization:.3g}, drive gains
-{html.escape(ident.gains_source)}. Validation: <code>rd.validate</code> on the last 30 % of each
-run and on every jointwise run. The manufacturer's model is the URDF's inertial parameters with
-the controller's current-to-torque constants (9.13 N m/A joints 1&ndash;4, 5.852 N m/A joints
-5&ndash;7), no friction and no rotor inertia.</p>
-<h3>Held-out current error (last 30 % of the whole-arm runs, all joints together)</h3>
-<p>"Against filtered" and the noise floor use validation's {held_id[0].noise.cutoff:g} Hz
-zero-phase low-pass, the reference filter of <code>robodyn.validation.heldout</code> (the data
-README does not state its cut-off; this one reproduces the noise floor of about 0.26 that it
-quotes). The friction table below uses the same filter.</p>
-{html_table(("model", "relative error (raw)", "against filtered", "noise floor",
-             f"vs README baseline {base_raw} / {base_filt}"), summary)}
-<h3>Per joint, against the manufacturer's URDF</h3>
-<p>Relative current error of each joint on the held-out data and on the jointwise run in which
-only that joint moves (for its own current), for the identified and the manufacturer's model;
-beside them the identified drive gain against the controller's constant, the identified friction
-and reflected rotor inertia (the URDF has neither), and the current the identified model needs
-to hold the arm against gravity as a multiple of what the URDF with the controller's constant
-needs (least-squares scale of g(q)/k over the held-out states; the data README estimates about
-1.3 on joints 2 and 4 and 2 on joint 6 from a mounted tool).</p>
-{html_table(_JOINT_HEADERS, joint_rows)}
-{friction_html}
-<details><summary>Identified base parameters</summary>{parameter_table(ident)}</details>
-{"".join(parts)}"""
+    summary_table = html_table(("model", "relative error (raw)", "against filtered", "noise floor",
+                                f"vs README baseline {base_raw} / {base_filt}"), summary)
+    section = _macro("kinova_section", data_dir=str(data_dir), method=method,
+                     runs=[p.name for p in runs], ident=ident, cutoff=held_id[0].noise.cutoff,
+                     summary=Markup(summary_table),
+                     joints=Markup(html_table(_JOINT_HEADERS, joint_rows)),
+                     friction=Markup(friction_html), parameters=Markup(parameter_table(ident)),
+                     parts=Markup("".join(parts)))
     return section, True
 
 
@@ -405,12 +368,7 @@ def _friction_html(ft: Any, names: Sequence[str]) -> str:
             for _, r in ft.iterrows()]
     headers = ("friction model", "held-out rel. error", "against filtered", "noise floor",
                *names)
-    return f"""<h3>What friction adds (held-out current error by friction model)</h3>
-<p>Each friction model identified anew on the same 70 % and evaluated on the same held-out 30 %
-(<code>robodyn.identification.friction_table</code>; "against filtered" and the noise floor
-use the identification's own low-pass cut-off). "none" is the rigid-body and drive model
-alone: the difference to the other rows is what friction is worth here.</p>
-{html_table(headers, rows)}"""
+    return _macro("friction_section", table=Markup(html_table(headers, rows)))
 
 
 def _default_data_dir() -> Path:
