@@ -129,3 +129,19 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:
         "set ROBODYN_REQUIRE_ALL=1 to make missing oracles/tools/data fail")
     hidden = f"; hidden: {', '.join(sorted(HIDDEN))}" if HIDDEN else ""
     terminalreporter.write_line(f"robodyn: {skipped} test(s) skipped ({mode}{hidden})")
+
+
+@pytest.fixture(scope="session")
+def renderer():
+    """``benchmarks/render_readme.py`` as a module (:func:`tests.readme_results.load_renderer`)."""
+    from tests.readme_results import load_renderer
+
+    return load_renderer()
+
+
+@pytest.fixture(scope="session")
+def sections():
+    """README's marked benchmark sections by name (:func:`tests.readme_results.readme_sections`)."""
+    from tests.readme_results import readme_sections
+
+    return readme_sections()

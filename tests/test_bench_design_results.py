@@ -9,30 +9,21 @@ what they are, and every figure not measured in the run carries its source.
 
 from __future__ import annotations
 
-import json
 import re
 from pathlib import Path
 from typing import Any
 
 import pytest
 
+from tests.readme_results import section_data
+
 ROOT = Path(__file__).resolve().parent.parent
 MARKER = re.compile(r"<!-- results:(?P<name>[\w-]+) (?P<path>\S+) -->")
 
 
-@pytest.fixture(scope="module")
-def sections() -> dict[str, str]:
-    """README's marked sections: benchmark name -> results file it names."""
-    text = (ROOT / "README.md").read_text()
-    return {m["name"]: m["path"] for m in MARKER.finditer(text)}
-
-
-def _entry(sections: dict[str, str], name: str) -> dict[str, Any]:
+def _entry(sections: dict[str, Any], name: str) -> dict[str, Any]:
     """Entry ``name`` of the results file that README's section ``name`` names."""
-    assert name in sections, f"README has no <!-- results:{name} PATH --> section"
-    path = ROOT / sections[name]
-    assert path.is_file(), f"README names {sections[name]}, which is not committed"
-    return json.loads(path.read_text())["benchmarks"][name]
+    return section_data(sections, name)["benchmarks"][name]
 
 
 def _close(a: float, b: float) -> bool:

@@ -9,41 +9,14 @@ nothing here times or runs a benchmark. The checks are plain functions, callable
 
 from __future__ import annotations
 
-import importlib.util
-import json
 from pathlib import Path
-from types import ModuleType
 from typing import Any
 
 import pytest
 
+from tests.readme_results import section_data as _data
+
 ROOT = Path(__file__).resolve().parent.parent
-
-
-@pytest.fixture(scope="module")
-def renderer() -> ModuleType:
-    """``benchmarks/render_readme.py`` loaded as a module (``benchmarks/`` is not a package)."""
-    spec = importlib.util.spec_from_file_location("render_readme_dynamics",
-                                                  ROOT / "benchmarks" / "render_readme.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-@pytest.fixture(scope="module")
-def sections(renderer: ModuleType) -> dict[str, Any]:
-    """README's marked sections by benchmark name (the regex match of each)."""
-    text = (ROOT / "README.md").read_text()
-    return {m["name"]: m for m in renderer.MARKER.finditer(text)}
-
-
-def _data(sections: dict[str, Any], name: str) -> dict[str, Any]:
-    """The results file that README's section ``name`` names (asserted to exist)."""
-    assert name in sections, f"README has no <!-- results:{name} PATH --> section"
-    path = ROOT / sections[name]["path"]
-    assert path.is_file(), f"README names {sections[name]['path']}, which is not committed"
-    return json.loads(path.read_text())
 
 
 def _ratio_follows(ratio: dict[str, float], theirs: dict[str, float], ours: dict[str, float]) -> None:
