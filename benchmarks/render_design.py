@@ -112,18 +112,7 @@ def _derivation_chains(ch: dict[str, Any]) -> list[str]:
 
 
 def render_derivation(data: dict[str, Any]) -> str:
-    """Markdown of the ``derivation`` entry.
-
-    Parameters
-    ----------
-    data : dict
-        The whole results file (machine record and benchmarks).
-
-    Returns
-    -------
-    str
-        Lines ending in a newline.
-    """
+    """Markdown of the ``derivation`` entry."""
     e = data["benchmarks"]["derivation"]
     sym, quoted = e["symbolic"], e["quoted"]
     sec, sb = sym["seconds"], quoted["SymPyBotics"]

@@ -1,8 +1,9 @@
 """README sections of the dynamics suites: ``derivatives`` (``bench_derivatives.py``) and
 ``identify`` (``bench_identify.py``), rendered from their entries in the results file.
 
-Registered in ``render_readme.py`` through :data:`RENDERERS`. Standard library only; nothing
-here times anything.
+Registered in ``render_readme.py`` through :data:`RENDERERS`; each renderer takes the whole results
+file (machine record and benchmarks) and returns Markdown lines ending in a newline. Standard
+library only; nothing here times anything.
 """
 
 from __future__ import annotations
@@ -23,16 +24,6 @@ def _met(ok: bool) -> str:
 def render_derivatives(data: dict[str, Any]) -> str:
     """Markdown of the ``derivatives`` entry: the table with the loop and the binding taken out,
     what each side is, the agreement and the target.
-
-    Parameters
-    ----------
-    data : dict
-        The whole results file (machine record and benchmarks).
-
-    Returns
-    -------
-    str
-        Lines ending in a newline.
     """
     e = data["benchmarks"]["derivatives"]
     loop, floor, copies = e["python_loop_ns"], e["binding_floor_ns"], e["three_copies_ns"]

@@ -131,18 +131,7 @@ def _speed(e: dict[str, Any]) -> str:
 
 
 def render_identification_quality(data: dict[str, Any]) -> str:
-    """Markdown of the ``identification_quality`` entry.
-
-    Parameters
-    ----------
-    data : dict
-        The whole results file (machine record and benchmarks).
-
-    Returns
-    -------
-    str
-        Lines ending in a newline.
-    """
+    """Markdown of the ``identification_quality`` entry."""
     e = data["benchmarks"]["identification_quality"]
     lines = rc.wrap(rc.run(data, e, (
         "Held-out prediction error of the default `rd.identify` against a textbook "

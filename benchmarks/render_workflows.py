@@ -121,18 +121,7 @@ def _calibration_cli(e: dict[str, Any]) -> list[str]:
 
 
 def render_calibration(data: dict[str, Any]) -> str:
-    """Markdown of the ``calibration`` entry: error models, Jacobians, 1000 poses, the CLI.
-
-    Parameters
-    ----------
-    data : dict
-        The whole results file (machine record and benchmarks).
-
-    Returns
-    -------
-    str
-        Lines ending in a newline.
-    """
+    """Markdown of the ``calibration`` entry: error models, Jacobians, 1000 poses, the CLI."""
     e = data["benchmarks"]["calibration"]
     m = e["models"]
     lines = rc.wrap(rc.run(data, e, (
