@@ -82,7 +82,10 @@ def test_backends_agree_with_the_symbolic_equations(compiled):
 def test_c_batches_across_blocks_large_angles_and_resting_joints(compiled):
     """The C batch loops run in blocks with vectorised sin/cos and friction switches: check
     counts around the block size, angles far outside [-pi, pi] (and beyond the polynomial's
-    range), joints exactly at rest, and that one state alone gives the batch's very bits."""
+    range), joints exactly at rest, and that one state alone gives the batch's numbers: the same
+    operations, whose products the compiler may fuse (FMA) differently in the vector loop and in
+    its scalar remainder, so equal to rounding (1e-14 of the output's largest entry), not always
+    to the bit (the Kinova regressor at block width 8 differed in the last bits)."""
     robot, _, c_model, np_model = compiled
     n = robot.dof
     count = max(2 * BLOCK + 3, 12)  # any block width, 1 (scalar code) too
@@ -105,7 +108,8 @@ def test_c_batches_across_blocks_large_angles_and_resting_joints(compiled):
             close(out, getattr(np_model, name)(*part))
         for k in (0, 2, BLOCK, count - 1):
             single = getattr(c_model, name)(*(a[k] for a in arrays))
-            np.testing.assert_array_equal(single, out[k], err_msg=name)
+            scale = max(1.0, float(np.max(np.abs(out[k]))))
+            np.testing.assert_array_less(np.abs(single - out[k]), 1e-14 * scale, err_msg=name)
 
 
 def test_streamed_regressor_keeps_the_bits():
