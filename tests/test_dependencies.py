@@ -16,6 +16,7 @@ from robodyn.errors import MissingExtraError, RobodynError
 from robodyn.extras import EXTRAS, require
 
 ROOT = Path(__file__).resolve().parent.parent
+LIBRARY = ROOT / "src" / "robodyn" / "robot" / "library"
 
 
 def _requirement_names(reqs: list[str]) -> set[str]:
@@ -77,3 +78,23 @@ def test_a_missing_extra_names_the_pip_command(monkeypatch) -> None:
         require("mcap", "rd.read_recording('run.mcap')")
     assert isinstance(info.value, RobodynError) and isinstance(info.value, ImportError)
     assert "rd.read_recording('run.mcap')" in str(info.value)
+
+
+def test_urdf_files_need_the_urdf_extra_and_nothing_else_does(monkeypatch, tmp_path) -> None:
+    # the URDF parser is the `urdf` extra: without it a URDF file is refused with the pip
+    # command, while a built-in robot and a YAML description load as before
+    import robodyn as rd
+
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text('<robot name="arm"><link name="base"/><link name="l1"><inertial><mass value="1"/>'
+                    '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
+                    '</link><joint name="j1" type="revolute"><parent link="base"/><child link="l1"/>'
+                    '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+                    '</robot>', encoding="utf-8")
+    assert rd.load(str(urdf)).dof == 1  # with the extra installed (the test environment)
+    monkeypatch.setitem(sys.modules, "yourdfpy", None)  # import yourdfpy now raises ImportError
+    with pytest.raises(MissingExtraError, match=r"pip install 'robodyn\[urdf\]'") as info:
+        rd.load(str(urdf))
+    assert str(urdf) in str(info.value)
+    assert rd.load("puma560").dof == 6
+    assert rd.load(str(LIBRARY / "planar_2r.yaml")).dof == 2

@@ -1,7 +1,8 @@
 """Read a URDF file whose moving joints form a serial chain into a :class:`~robodyn.robot.model.Robot`.
 
-The file is parsed by the maintained URDF parser `yourdfpy`_ (meshes and scene graphs are not
-loaded); this module only maps its model onto robodyn's convention::
+The file is parsed by the maintained URDF parser `yourdfpy`_ (the ``urdf`` extra,
+``pip install 'robodyn[urdf]'``; meshes and scene graphs are not loaded); this module only maps
+its model onto robodyn's convention::
 
     T_i(q_i) = origin_i @ motion(axis_i, q_i)          (pre = origin, post = I)
 
@@ -44,11 +45,10 @@ import io
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import sympy as sp
-import yourdfpy
 from lxml import etree
 
 from robodyn import spatial as S
@@ -56,6 +56,10 @@ from robodyn.robot import placement, validation
 from robodyn.robot.chain import ChainElement, assemble, combine_links
 from robodyn.robot.errors import DescriptionError
 from robodyn.robot.model import Friction, Link, Robot
+from robodyn.robot.optional import require
+
+if TYPE_CHECKING:
+    import yourdfpy
 
 __all__ = ["load_urdf", "number"]
 
@@ -143,8 +147,9 @@ def load_urdf(path: str | Path, *, strict: bool = False, tool: str | None = None
     # blank lines before the XML declaration are common in pasted and generated files
     data = path.read_bytes().lstrip(b" \t\r\n")
     root = _parse_xml(data, name)
+    urdf_parser = require("yourdfpy", f"reading the URDF file {name}")
     try:
-        model = yourdfpy.URDF.load(
+        model = urdf_parser.URDF.load(
             io.BytesIO(data),
             load_meshes=False,
             build_scene_graph=False,
