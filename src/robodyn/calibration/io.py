@@ -14,12 +14,9 @@ comments. Columns (any order, extra columns ignored):
 Lengths and angles may be in other units (``mm``, ``deg``): :func:`robodyn.calibration.calibrate`
 converts them (``length_unit``, ``angle_unit``; CLI ``--length-unit``, ``--angle-unit``).
 
-Joint mapping (controller joints to model joints), a mapping or a YAML file::
-
-    q3: {column: J3, sign: -1, offset: 0.0, coupling: {J2: 1.0}}   # q3 = -J3 + 0 + 1.0 J2
-
-Each model joint named in the spec is ``sign * column + offset + sum(factor * other column)``
-(offset in the file's angle unit); joints not named are read from their own column.
+Joint mapping (controller columns to model joints: a recording spec, or the short form
+``q3: {column: J3, sign: -1, offset: 0.0, coupling: {J2: 1.0}}``):
+:mod:`robodyn.calibration.joint_map`.
 
 Every error names the file, and the row (1-based line number in the file) and column where it
 is.
@@ -37,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from robodyn.calibration.joint_map import JointMap, identity_map, read_joint_map
 from robodyn.calibration.result import Calibration, ErrorStats
 from robodyn.output_names import output_path
 from robodyn.robot.errors import DataFileError
@@ -189,70 +187,6 @@ def _quaternion_matrix(w, x, y, z) -> np.ndarray:
     ], 1)
 
 
-@dataclass(frozen=True)
-class JointMap:
-    """Controller columns to model joints: ``q_j = sign * column + offset + sum(factor * other)``.
-
-    Attributes
-    ----------
-    entries : dict of str to (str, float, float, dict of str to float)
-        Model joint -> (column, sign, offset, coupling).
-    source : str
-        The spec's file name (or ``"<mapping>"``) for error messages.
-    """
-
-    entries: dict
-    source: str = "<mapping>"
-
-
-def read_joint_map(spec, robot: Robot) -> JointMap:
-    """Validate a joint-mapping spec (a mapping, or a YAML file path) against ``robot``.
-
-    Raises
-    ------
-    DataFileError
-        A joint the robot does not have, an unknown key, a sign other than +-1, a non-numeric
-        offset or coupling factor (the message names the spec and the joint).
-    """
-    source = "<mapping>"
-    if isinstance(spec, (str, Path)):
-        from robodyn.robot.safe_yaml import safe_yaml
-
-        source = str(spec)
-        try:
-            text = Path(spec).read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise DataFileError(f"{source}: cannot read the joint mapping: {exc}") from None
-        spec = safe_yaml(text, source, DataFileError)
-    if not isinstance(spec, dict):
-        raise DataFileError(f"{source}: a joint mapping is a mapping of model joint -> "
-                            "{column, sign, offset, coupling}")
-    entries = {}
-    for joint, item in spec.items():
-        if joint not in robot.joint_names:
-            raise DataFileError(f"{source}: joint mapping names joint {joint!r}, which {robot.name} "
-                                f"does not have (its joints: {', '.join(robot.joint_names)})")
-        item = {"column": item} if isinstance(item, str) else item
-        if not isinstance(item, dict):
-            raise DataFileError(f"{source}: joint {joint!r}: expected a column name or a mapping")
-        unknown = set(item) - {"column", "sign", "offset", "coupling"}
-        if unknown:
-            raise DataFileError(f"{source}: joint {joint!r}: unknown key(s) {', '.join(sorted(unknown))} "
-                                "(allowed: column, sign, offset, coupling)")
-        column = str(item.get("column", joint))
-        sign, offset = item.get("sign", 1), item.get("offset", 0.0)
-        coupling = item.get("coupling", {}) or {}
-        if sign not in (1, -1):
-            raise DataFileError(f"{source}: joint {joint!r}, field 'sign': {sign!r} is not 1 or -1")
-        numbers = [("offset", offset)] + [(f"coupling.{k}", v) for k, v in dict(coupling).items()]
-        for field_name, v in numbers:
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-                raise DataFileError(f"{source}: joint {joint!r}, field {field_name!r}: {v!r} is not a "
-                                    "finite number")
-        entries[joint] = (column, float(sign), float(offset), {str(k): float(v) for k, v in coupling.items()})
-    return JointMap(entries, source)
-
-
 def _target_count(path: Path) -> int:
     """Number of targets in a calibration CSV's header (``x, y, z``, ``x2, y2, z2`` ...)."""
     records = _records(path)
@@ -274,7 +208,8 @@ def read_calibration_csv(path: str | Path, robot: Robot, *, targets: int | None 
     targets : int, optional
         Expected number of targets per pose (checked against the columns); default: as found.
     joint_map : JointMap, optional
-        Controller columns to model joints (:func:`read_joint_map`).
+        Controller columns to model joints (:func:`read_joint_map`); default: each joint from
+        the column of its name. With a recording spec's map the joints come out in rad (m).
 
     Raises
     ------
@@ -282,30 +217,16 @@ def read_calibration_csv(path: str | Path, robot: Robot, *, targets: int | None 
         Besides the table errors: a target count that differs from the data's columns, a
         mapping column the file does not have.
     """
-    joints = list(robot.joint_names)
     found = _target_count(Path(path)) if Path(path).exists() else 1
     if targets is not None and targets != found:
         raise DataFileError(f"{path}: {targets} target(s) per pose were declared but the columns hold "
                             f"{found} (x, y, z" + "".join(f", x{k}, y{k}, z{k}" for k in range(2, found + 1))
                             + ")")
     xyz = [f"{a}{k if k > 1 else ''}" for k in range(1, found + 1) for a in "xyz"]
-    mapping = joint_map.entries if joint_map is not None else {}
-    columns = []
-    for j in joints:
-        column, _, _, coupling = mapping.get(j, (j, 1.0, 0.0, {}))
-        columns += [column, *coupling]
-    columns = list(dict.fromkeys(columns))
-    table, lines = _read_table(path, columns + xyz,
+    jmap = joint_map if joint_map is not None else identity_map(robot)
+    table, lines = _read_table(path, list(jmap.columns) + xyz,
                                ["qw", "qx", "qy", "qz", "sigma"], (), MAX_ABS_VALUE)
-    cols = []
-    for j in joints:
-        column, sign, offset, coupling = mapping.get(j, (j, 1.0, 0.0, {}))
-        # q_j = sign * column + offset + sum(factor * other column)
-        v = sign * np.array(table[column]) + offset
-        for other, factor in coupling.items():
-            v = v + factor * np.array(table[other])
-        cols.append(v)
-    q = np.column_stack(cols)
+    q = jmap.apply(table)  # q = W c + b (sign, offset, couplings; a spec's unit)
     points = np.stack([np.column_stack([table[f"{a}{k if k > 1 else ''}"] for a in "xyz"])
                        for k in range(1, found + 1)], axis=1)
     if found == 1:

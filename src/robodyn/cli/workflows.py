@@ -182,6 +182,10 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     stem = check_stem(args.stem) if args.stem is not None else \
         check_stem(f"{robot.name}_calibrated", what="robot name")
     jmap = read_joint_map(args.joint_map, robot) if args.joint_map else None
+    if jmap is not None and jmap.si and args.angle_unit != "rad":
+        raise InputError(f"--angle-unit {args.angle_unit}: the joint map {jmap.source} is a recording "
+                         "spec, whose position.unit already gives the joints' unit; leave "
+                         "--angle-unit at rad")
     data = read_calibration_csv(args.data, robot, targets=args.targets, joint_map=jmap)
     units = {"length_unit": args.length_unit, "angle_unit": args.angle_unit}
 
@@ -468,8 +472,10 @@ def _calibrate_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: st
     p.add_argument("--angle-unit", choices=("rad", "deg"), default="rad",
                    help="unit of the revolute joints' columns (default: %(default)s)")
     p.add_argument("--joint-map", metavar="FILE.yaml",
-                   help="controller columns to model joints: per joint {column, sign, offset, "
-                        "coupling: {other column: factor}} (docs/calibration.md)")
+                   help="controller columns to model joints: the arm's recording spec (its "
+                        "joints, position and couplings; docs/recording-spec.md), or per joint "
+                        "{column, sign, offset, coupling: {other column: factor}} "
+                        "(docs/calibration.md)")
     p.add_argument("--targets", type=int, metavar="K",
                    help="targets per pose (x, y, z, x2, y2, z2, ...); checked against the columns")
     p.add_argument("--sigma-rot", type=float, default=0.1, metavar="MRAD",

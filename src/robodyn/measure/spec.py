@@ -87,7 +87,7 @@ class RecordingSpec:
     delimiter: str | None
     header: bool
     comment: str | None
-    time_column: str | int
+    time_column: str | int | None  # None: a spec of joint conventions only (need_time=False)
     time_unit: str
     period: float | str | None  # seconds per sample for unit "index", or "estimate"
     channels: Mapping[str, Channel]
@@ -112,8 +112,12 @@ def builtin_specs() -> tuple[str, ...]:
     return tuple(sorted(p.name[:-5] for p in root.iterdir() if p.name.endswith(".yaml")))
 
 
-def load_spec(spec: str | PathLike[str] | Mapping[str, Any]) -> RecordingSpec:
+def load_spec(spec: str | PathLike[str] | Mapping[str, Any], *, need_time: bool = True) -> RecordingSpec:
     """A :class:`RecordingSpec` from a built-in name, a YAML file or a mapping.
+
+    ``need_time=False`` accepts a spec without a ``time`` block (``time_column`` is then None):
+    the joint conventions alone (``joints``, ``position``, ``couplings``), as a calibration
+    reads them (:func:`robodyn.calibration.io.read_joint_map`).
 
     Raises
     ------
@@ -121,7 +125,7 @@ def load_spec(spec: str | PathLike[str] | Mapping[str, Any]) -> RecordingSpec:
         Unknown built-in, unreadable YAML, or an invalid field (named as ``spec: field.path``).
     """
     if isinstance(spec, Mapping):
-        return _parse(dict(spec), "spec")
+        return _parse(dict(spec), "spec", need_time)
     text_name = str(spec)
     if text_name in builtin_specs():
         path = resources.files("robodyn.measure") / "specs" / f"{text_name}.yaml"
@@ -138,7 +142,7 @@ def load_spec(spec: str | PathLike[str] | Mapping[str, Any]) -> RecordingSpec:
     data = safe_yaml(text, name, RecordingError)
     if not isinstance(data, dict):
         raise RecordingError(f"{name}: a spec must be a mapping of fields, got {type(data).__name__}")
-    return _parse(data, name)
+    return _parse(data, name, need_time)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -273,7 +277,7 @@ def _channel(field: str, data: Any, n: int, name: str) -> Channel:
         missing=missing)
 
 
-def _parse(data: dict[str, Any], name: str) -> RecordingSpec:
+def _parse(data: dict[str, Any], name: str, need_time: bool = True) -> RecordingSpec:
     _keys(data, _TOP, name, "")
     joints = data.get("joints")
     count = joints if isinstance(joints, int) and not isinstance(joints, bool) else \
@@ -300,7 +304,25 @@ def _parse(data: dict[str, Any], name: str) -> RecordingSpec:
     comment = data.get("comment")
     if comment is not None and (not isinstance(comment, str) or len(comment) != 1):
         raise RecordingError(f"{name}: comment: expected one character, got {comment!r}")
-    time = data.get("time")
+    if data.get("time") is None and not need_time:
+        tcol, tunit, period = None, "s", None  # joint conventions only: no time column
+    else:
+        tcol, tunit, period = _time(data.get("time"), name)
+    channels = {f: _channel(f, data[f], n, name) for f in _ALLOWED if f in data}
+    if "position" not in channels:
+        raise RecordingError(f"{name}: position: missing (joint positions are required)")
+    if period == "estimate" and "velocity" not in channels:
+        raise RecordingError(f"{name}: time.period: 'estimate' needs a velocity block (the period is "
+                             "regressed from position increments on measured velocity)")
+    if "torque" in channels and channels["torque"].columns is None and "current" not in channels:
+        raise RecordingError(f"{name}: torque.from: 'current' needs a current block")
+    return RecordingSpec(name=name, joint_names=names, delimiter=delimiter, header=header,
+                         comment=comment, time_column=tcol, time_unit=tunit, period=period,
+                         channels=channels, couplings=_couplings(data.get("couplings"), names, name))
+
+
+def _time(time: Any, name: str) -> tuple[str | int, str, float | str | None]:
+    """The ``time`` block: column, unit and (for unit ``index``) the period or ``"estimate"``."""
     if not isinstance(time, dict):
         raise RecordingError(f"{name}: time: missing (a mapping with column and unit)")
     _keys(time, ("column", "unit", "period"), name, "time")
@@ -320,17 +342,7 @@ def _parse(data: dict[str, Any], name: str) -> RecordingSpec:
                                  f"or 'estimate', got {period!r}")
     elif period is not None:
         raise RecordingError(f"{name}: time.period: only meaningful with unit 'index'")
-    channels = {f: _channel(f, data[f], n, name) for f in _ALLOWED if f in data}
-    if "position" not in channels:
-        raise RecordingError(f"{name}: position: missing (joint positions are required)")
-    if period == "estimate" and "velocity" not in channels:
-        raise RecordingError(f"{name}: time.period: 'estimate' needs a velocity block (the period is "
-                             "regressed from position increments on measured velocity)")
-    if "torque" in channels and channels["torque"].columns is None and "current" not in channels:
-        raise RecordingError(f"{name}: torque.from: 'current' needs a current block")
-    return RecordingSpec(name=name, joint_names=names, delimiter=delimiter, header=header,
-                         comment=comment, time_column=tcol, time_unit=tunit, period=period,
-                         channels=channels, couplings=_couplings(data.get("couplings"), names, name))
+    return tcol, tunit, period
 
 
 def _couplings(data: Any, names: tuple[str, ...], name: str) -> tuple[Coupling, ...]:
