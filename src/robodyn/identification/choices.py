@@ -121,6 +121,11 @@ class Choices:
     prediction_scores : tuple of (str, float)
         Each candidate cut-off's relative error against the raw target of the identification
         recordings.
+    resonance : bool or None
+        Whether ``resonance="auto"`` (or True) kept a drive mode on some joint
+        (:mod:`robodyn.identification.resonance`), else None.
+    resonance_scores : tuple of (str, float)
+        Relative held-out error of the model's residual without and with the modes.
     """
 
     velocity: str
@@ -137,6 +142,8 @@ class Choices:
     ripple_scores: tuple[tuple[str, float], ...] = ()
     prediction_cutoff: float | None = None
     prediction_scores: tuple[tuple[str, float], ...] = ()
+    resonance: bool | None = None
+    resonance_scores: tuple[tuple[str, float], ...] = ()
 
     @property
     def friction_reason(self) -> str:
@@ -157,6 +164,10 @@ class Choices:
         if self.ripple is not None:
             scores = ", ".join(f"{k} {v:.4f}" for k, v in self.ripple_scores)
             lines.append(f"  position ripple {'kept' if self.ripple else 'not kept'} (held-out "
+                         f"blocks of the model's residual: {scores})")
+        if self.resonance is not None:
+            scores = ", ".join(f"{k} {v:.4f}" for k, v in self.resonance_scores)
+            lines.append(f"  drive modes {'kept' if self.resonance else 'not kept'} (held-out "
                          f"blocks of the model's residual: {scores})")
         if self.prediction_cutoff is not None:
             scores = ", ".join(f"{k} {v:.4f}" for k, v in self.prediction_scores)

@@ -90,6 +90,11 @@ class IdentifyOptions:
         fitted on what the identified model leaves of the target
         (:mod:`robodyn.identification.ripple`); "auto": kept when it predicts held-out time
         blocks of that residual better than none.
+    resonance : bool or "auto"
+        One lightly damped drive mode per joint added to the prediction
+        (:mod:`robodyn.identification.resonance`): frequency, damping and share chosen by
+        held-out time blocks of the model's residual; "auto": a joint's mode kept only when it
+        beats none by one standard error; True: every joint's best mode; False: none.
     prediction_cutoff : float, "auto" or "fit"
         Cut-off (Hz) of the states :meth:`Identification.predict` evaluates the model at
         (:mod:`robodyn.identification.bandwidth`): "fit" (the default) is the fit's cut-off;
@@ -118,6 +123,7 @@ class IdentifyOptions:
     sensor: str = "motor"
     spikes: str = "keep"
     ripple: bool | str = "auto"
+    resonance: bool | str = "auto"
     prediction_cutoff: float | str = "fit"
 
     def __post_init__(self) -> None:
@@ -136,8 +142,10 @@ class IdentifyOptions:
                                       f"{self.dead_band!r}")
         _choice("gains", self.gains, ("auto", "description", "absorbed"))
         _choice("spikes", self.spikes, SPIKES)
-        if not any(self.ripple is v for v in (False, True)) and self.ripple != "auto":
-            raise IdentificationError(f"ripple: expected False, True or 'auto', got {self.ripple!r}")
+        for name in ("ripple", "resonance"):
+            value = getattr(self, name)
+            if not any(value is v for v in (False, True)) and value != "auto":
+                raise IdentificationError(f"{name}: expected False, True or 'auto', got {value!r}")
         pc = self.prediction_cutoff
         if isinstance(pc, str) or isinstance(pc, bool) or not isinstance(pc, (int, float)):
             if pc not in ("auto", "fit"):

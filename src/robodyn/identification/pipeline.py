@@ -48,6 +48,7 @@ from robodyn.identification.preprocess import (
     slowest_rate,
 )
 from robodyn.identification.prior import joint_prior
+from robodyn.identification.resonance import with_resonance
 from robodyn.identification.result import BaseParameters, Identification
 from robodyn.identification.ripple import gravity_free_joints, with_ripple
 from robodyn.identification.spikes import drop_spikes
@@ -112,7 +113,8 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
              bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None,
              payloads: Sequence[Payload | None] | None = None, weights: str = "residual",
              state_noise: Any = None, thermal: bool | str = False, sensor: str = "motor",
-             spikes: str = "keep", ripple: bool | str = "auto", prediction_cutoff: float | str = "fit",
+             spikes: str = "keep", ripple: bool | str = "auto", resonance: bool | str = "auto",
+             prediction_cutoff: float | str = "fit",
              options: IdentifyOptions | None = None) -> Identification:
     """Identify the base inertial, drive and friction parameters of a robot from recordings.
 
@@ -130,7 +132,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         The choices: the attributes of the same names of
         :class:`~robodyn.identification.options.IdentifyOptions` (what each does, its values
         and default). ``method``: "ols", "wls" or "consistent" (default).
-    weights, state_noise, thermal, sensor, spikes, ripple, prediction_cutoff
+    weights, state_noise, thermal, sensor, spikes, ripple, resonance, prediction_cutoff
         Likewise.
     model : Model, optional
         A compiled model of ``robot`` to reuse (default ``rd.compile_model(robot)``).
@@ -158,7 +160,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         method=method, friction=friction, regularization=regularization, cutoff=cutoff,
         decimate=decimate, velocity=velocity, dead_band=dead_band, gains=gains, bounds=bounds,
         weights=weights, state_noise=state_noise, thermal=thermal, sensor=sensor, spikes=spikes,
-        ripple=ripple, prediction_cutoff=prediction_cutoff),
+        ripple=ripple, resonance=resonance, prediction_cutoff=prediction_cutoff),
         IdentificationError)
     recs, target, pays = checked_inputs(robot, recordings, target, opts.sensor, payloads)
     check_prediction_cutoff(recs, opts.prediction_cutoff)
@@ -223,6 +225,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
                          gravity_free_joints(model, revolute),
                          opts.ripple)
     result = with_prediction_cutoff(result, recs, pays, target, opts.prediction_cutoff)
+    result = with_resonance(result, recs, pays, target, opts.resonance)
     return replace(result, options=opts)
 
 

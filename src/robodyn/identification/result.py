@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import Any
 
@@ -14,6 +14,7 @@ from robodyn.identification.choices import Choices
 from robodyn.identification.friction import FrictionFit, without_friction
 from robodyn.identification.options import IdentifyOptions
 from robodyn.identification.preprocess import Preprocess, prediction_rows, preprocess
+from robodyn.identification.resonance import ResonanceFit
 from robodyn.identification.ripple import RippleFit
 from robodyn.identification.thermal import ThermalFit, temperatures
 from robodyn.numeric.model import Model
@@ -143,6 +144,10 @@ class Identification:
     prediction : Preprocess or None
         The processing :meth:`predict` uses when it differs from ``preprocess``: the same with
         the prediction cut-off chosen from the data (:mod:`robodyn.identification.bandwidth`).
+    resonance_fit : ResonanceFit or None
+        One lightly damped mode per joint (:mod:`robodyn.identification.resonance`):
+        :meth:`predict` evaluates the model on states at the mode's band and adds what the modes
+        add to it; ``robot`` does not carry them.
     """
 
     robot: Robot
@@ -168,6 +173,7 @@ class Identification:
     options: IdentifyOptions | None = None
     ripple_fit: RippleFit | None = None
     prediction: Preprocess | None = None
+    resonance_fit: ResonanceFit | None = None
 
     @property
     def gains_identified(self) -> bool:
@@ -182,7 +188,8 @@ class Identification:
         decimation, at the prediction cut-off (:attr:`prediction_settings`: the fit's, or a
         wider one chosen from the data by :mod:`robodyn.identification.bandwidth`); the
         prediction is the model's effort ``Y(q, qd, qdd) p`` at the processed states
-        (:meth:`effort`).
+        (:meth:`effort`). A joint with a drive mode (:attr:`resonance_fit`) is predicted from
+        states processed at the mode's band, plus what the mode adds.
 
         Parameters
         ----------
@@ -199,9 +206,13 @@ class Identification:
         from robodyn.identification.inputs import check_recording
 
         check_recording(self.robot, recording, 0, None)
-        s = preprocess(recording, self.prediction_settings, None)
         temp = temperatures(recording, 0, self.robot.dof) if self.thermal_fit is not None else None
-        return self.effort(s, temp, payload)
+        s = preprocess(recording, self.prediction_settings, None)
+        plain = self.effort(s, temp, payload)
+        if self.resonance_fit is None:
+            return plain
+        wide = preprocess(recording, replace(self.preprocess, cutoff=self.resonance_fit.band), None)
+        return self.resonance_fit.combine(wide.t, self.effort(wide, temp, payload), plain)
 
     @property
     def prediction_settings(self) -> Preprocess:
