@@ -2,8 +2,9 @@
 
 For every data set and split: the nominal description, the textbook baseline
 (``benchmarks/textbook.py``: Pinocchio regressor, QR base columns, OLS, 5 Hz Butterworth),
-robodyn's default ``rd.identify(robot, fit, target=...)`` and its other methods, and the noise
-floor. Figures are ``||pred - y|| / ||y||`` pooled over the held-out samples and all joints
+robodyn's default ``rd.identify(robot, fit, target=...)`` (with its drive modes, and without
+them: the previous default) and its other methods, and the noise floor. Figures are
+``||pred - y|| / ||y||`` pooled over the held-out samples and all joints
 (``raw``: against the measured target; ``filt``: against the reference-filtered target,
 :mod:`robodyn.validation.heldout`; ``floor``: ``||y - y_f|| / ||y||``).
 
@@ -230,9 +231,13 @@ def _nominal(case: Case, model: rd.Model) -> Callable[[rd.Recording], np.ndarray
 METHODS: Sequence[tuple[str, dict, str]] = (
     ("robodyn default", {},
      "rd.identify(robot, fit, target=...): the physically consistent program with the Tikhonov "
-     "weight, velocity source, cut-off, friction law (linear or Stribeck) and position ripple "
-     "chosen by held-out time blocks of the fit data"),
-    ("wls (default before)", {"method": "wls"},
+     "weight, velocity source, cut-off, friction law (linear or Stribeck), position ripple and "
+     "drive modes (one second-order mode per joint) chosen by held-out time blocks of the fit "
+     "data"),
+    ("no drive modes", {"resonance": False},
+     "the default without the drive modes (resonance=False): the default of the previous "
+     "version"),
+    ("wls", {"method": "wls"},
      "method='wls' (weight of least held-out error; the same velocity, friction and ripple "
      "choices)"),
     ("ols", {"method": "ols"}, "method='ols'"),
@@ -257,7 +262,8 @@ def _choices(ident: Any) -> dict[str, Any] | None:
     if c is None:
         return None
     return {"velocity": c.velocity, "cutoff_hz": c.cutoff, "regularization": c.regularization,
-            "friction": c.friction, "ripple": c.ripple, "candidates": len(c.candidates)}
+            "friction": c.friction, "ripple": c.ripple, "candidates": len(c.candidates),
+            "modes": [[name, f0, zeta, round(gain, 3)] for name, f0, zeta, gain in c.resonance_modes]}
 
 
 def run_case(case: Case, rows: list[list[str]]) -> dict[str, Any]:

@@ -66,8 +66,11 @@ def _choices(c: dict[str, Any] | None) -> str:
     cut = "no cut-off" if c["cutoff_hz"] is None else f"cut-off {c['cutoff_hz']:g} Hz"
     friction = "" if c["friction"] is None else f", {c['friction']} friction"
     ripple = "" if c["ripple"] is None else f", ripple {'kept' if c['ripple'] else 'not kept'}"
-    return (f"{c['velocity']} velocity, {cut}, weight {c['regularization']:.3g}{friction}{ripple} "
-            f"(of {c['candidates']} preprocessing candidates)")
+    modes = c.get("modes")
+    drive = "" if modes is None else (", no drive mode" if not modes else ", drive modes on "
+                                      + ", ".join(f"{m[0]} ({m[1]:g} Hz, share {m[3]:.2g})" for m in modes))
+    return (f"{c['velocity']} velocity, {cut}, weight {c['regularization']:.3g}{friction}{ripple}"
+            f"{drive} (of {c['candidates']} preprocessing candidates)")
 
 
 def _best_other(models: dict[str, Any], figure: str) -> str:

@@ -190,6 +190,26 @@ def test_identify_prints_and_reports_the_prediction_cutoff_choice(files, tmp_pat
         assert exc.value.code == 2 and message in capsys.readouterr().err
 
 
+@pytest.mark.slow
+def test_identify_prints_and_reports_the_drive_mode_choice(files, tmp_path, capsys):
+    train, _ = files
+    rc = main(["identify", "puma560", "--data", str(train), "--resonance", "on", "--ripple", "off",
+               "-o", str(tmp_path)])
+    out = capsys.readouterr().out
+    # forced on: every joint's best mode, printed with its frequency, damping and share
+    assert rc == 0 and "drive modes kept (held-out blocks of the target: none 1.0000" in out
+    assert " Hz, damping " in out and ", share " in out
+    assert "Drive modes (one second-order mode per joint" in (tmp_path / "report.html").read_text(
+        encoding="utf-8")
+    rc = main(["identify", "puma560", "--data", str(train), "--resonance", "off", "--ripple", "off",
+               "--no-report", "-o", str(tmp_path / "off")])
+    assert rc == 0 and "drive modes" not in capsys.readouterr().out
+    with pytest.raises(SystemExit) as exc:
+        main(["identify", "puma560", "--data", str(train), "--resonance", "2", "-o", str(tmp_path)])
+    assert exc.value.code == 2
+    assert "--resonance: expected auto, on or off, got '2'" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("option, value", [("--cutoff", "fast"), ("--regularization", "inf"),
                                            ("--dead-band", "wide"), ("--decimate", "2.5")])
 def test_identify_bad_preprocessing_option_is_refused(files, tmp_path, capsys, option, value):

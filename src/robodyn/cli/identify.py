@@ -136,7 +136,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                             friction=args.friction, velocity=args.velocity,
                             dead_band=args.dead_band, spikes=args.spikes, cutoff=args.cutoff,
                             regularization=args.regularization, decimate=args.decimate,
-                            sensor=args.sensor, ripple=args.ripple,
+                            sensor=args.sensor, ripple=args.ripple, resonance=args.resonance,
                             prediction_cutoff=args.prediction_cutoff, **extra)
     paths = {"yaml": out / f"{stem}.yaml", "urdf": out / f"{stem}.urdf",
              "parameters": out / "parameters.csv"}
@@ -165,6 +165,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
             + (f", Coulomb dead band {pre.dead_band:g} rad/s" if pre.dead_band else ""))
     if pre.velocity == "position" and not pre.dead_band and ident.friction_fit is None \
             and ident.thermal_fit is None and ident.ripple_fit is None and pre.cutoff is not None \
+            and ident.resonance_fit is None \
             and ident.prediction is None:
         note += (f"; robodyn validate {paths['yaml']} --target {ident.target} --cutoff "
                  f"{pre.cutoff:.17g} reproduces these figures from the written description")
@@ -411,8 +412,8 @@ def _auto_or(kind: type, *, none: bool = False) -> Any:
     return parse
 
 
-def _ripple(text: str) -> bool | str:
-    """``--ripple``: "auto", "on" (True) or "off" (False)."""
+def _auto_on_off(text: str) -> bool | str:
+    """``--ripple``, ``--resonance``: "auto", "on" (True) or "off" (False)."""
     values = {"auto": "auto", "on": True, "off": False}
     if text not in values:
         raise argparse.ArgumentTypeError(f"expected auto, on or off, got {text!r}")
@@ -446,10 +447,15 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
                    help="one-sample glitches (a position or target sample far off the line "
                         "through its neighbours) in the identification recordings: keep them, or "
                         "drop those rows before the fit (default: %(default)s)")
-    p.add_argument("--ripple", type=_ripple, default="auto", metavar="{auto,on,off}",
+    p.add_argument("--ripple", type=_auto_on_off, default="auto", metavar="{auto,on,off}",
                    help="a torque once per revolution of each revolute joint (a sin q + b cos q), "
                         "fitted on what the model leaves: on, off, or auto: kept when it predicts "
                         "held-out time blocks better (default: %(default)s)")
+    p.add_argument("--resonance", type=_auto_on_off, default="auto", metavar="{auto,on,off}",
+                   help="one lightly damped drive mode per joint (joint and gear elasticity, the "
+                        "current loop) added to the prediction, its frequency, damping and share "
+                        "fitted on what the model leaves: on, off, or auto: kept on a joint when "
+                        "it predicts held-out time blocks better (default: %(default)s)")
     p.add_argument("--prediction-cutoff", type=_prediction_cutoff, default="fit",
                    metavar="{fit,auto,HZ}",
                    help="low-pass cut-off of the states the model is evaluated at in predictions: "

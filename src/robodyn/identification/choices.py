@@ -125,7 +125,9 @@ class Choices:
         Whether ``resonance="auto"`` (or True) kept a drive mode on some joint
         (:mod:`robodyn.identification.resonance`), else None.
     resonance_scores : tuple of (str, float)
-        Relative held-out error of the model's residual without and with the modes.
+        Relative held-out error of the target without and with the modes.
+    resonance_modes : tuple of (str, float, float, float)
+        Each kept mode: joint name, frequency (Hz), damping ratio, share.
     """
 
     velocity: str
@@ -144,6 +146,7 @@ class Choices:
     prediction_scores: tuple[tuple[str, float], ...] = ()
     resonance: bool | None = None
     resonance_scores: tuple[tuple[str, float], ...] = ()
+    resonance_modes: tuple[tuple[str, float, float, float], ...] = ()
 
     @property
     def friction_reason(self) -> str:
@@ -168,7 +171,9 @@ class Choices:
         if self.resonance is not None:
             scores = ", ".join(f"{k} {v:.4f}" for k, v in self.resonance_scores)
             lines.append(f"  drive modes {'kept' if self.resonance else 'not kept'} (held-out "
-                         f"blocks of the model's residual: {scores})")
+                         f"blocks of the target: {scores})")
+            lines += [f"    {name}: {f0:g} Hz, damping {zeta:g}, share {gain:.3g}"
+                      for name, f0, zeta, gain in self.resonance_modes]
         if self.prediction_cutoff is not None:
             scores = ", ".join(f"{k} {v:.4f}" for k, v in self.prediction_scores)
             lines.append(f"  prediction cut-off {self.prediction_cutoff:g} Hz (raw target of the "

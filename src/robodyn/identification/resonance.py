@@ -10,7 +10,7 @@ second-order response of unit static gain::
     H_j(s) = w_j^2 / (s^2 + 2 zeta_j w_j s + w_j^2),    w_j = 2 pi f_j
 
 and the prediction becomes ``p_j + b_j (H_j p_j - p_j)``: the identified model's effort ``p_j``,
-plus ``b_j`` times what the mode adds to it (zero at rest and at low frequency, so the
+plus ``b_j >= 0`` times what the mode adds to it (zero at rest and at low frequency, so the
 rigid-body parameters keep their meaning). ``p`` is evaluated on states low-passed at the widest
 prediction band of :mod:`robodyn.identification.bandwidth` (``min(4 f_c, 0.2 x rate)``), since the
 mode lies above the fit's cut-off ``f_c``. ``H`` is discretised by the bilinear transform at the
@@ -18,11 +18,13 @@ median sampling step, on a uniform grid (irregular stamps are interpolated onto 
 
 The frequency and damping of each joint come from a grid (:data:`F0_GRID`, :data:`ZETA_GRID`,
 frequencies kept below 0.4 x the slowest recording's Nyquist frequency), ``b_j`` by least squares
-on the model's residual; both are chosen by time-block cross-validation on the identification
+on the model's residual (at least 0: a negative share would remove the model's own content near
+the mode, which no mode does); both are chosen by time-block cross-validation on the identification
 recordings (:data:`~robodyn.identification.estimate.FOLDS` contiguous blocks per recording, each
 predicted by a fit on the others). ``resonance="auto"`` (the default of :func:`robodyn.identify`)
-keeps a joint's mode only when it predicts the held-out blocks of that joint's residual better
-than none by more than one standard error of the paired block differences (the rule of
+keeps a joint's mode only when it predicts the held-out blocks of that joint's target better than
+the plain prediction and better than the model at the band without a mode, each by more than one
+standard error of the paired block differences (the rule of
 :mod:`robodyn.identification.choices`); ``True`` keeps every joint's best mode. The result's
 ``resonance_fit`` holds the modes; ``ident.choices.resonance`` and ``resonance_scores`` record the
 choice. The written description does not carry them.
@@ -42,6 +44,7 @@ from typing import Any
 import numpy as np
 import scipy.signal as ss
 
+from robodyn.identification.bandwidth import prediction_candidates
 from robodyn.identification.estimate import FOLDS, paired_se
 from robodyn.identification.preprocess import preprocess, slowest_rate, target_signal
 from robodyn.identification.thermal import temperatures
@@ -75,16 +78,17 @@ def mode_response(t: np.ndarray, x: np.ndarray, f0: float, zeta: float) -> np.nd
     """
     t = np.asarray(t, dtype=float)
     x = np.asarray(x, dtype=float)
-    dt = float(np.median(np.diff(t)))
-    steps = int(round((t[-1] - t[0]) / dt)) + 1
-    tu = t[0] + dt * np.arange(steps)
-    uniform = np.column_stack([np.interp(tu, t, x[:, k]) for k in range(x.shape[1])])
+    steps = np.diff(t)
+    dt = float(np.median(steps))
+    regular = bool(np.all(np.abs(steps - dt) <= 1e-6 * dt))
+    tu = t if regular else t[0] + dt * np.arange(int(round((t[-1] - t[0]) / dt)) + 1)
+    uniform = x if regular else np.column_stack([np.interp(tu, t, x[:, k]) for k in range(x.shape[1])])
     w = 2.0 * np.pi * f0
     # H(s) = w^2 / (s^2 + 2 zeta w s + w^2), bilinear at the median step, started at rest on x[0]
     b, a = ss.bilinear([w * w], [1.0, 2.0 * zeta * w, w * w], fs=1.0 / dt)
     zi = ss.lfilter_zi(b, a)[:, None] * uniform[0][None, :]
     out, _ = ss.lfilter(b, a, uniform, axis=0, zi=zi)
-    return np.column_stack([np.interp(t, tu, out[:, k]) for k in range(x.shape[1])])
+    return out if regular else np.column_stack([np.interp(t, tu, out[:, k]) for k in range(x.shape[1])])
 
 
 @dataclass(frozen=True, eq=False)
@@ -162,8 +166,7 @@ def fit_resonance(times: Sequence[np.ndarray], efforts: Sequence[np.ndarray],
     blocks = [np.arange(len(t)) * FOLDS // max(len(t), 1) for t in times]
     resid = [np.asarray(y, float) - np.asarray(p, float) for y, p in zip(targets, efforts, strict=True)]
     # without modes: the plain prediction's squared error per block and joint (K, n)
-    none = np.array([[np.sum((y - p)[b == k] ** 2, axis=0) for k in range(FOLDS)]
-                     for y, p, b in zip(targets, plain, blocks, strict=True)]).reshape(-1, n)
+    none = np.vstack([_block_sums((y - p) ** 2, b) for y, p, b in zip(targets, plain, blocks, strict=True)])
     best_err, best = np.full(none.shape, np.inf), [None] * n
     for f0, zeta in grid:
         adds = [mode_response(t, p, f0, zeta) - p for t, p in zip(times, efforts, strict=True)]
@@ -171,10 +174,15 @@ def fit_resonance(times: Sequence[np.ndarray], efforts: Sequence[np.ndarray],
         for j in range(n):
             if err[:, j].sum() < best_err[:, j].sum():
                 best_err[:, j], best[j] = err[:, j], (f0, zeta)
+    # the model at the band alone, no mode: a mode must beat it as well, so that what is kept
+    # is a mode, not only the wider band (that is the prediction cut-off's choice)
+    wide = np.vstack([_block_sums(r * r, b) for r, b in zip(resid, blocks, strict=True)])
     f0s, zetas, gains = np.full(n, np.nan), np.full(n, np.nan), np.zeros(n)
     for j in range(n):
-        d = best_err[:, j] - none[:, j]  # paired block differences against no mode
-        if best[j] is None or (keep == "auto" and not d.sum() < -paired_se(d)):
+        # paired block differences against the plain prediction and against the band alone
+        d, dw = best_err[:, j] - none[:, j], best_err[:, j] - wide[:, j]
+        if best[j] is None or (keep == "auto" and not (d.sum() < -paired_se(d)
+                                                       and dw.sum() < -paired_se(dw))):
             best_err[:, j] = none[:, j]
             continue
         f0s[j], zetas[j] = best[j]
@@ -182,24 +190,33 @@ def fit_resonance(times: Sequence[np.ndarray], efforts: Sequence[np.ndarray],
                 for t, p in zip(times, efforts, strict=True)]
         a = np.concatenate([x[:, 0] for x in adds])
         r = np.concatenate([x[:, j] for x in resid])
-        gains[j] = float(a @ r / max(float(a @ a), 1e-300))  # least squares b_j
+        gains[j] = max(float(a @ r / max(float(a @ a), 1e-300)), 0.0)  # least squares b_j >= 0
+        if gains[j] == 0.0:
+            f0s[j] = zetas[j] = np.nan
+            best_err[:, j] = none[:, j]
     scores = {"none": 1.0, "resonance": float(np.sqrt(best_err.sum() / max(none.sum(), 1e-300)))}
     if not np.any(gains != 0.0):
         return None, scores
     return ResonanceFit(f0s, zetas, gains, float(band)), scores
 
 
+def _block_sums(x: np.ndarray, blocks: np.ndarray) -> np.ndarray:
+    """Column sums of ``x`` (N, n) over each of the FOLDS contiguous blocks, (FOLDS, n)."""
+    starts = np.searchsorted(blocks, np.arange(FOLDS))
+    out = np.add.reduceat(x, np.minimum(starts, len(x) - 1), axis=0)
+    out[np.bincount(blocks, minlength=FOLDS) == 0] = 0.0  # an empty block (a very short run)
+    return out
+
+
 def _cv_errors(adds: Sequence[np.ndarray], resid: Sequence[np.ndarray],
                blocks: Sequence[np.ndarray]) -> np.ndarray:
     """Held-out squared error of each block (K = FOLDS x R) and joint of ``r ~ b a`` (K, n)."""
-    aa = np.array([[np.sum(a[b == k] ** 2, axis=0) for k in range(FOLDS)]
-                   for a, b in zip(adds, blocks, strict=True)]).reshape(-1, adds[0].shape[1])
-    ar = np.array([[np.sum(a[b == k] * r[b == k], axis=0) for k in range(FOLDS)]
-                   for a, r, b in zip(adds, resid, blocks, strict=True)]).reshape(aa.shape)
-    rr = np.array([[np.sum(r[b == k] ** 2, axis=0) for k in range(FOLDS)]
-                   for r, b in zip(resid, blocks, strict=True)]).reshape(aa.shape)
-    # b of the other blocks: sum(a r) / sum(a a); held-out error sum (r - b a)^2
-    gain = (ar.sum(axis=0)[None, :] - ar) / np.maximum(aa.sum(axis=0)[None, :] - aa, 1e-300)
+    aa = np.vstack([_block_sums(a * a, b) for a, b in zip(adds, blocks, strict=True)])
+    ar = np.vstack([_block_sums(a * r, b) for a, r, b in zip(adds, resid, blocks, strict=True)])
+    rr = np.vstack([_block_sums(r * r, b) for r, b in zip(resid, blocks, strict=True)])
+    # b of the other blocks: sum(a r) / sum(a a), at least 0; held-out error sum (r - b a)^2
+    gain = np.maximum((ar.sum(axis=0)[None, :] - ar) / np.maximum(aa.sum(axis=0)[None, :] - aa, 1e-300),
+                      0.0)
     return rr - 2.0 * gain * ar + gain**2 * aa
 
 
@@ -216,8 +233,6 @@ def with_resonance(ident: Any, recordings: Sequence[Any], payloads: Sequence[Any
     target : {"tau", "current"}
     option : bool or "auto"
     """
-    from robodyn.identification.bandwidth import prediction_candidates
-
     fit_cut = ident.preprocess.cutoff
     if option is False or fit_cut is None:
         return ident
@@ -233,6 +248,9 @@ def with_resonance(ident: Any, recordings: Sequence[Any], payloads: Sequence[Any
         targets.append(np.asarray(target_signal(rec, target), float))
         plain.append(ident.effort(preprocess(rec, ident.prediction_settings, None), temp, pay))
     fit, scores = fit_resonance(times, efforts, targets, plain, band, option)
-    choices = replace(ident.choices, resonance=fit is not None,
-                      resonance_scores=tuple(scores.items())) if ident.choices is not None else None
+    modes = () if fit is None else tuple(
+        (ident.robot.joint_names[j], float(fit.f0[j]), float(fit.zeta[j]), float(fit.gain[j]))
+        for j in np.flatnonzero(fit.kept))
+    choices = replace(ident.choices, resonance=fit is not None, resonance_scores=tuple(scores.items()),
+                      resonance_modes=modes) if ident.choices is not None else None
     return replace(ident, resonance_fit=fit, choices=choices)
