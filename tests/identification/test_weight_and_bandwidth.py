@@ -63,9 +63,9 @@ def fast_run():
 
 def test_auto_prediction_cutoff_widens_to_the_motion_and_predicts_it_better(fast_run):
     robot, model, rec, tau = fast_run
-    fit = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False,
+    fit = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False, resonance=False,
                       friction="linear")
-    auto = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False,
+    auto = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False, resonance=False,
                        friction="linear", prediction_cutoff="auto")
     assert fit.choices.prediction_cutoff is None and fit.prediction is None
     # the motion reaches 6 Hz: the chosen cut-off is wider than the fit's
@@ -78,7 +78,7 @@ def test_auto_prediction_cutoff_widens_to_the_motion_and_predicts_it_better(fast
     assert err[1] < 0.5 * err[0]
     np.testing.assert_array_equal(auto.standard, fit.standard)
     # a fixed cut-off is used as given
-    fixed = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False,
+    fixed = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False, resonance=False,
                         friction="linear", prediction_cutoff=9.0)
     assert fixed.prediction_settings.cutoff == 9.0 and fixed.preprocess.cutoff == 1.5
 
