@@ -95,7 +95,7 @@ def quintic(q0: Sequence[float], q1: Sequence[float], duration: float, *, dt: fl
     """
     a, b = _vectors(q0, q1)
     n = a.size
-    v0, v1, c0, c1 = (np.zeros(n) if v is None else _vector(v, n, name)
+    v0, v1, c0, c1 = (np.zeros(n) if v is None else finite_vector(v, n, name)
                       for v, name in ((qd0, "qd0"), (qd1, "qd1"), (qdd0, "qdd0"), (qdd1, "qdd1")))
     T = _positive(duration, "duration")
     h = b - a
@@ -358,7 +358,8 @@ def _positive(value: float, name: str) -> float:
     return v
 
 
-def _vector(v: Sequence[float], n: int, name: str) -> np.ndarray:
+def finite_vector(v: Sequence[float], n: int, name: str) -> np.ndarray:
+    """``v`` as a finite (n,) float array, or an :class:`InputError` naming ``name``."""
     arr = np.asarray(v, dtype=float)
     if arr.shape != (n,) or not np.all(np.isfinite(arr)):
         raise InputError(f"{name} must be a finite ({n},) array, got shape {arr.shape}")
@@ -369,7 +370,7 @@ def _vectors(q0: Sequence[float], q1: Sequence[float]) -> tuple[np.ndarray, np.n
     a = np.asarray(q0, dtype=float)
     if a.ndim != 1 or a.size == 0:
         raise InputError(f"q0 must be a 1-D array of joint values, got shape {a.shape}")
-    return _vector(a, a.size, "q0"), _vector(q1, a.size, "q1")
+    return finite_vector(a, a.size, "q0"), finite_vector(q1, a.size, "q1")
 
 
 def _limit_vector(v: float | Sequence[float], n: int, name: str) -> np.ndarray:
@@ -379,4 +380,5 @@ def _limit_vector(v: float | Sequence[float], n: int, name: str) -> np.ndarray:
     return arr
 
 
-__all__ = ["JointTrajectory", "cartesian_line", "concatenate", "quintic", "trapezoidal", "via_points"]
+__all__ = ["JointTrajectory", "cartesian_line", "concatenate", "finite_vector", "quintic", "trapezoidal",
+           "via_points"]

@@ -10,6 +10,7 @@ import numpy as np
 
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
+from robodyn.simulation.trajectory import finite_vector
 
 __all__ = ["DEFAULT_ACCELERATION", "DEFAULT_RANGE", "DEFAULT_VELOCITY", "ExcitationLimits",
            "excitation_limits"]
@@ -91,9 +92,9 @@ def excitation_limits(robot: Robot, *, lower: Sequence[float] | None = None,
     span = hi - lo
     lo, hi = lo + margin * span, hi - margin * span
     if lower is not None:
-        lo = _finite_vector(lower, n, "lower")
+        lo = finite_vector(lower, n, "excitation_limits: lower")
     if upper is not None:
-        hi = _finite_vector(upper, n, "upper")
+        hi = finite_vector(upper, n, "excitation_limits: upper")
     if np.any(hi <= lo):
         bad = int(np.argmax(hi <= lo))
         raise InputError(f"excitation_limits: joint {robot.joint_names[bad]!r}: upper limit "
@@ -114,12 +115,6 @@ def _frozen(a: np.ndarray) -> np.ndarray:
     a.flags.writeable = False
     return a
 
-
-def _finite_vector(v: Sequence[float], n: int, name: str) -> np.ndarray:
-    arr = np.asarray(v, dtype=float)
-    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-        raise InputError(f"excitation_limits: {name} must be a finite ({n},) array, got {v!r}")
-    return arr
 
 
 def _positive_vector(v: float | Sequence[float], n: int, name: str) -> np.ndarray:
