@@ -8,7 +8,7 @@ underwater_2r written out here), vectorised over the states. Both are timed in t
 compared for accuracy against a 4000-strip sum of the same integrand (the reference), with a
 0.3 m/s current so that the normal velocity changes sign inside the links (the hard case).
 Last, 10 s of the underwater two-link arm (every effect on, 0.3 m/s current) released from rest,
-RK4 at 1 ms: robodyn (``rd.simulate`` and ``Model.integrate``, generated C) against SciPy
+RK4 at 1 ms: robodyn (``rd.simulate`` and ``rd.rollout``, generated C) against SciPy
 ``solve_ivp`` (RK45) on a lambdified model: ``sympy.lambdify`` of robodyn's OWN symbolic M(q) and
 tau(q, qd, 0) (Lagrange form; the rhs solves M qdd = -h), the usual Python route, and against
 SciPy at its best, ``solve_ivp`` DOP853 over robodyn's compiled ``Model.state_derivative``
@@ -141,7 +141,7 @@ def solve_ivp_benchmark(repeats: int = REPEATS) -> dict[str, Any]:
     -------
     dict
         ``rows`` (label, ms min/median, max error, settings, ratio to ``rd.simulate`` and to
-        ``Model.integrate``), the two sweeps, robodyn's error, the reference's check.
+        ``rd.rollout``), the two sweeps, robodyn's error, the reference's check.
     """
     values = {"vc": float(CURRENT[0])}
     robot = rd.load("underwater_2r")
@@ -153,7 +153,7 @@ def solve_ivp_benchmark(repeats: int = REPEATS) -> dict[str, Any]:
     print("\n== 10 s of underwater_2r (every effect, 0.3 m/s current), from rest, output every 1 ms ==")
     # reference: RK4 at dt / 20 (4th order: ~1e5 times more accurate than at dt), checked
     # against SciPy DOP853 at rtol = atol = 1e-12 on the same compiled derivative
-    ref = np.asarray(model.integrate(x0, 20 * steps, dt / 20, "rk4")[0])[::20]
+    ref = np.asarray(rd.rollout(model, x0, rd.RolloutOptions(20 * steps, dt / 20))[0])[::20]
     dop = scipy_peer.solver(scipy_peer.compiled_rhs(model), "DOP853", x0, t_eval, 1e-12)
     check = float(np.abs(dop().y.T - ref).max())  # (its atol: 1e-14)
     run = rd.simulate(model, q0, None, 10.0, dt, "rk4")
@@ -164,10 +164,10 @@ def solve_ivp_benchmark(repeats: int = REPEATS) -> dict[str, Any]:
     lamb = lambdified_rhs(robot, values)
     t_lamb = time.perf_counter() - start
     target = scipy_peer.MATCH_FACTOR * err_rd
-    fns = {"robodyn Model.integrate": lambda: model.integrate(x0, steps, dt, "rk4"),
+    fns = {"robodyn rd.rollout": lambda: rd.rollout(model, x0, rd.RolloutOptions(steps, dt)),
            "robodyn rd.simulate": lambda: rd.simulate(model, q0, None, 10.0, dt, "rk4")}
-    errors = {"robodyn Model.integrate": err_rd, "robodyn rd.simulate": err_rd}
-    settings = {"robodyn Model.integrate": "RK4 at 1 ms in robodyn's generated C, one call",
+    errors = {"robodyn rd.rollout": err_rd, "robodyn rd.simulate": err_rd}
+    settings = {"robodyn rd.rollout": "RK4 at 1 ms in robodyn's generated C, one call",
                 "robodyn rd.simulate": "the same, plus qdd, energy and the Trajectory result"}
     sweeps = {}
     for label, rhs, method, text in (
@@ -187,12 +187,12 @@ def solve_ivp_benchmark(repeats: int = REPEATS) -> dict[str, Any]:
     times = timing.interleaved(fns, repeats)
     rows = [{"label": k, "ms": results.summary(v, 1e3, 2), "max_error": errors[k],
              "vs_simulate": results.ratio(v, times["robodyn rd.simulate"], 1),
-             "vs_integrate": results.ratio(v, times["robodyn Model.integrate"], 1),
+             "vs_rollout": results.ratio(v, times["robodyn rd.rollout"], 1),
              "settings": settings[k]} for k, v in times.items()]
-    print(f"{'':34s}{'min ms':>9s}{'median':>9s}{'max err':>10s}  / rd.simulate  / Model.integrate")
+    print(f"{'':34s}{'min ms':>9s}{'median':>9s}{'max err':>10s}  / rd.simulate  / rd.rollout")
     for r in rows:
         print(f"  {r['label']:32s}{r['ms']['min']:9.2f}{r['ms']['median']:9.2f}"
-              f"{r['max_error']:10.1e}  {r['vs_simulate']['min']:8.1f}x {r['vs_integrate']['min']:12.1f}x")
+              f"{r['max_error']:10.1e}  {r['vs_simulate']['min']:8.1f}x {r['vs_rollout']['min']:12.1f}x")
     for r in rows:
         print(f"  {r['label']}: {r['settings']}")
     return {"steps": steps, "dt": dt, "repeats": repeats, "robodyn_error": err_rd,

@@ -23,9 +23,9 @@ Prints (PUMA 560, 100,000 random states, ns per state):
      on 1 and 2 threads, and the mass matrix against ``crba`` called from Python (the no-op
      loop's own cost is measured). Results entries ``casadi`` and ``threads``.
   2. ``--only ensemble``: 1000 trolley double-pendulum trajectories of 5 s, RK4 at 1 ms: one
-     ``model.integrate`` call with x0 (1000, 6) on 1 and 2 threads, against 1000
+     ``rd.rollout`` call with x0 (1000, 6) on 1 and 2 threads, against 1000
      one-at-a-time calls, against the same ensemble with one parameter set per trajectory
-     (``compile_model(robot, runtime_parameters=True)``, ``integrate(..., parameters=(1000,
+     (``compile_model(robot, runtime_parameters=True)``, ``rollout(..., parameters=(1000,
      6))``), and against MuJoCo's ``rollout`` from the same 1000 initial states (its own RK4 at
      1 ms, contacts disabled) on 1 thread and on its 2-thread pool. Results entry ``ensemble``.
 
@@ -206,17 +206,18 @@ def bench_ensemble(quick: bool, results_path: Path | None, command: str) -> None
     states = _mujoco_states(mj, x0)
     datas = [mujoco.MjData(mj) for _ in range(2)]
     mj_states, _ = rollout.rollout(mj, datas[0], states, nstep=steps)
-    xs, _ = model.integrate(x0, steps, dt)
+    opts, opts2 = rd.RolloutOptions(steps, dt), rd.RolloutOptions(steps, dt, threads=2)
+    xs, _ = rd.rollout(model, x0, opts)
     agree = float(np.max(np.abs(mj_states[:, :, 1:4] - xs[:, 1:, :3])))
 
     def one_at_a_time() -> None:
         for x in x0:
-            model.integrate(x, steps, dt)
+            rd.rollout(model, x, opts)
 
-    fns = {"robodyn ensemble": lambda: model.integrate(x0, steps, dt),
-           "robodyn ensemble 2 threads": lambda: model.integrate(x0, steps, dt, threads=2),
+    fns = {"robodyn ensemble": lambda: rd.rollout(model, x0, opts),
+           "robodyn ensemble 2 threads": lambda: rd.rollout(model, x0, opts2),
            "robodyn one call each": one_at_a_time,
-           "robodyn parameter sets": lambda: runtime.integrate(x0, steps, dt, parameters=sets),
+           "robodyn parameter sets": lambda: rd.rollout(runtime, x0, opts, parameters=sets),
            "MuJoCo rollout": lambda: rollout.rollout(mj, datas[0], states, nstep=steps),
            "MuJoCo rollout 2 threads": lambda: rollout.rollout(mj, datas, states, nstep=steps)}
     times = timing.interleaved(fns, repeats)
@@ -232,7 +233,7 @@ def bench_ensemble(quick: bool, results_path: Path | None, command: str) -> None
         "load_average_at_start": start_load, "rows": rows,
         "mujoco_agreement_rad": agree, "mujoco_model": source, "command": command,
         "peers": {
-            "robodyn": "Model.integrate: RK4 at 1 ms in generated C, x0 (N, 6), one call for the "
+            "robodyn": "rd.rollout: RK4 at 1 ms in generated C, x0 (N, 6), one call for the "
                        "ensemble (threads=1, or threads=2 with OpenMP); 'one call each': N calls "
                        "with one x0; 'parameter sets': compile_model(runtime_parameters=True), "
                        "one set of the 6 parameters per trajectory (x0.8-1.2)",

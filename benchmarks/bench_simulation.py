@@ -155,7 +155,7 @@ def bench_trolley(quick: bool) -> dict[str, Any]:
     -------
     dict
         ``rows`` (label, ms min/median, max error against the reference, settings), ratios to
-        ``Model.integrate``, the two SciPy sweeps, robodyn's error and the reference's check.
+        ``rd.rollout``, the two SciPy sweeps, robodyn's error and the reference's check.
     """
     robot = rd.load("trolley_double_pendulum")
     model = rd.compile_model(robot)
@@ -166,8 +166,9 @@ def bench_trolley(quick: bool) -> dict[str, Any]:
     print("== 1. Trolley + double inverted pendulum (thesis Fig. 3.1), 5 s, RK4 at 1 ms ==")
     # reference: DOP853 at rtol = atol = 1e-13 on the compiled model, checked against RK4 at dt / 20
     ref = rd.simulate(model, q0, None, 5.0, dt, "DOP853", rtol=1e-13, atol=1e-13).x
-    check = float(np.max(np.abs(model.integrate(x0, 20 * steps, dt / 20, "rk4")[0][::20] - ref)))
-    err_rd = float(np.max(np.abs(model.integrate(x0, steps, dt, "rk4")[0] - ref)))
+    fine = rd.rollout(model, x0, rd.RolloutOptions(20 * steps, dt / 20))[0][::20]
+    check = float(np.max(np.abs(fine - ref)))
+    err_rd = float(np.max(np.abs(rd.rollout(model, x0, rd.RolloutOptions(steps, dt))[0] - ref)))
     print(f"reference: DOP853 rtol = atol = 1e-13 (compiled model); RK4 at {dt / 20:g} s differs "
           f"by {check:.1e}; robodyn RK4 at 1 ms: max |x - x_ref| over 5 s = {err_rd:.1e} "
           "(chaotic motion: errors grow with time)")
@@ -181,9 +182,9 @@ def bench_trolley(quick: bool) -> dict[str, Any]:
                                                 target)
         sweeps[label]["run"] = (rhs, *scipy_peer.timed_setting(trials, matched))
     fns, mj_x, source = _mujoco_trolley(robot, q0, steps)
-    fns = {"robodyn Model.integrate": lambda: model.integrate(x0, steps, dt, "rk4"),
+    fns = {"robodyn rd.rollout": lambda: rd.rollout(model, x0, rd.RolloutOptions(steps, dt)),
            "robodyn rd.simulate": lambda: rd.simulate(model, q0, None, 5.0, dt, "rk4"), **fns}
-    errors = {"robodyn Model.integrate": err_rd, "robodyn rd.simulate": err_rd,
+    errors = {"robodyn rd.rollout": err_rd, "robodyn rd.simulate": err_rd,
               "MuJoCo mj_step loop": float(np.max(np.abs(mj_x - ref[1:])))}
     errors["MuJoCo rollout"] = errors["MuJoCo mj_step loop"]
     for label, s in sweeps.items():
@@ -207,11 +208,11 @@ def bench_trolley(quick: bool) -> dict[str, Any]:
 
 def _trolley_rows(times: dict[str, list[float]], errors: dict[str, float],
                   sweeps: dict[str, dict[str, Any]], source: str) -> list[dict[str, Any]]:
-    """Rows of the trolley entry: times, errors, ratio to ``Model.integrate``, what differs."""
+    """Rows of the trolley entry: times, errors, ratio to ``rd.rollout``, what differs."""
     import mujoco
 
     settings = {
-        "robodyn Model.integrate": "RK4 at 1 ms in robodyn's generated C, one call, the state "
+        "robodyn rd.rollout": "RK4 at 1 ms in robodyn's generated C, one call, the state "
                                    "and torque recorded every step",
         "robodyn rd.simulate": "the same call, plus qdd, energy and the Trajectory result",
         "MuJoCo mj_step loop": f"MuJoCo {mujoco.__version__}: its RK4 at 1 ms, contacts disabled, "
@@ -229,22 +230,22 @@ def _trolley_rows(times: dict[str, list[float]], errors: dict[str, float],
         trial = scipy_peer.Trial(**s["timed"])
         settings[f"SciPy {label}"] = (
             f"{scipy_peer.describe(s['method'], trial, s['matched'] is not None)}: {rhs}")
-    base = times["robodyn Model.integrate"]
+    base = times["robodyn rd.rollout"]
     rows = []
     for name, t in times.items():
         rows.append({"label": name, "ms": results.summary(t, 1e3, 3),
-                     "max_error": errors[name], "vs_integrate": results.ratio(t, base, 1),
+                     "max_error": errors[name], "vs_rollout": results.ratio(t, base, 1),
                      "settings": settings[name]})
     return rows
 
 
 def _print_trolley(entry: dict[str, Any]) -> None:
-    """Print the trolley rows: ms min / median, error, ratio to ``Model.integrate``."""
-    print(f"{'':34s}{'min ms':>9s}{'median':>9s}{'max err':>10s}  time / Model.integrate")
+    """Print the trolley rows: ms min / median, error, ratio to ``rd.rollout``."""
+    print(f"{'':34s}{'min ms':>9s}{'median':>9s}{'max err':>10s}  time / rd.rollout")
     for r in entry["rows"]:
         print(f"  {r['label']:32s}{r['ms']['min']:9.3f}{r['ms']['median']:9.3f}"
-              f"{r['max_error']:10.1e}  {r['vs_integrate']['min']:7.1f}x "
-              f"({r['vs_integrate']['median']:.1f}x)")
+              f"{r['max_error']:10.1e}  {r['vs_rollout']['min']:7.1f}x "
+              f"({r['vs_rollout']['median']:.1f}x)")
     for r in entry["rows"]:
         print(f"  {r['label']}: {r['settings']}")
     print("thesis Table 3.1, CPU seconds for the same 5 s (1990s hardware, for the record only):")

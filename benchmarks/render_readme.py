@@ -211,8 +211,8 @@ def render_simulation(data: dict[str, Any]) -> str:
         f"differs from RK4 at 0.05 ms by {t['reference_vs_rk4_dt_over_20']:.1e}); the motion "
         f"is chaotic, so errors grow with time. Each SciPy route runs at the loosest tolerance "
         f"whose error is within {t['match_factor']:g}x robodyn's ({t['robodyn_error']:.1e}). "
-        "Ratio = the row's time / `Model.integrate`'s; targets judged on the minima."))
-    lines += [""] + _route_table(t["rows"], "vs_integrate", t["targets"], 3)
+        "Ratio = the row's time / `rd.rollout`'s; targets judged on the minima."))
+    lines += [""] + _route_table(t["rows"], "vs_rollout", t["targets"], 3)
     lines += [""] + rc.wrap(_sweeps_text(t["sweeps"]))
     p = e["puma"]
     lines += [""] + rc.wrap(

@@ -118,10 +118,10 @@ def test_simulation_rows_have_scipy_at_its_best_and_mujoco(sections):
     entry = _data(sections, "simulation")["benchmarks"]["simulation"]
     t = entry["trolley"]
     labels = {r["label"] for r in t["rows"]}
-    assert {"robodyn Model.integrate", "MuJoCo mj_step loop", "MuJoCo rollout",
+    assert {"robodyn rd.rollout", "MuJoCo mj_step loop", "MuJoCo rollout",
             "SciPy RK45 + lambdify", "SciPy DOP853 + compiled RHS"} <= labels
     assert t["sweeps"]["DOP853 + compiled RHS"]["rhs"] == "compiled RHS"
-    _check_routes(t["rows"], t["sweeps"], "vs_integrate", "robodyn Model.integrate")
+    _check_routes(t["rows"], t["sweeps"], "vs_rollout", "robodyn rd.rollout")
     assert entry["puma"]["rows"] and entry["compile"]["first_s"] > 0
 
 

@@ -98,3 +98,19 @@ def test_urdf_files_need_the_urdf_extra_and_nothing_else_does(monkeypatch, tmp_p
     assert str(urdf) in str(info.value)
     assert rd.load("puma560").dof == 6
     assert rd.load(str(LIBRARY / "planar_2r.yaml")).dof == 2
+
+
+def test_html_reports_need_the_report_extra(monkeypatch) -> None:
+    # Jinja2 (and markupsafe) is the `report` extra: without it a report is refused with the pip
+    # command when its module loads, while the library itself (no report) works as before
+    import importlib
+
+    import robodyn as rd
+
+    for name in [m for m in sys.modules if m.startswith("robodyn.report")]:
+        monkeypatch.delitem(sys.modules, name)
+    monkeypatch.setitem(sys.modules, "jinja2", None)  # import jinja2 now raises ImportError
+    with pytest.raises(MissingExtraError, match=r"pip install 'robodyn\[report\]'") as info:
+        importlib.import_module("robodyn.report.identification_report")
+    assert "an HTML report" in str(info.value)
+    assert rd.compile_model(rd.load("planar_2r"), backend="numpy").dof == 2

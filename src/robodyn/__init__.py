@@ -7,6 +7,7 @@ Public API::
     eom = rd.derive(robot, method="newton_euler")   # or "lagrange", "kane"
     model = rd.compile_model(robot)                  # generated C, loaded in-process
     model.inverse_dynamics(q, qd, qdd)               # (n,) or (N, n)
+    x, tau = rd.rollout(model, x0, rd.RolloutOptions(steps=1000, dt=1e-3))  # one C call
 """
 
 from __future__ import annotations
@@ -45,6 +46,9 @@ _EXPORTS = {
     "Trajectory": "robodyn.simulation",
     "SimulateOptions": "robodyn.simulation",
     "simulate": "robodyn.simulation",
+    "FeedbackLaw": "robodyn.simulation.rollouts",
+    "RolloutOptions": "robodyn.simulation.rollouts",
+    "rollout": "robodyn.simulation.rollouts",
     "sweep": "robodyn.studies.sweeps",
     "EquationsOfMotion": "robodyn.symbolic.eom",
     "derive": "robodyn.symbolic.eom",
@@ -60,6 +64,7 @@ if TYPE_CHECKING:  # static analysers see ordinary imports
     from robodyn.robot.load import builtin_names, load
     from robodyn.robot.model import Drive, Friction, Joint, Link, Robot
     from robodyn.simulation import Trajectory, simulate
+    from robodyn.simulation.rollouts import FeedbackLaw, RolloutOptions, rollout
     from robodyn.studies.excitation import excitation
     from robodyn.studies.sweeps import sweep
     from robodyn.symbolic.eom import EquationsOfMotion, derive
@@ -84,6 +89,7 @@ __all__ = [
     "Calibration",
     "Drive",
     "EquationsOfMotion",
+    "FeedbackLaw",
     "Identification",
     "IdentifyOptions",
     "Payload",
@@ -93,6 +99,7 @@ __all__ = [
     "Model",
     "Recording",
     "Robot",
+    "RolloutOptions",
     "SimulateOptions",
     "Trajectory",
     "Validation",
@@ -104,6 +111,7 @@ __all__ = [
     "identify",
     "load",
     "read_recording",
+    "rollout",
     "simulate",
     "sweep",
     "validate",

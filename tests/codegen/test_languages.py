@@ -231,7 +231,7 @@ def test_c_simulator_matches_compiled_model(bundle):
     table = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
     assert table.shape == (SIM_STEPS + 1, 1 + 2 * n)
     np.testing.assert_allclose(table[:, 0], SIM_DT * np.arange(SIM_STEPS + 1), rtol=0, atol=1e-15)
-    x_ref, _ = rd.compile_model(bundle.robot).integrate(x0, SIM_STEPS, SIM_DT)
+    x_ref, _ = rd.rollout(rd.compile_model(bundle.robot), x0, rd.RolloutOptions(SIM_STEPS, SIM_DT))
     err = _rel_error(table[:, 1:], x_ref)
     print(f"\nC simulator {bundle.name}: max relative difference {err:.2e} over {SIM_STEPS} RK4 steps")
     assert err <= REL

@@ -8,6 +8,8 @@ for any number of threads, and the NumPy backend's ensemble must agree with the 
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -41,10 +43,11 @@ def _close(a, b):
 @pytest.mark.parametrize("count", [1, 7, 16, 17, 37])
 def test_passive_ensemble_equals_separate_runs(trolley, method, count):
     x0 = _x0(trolley, count, seed=count)
-    xs, taus = trolley.integrate(x0, 400, 1e-3, method)
+    options = rd.RolloutOptions(400, 1e-3, method)
+    xs, taus = rd.rollout(trolley, x0, options)
     assert xs.shape == (count, 401, 2 * trolley.dof) and taus.shape == (count, 400, trolley.dof)
     for i in range(count):
-        x1, tau1 = trolley.integrate(x0[i], 400, 1e-3, method)
+        x1, tau1 = rd.rollout(trolley, x0[i], options)
         assert _close(xs[i], x1) and _close(taus[i], tau1)
         np.testing.assert_array_equal(xs[i], x1)  # the same bits, not only close
 
@@ -56,16 +59,16 @@ def test_controlled_ensemble_equals_separate_runs_on_any_thread_count(puma, mode
     t = dt * np.arange(steps)
     reference = np.hstack([0.3 * np.sin(np.outer(t, np.arange(1, n + 1))),
                            0.3 * np.cos(np.outer(t, np.arange(1, n + 1))) * np.arange(1, n + 1)])
-    kwargs = {"reference": reference, "gain": np.hstack([np.diag(np.full(n, 400.0)),
-                                                           np.diag(np.full(n, 40.0))]),
-              "feedforward": np.full((steps, n), 0.1), "integral_gain": np.full(n, 5.0),
-              "tau_limit": np.full(n, 150.0), "mode": mode}
+    law = rd.FeedbackLaw(mode, reference=reference, gain=np.hstack([np.diag(np.full(n, 400.0)),
+                                                                    np.diag(np.full(n, 40.0))]),
+                         feedforward=np.full((steps, n), 0.1), integral_gain=np.full(n, 5.0))
+    options = rd.RolloutOptions(steps, dt, tau_limit=np.full(n, 150.0))
     x0 = _x0(puma, 21, seed=4)
-    xs, taus = puma.integrate(x0, steps, dt, **kwargs)
+    xs, taus = rd.rollout(puma, x0, options, law)
     for i in range(len(x0)):
-        x1, tau1 = puma.integrate(x0[i], steps, dt, **kwargs)
+        x1, tau1 = rd.rollout(puma, x0[i], options, law)
         assert _close(xs[i], x1) and _close(taus[i], tau1)
-    xs2, taus2 = puma.integrate(x0, steps, dt, threads=2, **kwargs)
+    xs2, taus2 = rd.rollout(puma, x0, replace(options, threads=2), law)
     np.testing.assert_array_equal(xs2, xs)
     np.testing.assert_array_equal(taus2, taus)
 
@@ -74,22 +77,22 @@ def test_numpy_backend_ensemble_agrees_with_c():
     robot = rd.load("trolley_double_pendulum")
     c_model, np_model = rd.compile_model(robot), rd.compile_model(robot, backend="numpy")
     x0 = _x0(c_model, 3, seed=9)
-    xs_np, _ = np_model.integrate(x0, 50, 1e-3)
-    xs_c, _ = c_model.integrate(x0, 50, 1e-3)
+    xs_np, _ = rd.rollout(np_model, x0, rd.RolloutOptions(50, 1e-3))
+    xs_c, _ = rd.rollout(c_model, x0, rd.RolloutOptions(50, 1e-3))
     assert _close(xs_c, xs_np)
 
 
 def test_ensemble_bad_input_and_failed_trajectory(trolley):
     x0 = _x0(trolley, 4)
     with pytest.raises(ValueError, match=r"x0 must have shape \(4, 6\)"):
-        trolley.integrate(x0[:, :5], 10, 1e-3)
+        rd.rollout(trolley, x0[:, :5], rd.RolloutOptions(10, 1e-3))
     with pytest.raises(ValueError, match="sampled"):
-        trolley.integrate(x0, 10, 1e-3, control="continuous")
+        rd.rollout(trolley, x0, rd.RolloutOptions(10, 1e-3, control="continuous"))
     before = x0.copy()
     bad = x0.copy()
     bad[2, 3:] = 1e200  # velocities that overflow in the first steps
     with pytest.raises(SimulationError, match="1 of 4 trajectories.*trajectory 2") as info:
-        trolley.integrate(bad, 10, 1e-3)
+        rd.rollout(trolley, bad, rd.RolloutOptions(10, 1e-3))
     assert info.value.trajectory == 2
-    trolley.integrate(x0, 10, 1e-3)
+    rd.rollout(trolley, x0, rd.RolloutOptions(10, 1e-3))
     np.testing.assert_array_equal(x0, before)

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
+import robodyn as rd
 from robodyn.codegen.c_simulation import simulation_source
 from robodyn.codegen.fixed_step import RK4, law, semi_implicit_step
 from robodyn.simulation import LQR, PD, PID, ComputedTorque, GravityCompensation, quintic
@@ -100,8 +101,7 @@ def test_each_controller_law_equals_the_generated_c_law(planar):
     x0 = np.array([-0.3, 0.1, 0.2, -0.4])
     t = np.array([0.25])
     for ctrl in _controllers(planar):
-        inputs = ctrl.sampled(planar, t)
-        _, tau = planar.integrate(x0, 1, 0.01, "rk4", **inputs)
+        _, tau = rd.rollout(planar, x0, rd.RolloutOptions(1, 0.01, "rk4"), ctrl.sampled(planar, t))
         z = 0.01 * ctrl.position_error(0.25, x0[:2]) if ctrl.has_integral else None
         got = ctrl.law(planar, 0.25, x0, z)
         np.testing.assert_allclose(got, tau[0], rtol=1e-12, atol=1e-12, err_msg=ctrl.name)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import robodyn as rd
 from robodyn.robot.errors import SimulationError
 from robodyn.simulation import PD, PID, ComputedTorque, quintic, simulate
 from robodyn.simulation import simulation as sim_mod
@@ -63,9 +64,9 @@ def test_a_run_split_into_pieces_equals_one_piece(planar, monkeypatch, control):
             np.testing.assert_allclose(run.tau, ref.tau[::dec], rtol=0, atol=1e-9, err_msg=c.name)
 
 
-def test_integrate_refuses_an_output_it_cannot_hold(planar):
+def test_rollout_refuses_an_output_it_cannot_hold(planar):
     with pytest.raises(ValueError, match="split the run into several calls"):
-        planar.integrate(np.zeros(4), 10**12, 1e-3)
+        rd.rollout(planar, np.zeros(4), rd.RolloutOptions(10**12, 1e-3))
 
 
 def test_a_run_that_blows_up_is_a_simulation_error(planar):

@@ -108,11 +108,12 @@ def test_ensemble_with_parameter_sets_equals_separate_models(runtime, folded, me
     x0 = np.hstack([q, 0.3 * qd])
     which = np.arange(count) % 3
     gain = np.hstack([np.diag([-5.0, 40.0, 40.0]), np.diag([-2.0, 5.0, 5.0])])
-    xs, taus = runtime.integrate(x0, 300, 1e-3, method, gain=gain, mode="gravity",
-                                 parameters=SETS[which], threads=2)
+    law = rd.FeedbackLaw("gravity", gain=gain)
+    xs, taus = rd.rollout(runtime, x0, rd.RolloutOptions(300, 1e-3, method, threads=2), law,
+                          SETS[which])
     for k in range(count):
         # a model-based law (gravity compensation) with each trajectory's own parameters
-        x_ref, tau_ref = folded[which[k]].integrate(x0[k], 300, 1e-3, method, gain=gain, mode="gravity")
+        x_ref, tau_ref = rd.rollout(folded[which[k]], x0[k], rd.RolloutOptions(300, 1e-3, method), law)
         assert _close(xs[k], x_ref)
         assert _close(taus[k], tau_ref)
 
@@ -121,8 +122,8 @@ def test_numpy_backend_ensemble_matches_c(robot, runtime):
     numpy_model = rd.compile_model(robot, "numpy", runtime_parameters=True)
     x0 = np.hstack(_states(runtime.dof, 4, seed=5)[:2])
     p = SETS[[0, 1, 2, 1]]
-    x_c, _ = runtime.integrate(x0, 40, 1e-3, parameters=p)
-    x_np, _ = numpy_model.integrate(x0, 40, 1e-3, parameters=p)
+    x_c, _ = rd.rollout(runtime, x0, rd.RolloutOptions(40, 1e-3), parameters=p)
+    x_np, _ = rd.rollout(numpy_model, x0, rd.RolloutOptions(40, 1e-3), parameters=p)
     assert _close(x_np, x_c)
 
 
@@ -159,12 +160,12 @@ def test_bad_parameter_input_is_named(robot, runtime):
     negative = np.tile(SETS[0], (2, 1))
     negative[1, 1] = -1.0
     with pytest.raises(DescriptionError, match="row 1"):
-        runtime.integrate(np.zeros((2, 2 * runtime.dof)), 5, 1e-3, parameters=negative)
+        rd.rollout(runtime, np.zeros((2, 2 * runtime.dof)), rd.RolloutOptions(5, 1e-3), parameters=negative)
     # one bad set among many (the vectorised screen finds it, the description's check names it)
     many = np.tile(SETS[1], (100, 1))
     many[57, 2] = -0.1
     with pytest.raises(DescriptionError, match=r"row 57.*mass of link .* is negative"):
-        runtime.integrate(np.zeros((100, 2 * runtime.dof)), 5, 1e-3, parameters=many)
+        rd.rollout(runtime, np.zeros((100, 2 * runtime.dof)), rd.RolloutOptions(5, 1e-3), parameters=many)
     folded_model = rd.compile_model(robot)
     with pytest.raises(ValueError, match="compiled with runtime parameters"):
         folded_model.gravity(q, parameters={"M": 1.0})
@@ -179,5 +180,5 @@ def test_user_input_not_modified(runtime):
     before = p.copy()
     q, qd, qdd = _states(runtime.dof, 5)
     runtime.inverse_dynamics(q, qd, qdd, parameters=p)
-    runtime.integrate(np.hstack([q, qd]), 3, 1e-3, parameters=p)
+    rd.rollout(runtime, np.hstack([q, qd]), rd.RolloutOptions(3, 1e-3), parameters=p)
     assert np.array_equal(p, before)

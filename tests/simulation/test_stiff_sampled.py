@@ -74,7 +74,7 @@ def test_the_zero_order_hold_loop_is_stable_and_one_rk4_step_is_not(exported):
     x0 = np.concatenate([[0.1, -0.1, 0.1, 0.1, -0.1, 0.1], np.zeros(n)])
 
     def rk4(x, tau):
-        return exported.integrate(x, 1, dt, feedforward=tau[None])[0][-1]
+        return rd.rollout(exported, x, rd.RolloutOptions(1, dt), rd.FeedbackLaw(feedforward=tau[None]))[0][-1]
 
     def exact(x, tau):
         sol = solve_ivp(lambda t, y: exported.state_derivative(y, tau), (0.0, dt), x,

@@ -157,8 +157,9 @@ def fit_resonance(times: Sequence[np.ndarray], efforts: Sequence[np.ndarray],
     Returns
     -------
     (ResonanceFit or None, dict of str to float)
-        The modes (None: no joint kept), and the relative held-out error of the residual
-        without (``"none"``, 1) and with the modes (``"resonance"``).
+        The modes (None: no joint kept), and the held-out error of the target relative to that
+        of the plain prediction: 1 without modes (``"none"``) and with the modes kept
+        (``"resonance"``), over the held-out time blocks of all joints.
     """
     rate = min(1.0 / float(np.median(np.diff(t))) for t in times)
     grid = _grid(rate)
@@ -168,12 +169,16 @@ def fit_resonance(times: Sequence[np.ndarray], efforts: Sequence[np.ndarray],
     # without modes: the plain prediction's squared error per block and joint (K, n)
     none = np.vstack([_block_sums((y - p) ** 2, b) for y, p, b in zip(targets, plain, blocks, strict=True)])
     best_err, best = np.full(none.shape, np.inf), [None] * n
+    # the best mode's addition per recording and joint, kept as it is found (not recomputed)
+    best_add = [np.zeros_like(p, dtype=float) for p in efforts]
     for f0, zeta in grid:
         adds = [mode_response(t, p, f0, zeta) - p for t, p in zip(times, efforts, strict=True)]
         err = _cv_errors(adds, resid, blocks)  # (K, n)
         for j in range(n):
             if err[:, j].sum() < best_err[:, j].sum():
                 best_err[:, j], best[j] = err[:, j], (f0, zeta)
+                for keep_add, a in zip(best_add, adds, strict=True):
+                    keep_add[:, j] = a[:, j]
     # the model at the band alone, no mode: a mode must beat it as well, so that what is kept
     # is a mode, not only the wider band (that is the prediction cut-off's choice)
     wide = np.vstack([_block_sums(r * r, b) for r, b in zip(resid, blocks, strict=True)])
@@ -186,9 +191,7 @@ def fit_resonance(times: Sequence[np.ndarray], efforts: Sequence[np.ndarray],
             best_err[:, j] = none[:, j]
             continue
         f0s[j], zetas[j] = best[j]
-        adds = [mode_response(t, p[:, j:j + 1], *best[j]) - p[:, j:j + 1]
-                for t, p in zip(times, efforts, strict=True)]
-        a = np.concatenate([x[:, 0] for x in adds])
+        a = np.concatenate([x[:, j] for x in best_add])
         r = np.concatenate([x[:, j] for x in resid])
         gains[j] = max(float(a @ r / max(float(a @ a), 1e-300)), 0.0)  # least squares b_j >= 0
         if gains[j] == 0.0:

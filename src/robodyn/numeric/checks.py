@@ -11,7 +11,8 @@ from robodyn.codegen.singular import structural_singularity, without_infinities
 from robodyn.robot.errors import InputError, SingularMassMatrixError
 from robodyn.robot.model import Robot
 
-__all__ = ["check_structure", "out_buffer", "structural_singularity", "without_infinities"]
+__all__ = ["check_structure", "out_buffer", "structural_singularity", "thread_count",
+           "without_infinities"]
 
 
 def out_buffer(out: np.ndarray, shape: tuple[int, ...], inputs: Sequence[np.ndarray],
@@ -38,3 +39,10 @@ def check_structure(robot: Robot, kset: KernelSet, values: Mapping[str, float]) 
         raise SingularMassMatrixError(message)
 
 
+
+
+def thread_count(threads: int) -> int:
+    """``threads`` checked: a positive integer."""
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise InputError(f"threads must be a positive integer, got {threads!r}")
+    return int(threads)

@@ -31,7 +31,12 @@ from robodyn.codegen.kernels import (
     kernel_signature,
 )
 from robodyn.codegen.python import PythonPrinter
-from robodyn.numeric.checks import out_buffer, structural_singularity, without_infinities
+from robodyn.numeric.checks import (
+    out_buffer,
+    structural_singularity,
+    thread_count,
+    without_infinities,
+)
 from robodyn.numeric.joint_corrections import link_positions
 from robodyn.numeric.model_cache import (
     _code_hash,
@@ -43,7 +48,6 @@ from robodyn.numeric.model_cache import (
     _write_checked,
     openmp_flags,
 )
-from robodyn.numeric.rollout import rollout, thread_count
 from robodyn.numeric.runtime_parameters import (
     ParameterValues,
     check_physics,
@@ -76,7 +80,8 @@ class Model:
         Named parameters that are kernel inputs rather than compiled constants
         (``compile_model(robot, runtime_parameters=...)``): every method then takes
         ``parameters=`` (one set, or one per state of a batch; see :data:`ParameterValues`), and
-        :meth:`integrate` one set per trajectory of an ensemble. Empty: all folded.
+        :func:`~robodyn.simulation.rollouts.rollout` one set per trajectory of an ensemble.
+        Empty: all folded.
     singular : str or None
         Why the mass matrix is singular in every configuration (a kinematics-only description,
         such as a calibration's), or None. Such a model still gives kinematics, inverse dynamics
@@ -372,21 +377,6 @@ class Model:
         """The regressor-derivative kernel, generated and loaded on first use (cached)."""
         return _compile_derivatives(self, REGRESSOR_DERIVATIVE_KERNEL_NAMES, "regderiv")
 
-    def integrate(self, x0: np.ndarray, steps: int, dt: float, method: str = "rk4", *,
-                  feedforward: np.ndarray | None = None, reference: np.ndarray | None = None,
-                  gain: np.ndarray | None = None, integral_gain: np.ndarray | None = None,
-                  mode: str = "feedback", tau_limit: np.ndarray | None = None,
-                  control: str = "sampled", threads: int = 1,
-                  parameters: ParameterValues = None) -> tuple[np.ndarray, np.ndarray]:
-        """Fixed-step trajectory under a state-feedback law, in one call: states
-        ``(steps + 1, 2 n)`` and torques ``(steps, n)`` (a leading N for an ensemble ``x0`` of
-        shape (N, 2 n)). The law, arguments and errors are those of
-        :func:`robodyn.numeric.rollout.rollout`, which this calls with the model.
-        """
-        return rollout(self, x0, steps, dt, method, feedforward=feedforward, reference=reference,
-                       gain=gain, integral_gain=integral_gain, mode=mode, tau_limit=tau_limit,
-                       control=control, threads=threads, parameters=parameters)
-
     # --- plumbing ------------------------------------------------------------------------------
     def parameter_input(self, value: ParameterValues, batch: tuple[int, ...] = (),
                         where: str = "parameters") -> np.ndarray:
@@ -480,8 +470,8 @@ def compile_model(robot: Robot, backend: Backend = "c", *,
         Named parameters (``robot.parameters``) that stay inputs of the generated kernels
         instead of being folded in as constants: True for all of them, or their names. Every
         method of the model then takes ``parameters=`` (one set, or one per state), and
-        :meth:`Model.integrate` / :func:`robodyn.simulation` one set per trajectory of an
-        ensemble, all in one C call. ``parameters`` gives their default values. The code is
+        :func:`robodyn.simulation.rollouts.rollout` and :func:`robodyn.simulate` one set per
+        trajectory of an ensemble, all in one C call. ``parameters`` gives their default values. The code is
         slower than with folded constants (no constant folding), and a state's bits may
         differ from a model compiled with the same values in the last places (other rounding
         order; the tests hold them to 1e-12 relative).
@@ -584,13 +574,6 @@ def _compile_derivatives(model: Model, names: tuple[str, ...] = DERIVATIVE_KERNE
         impl = _from_cache((path,), write_py,
                            lambda: _import_file(path, f"robodyn_generated_{tag}_{key}"))
     return Model(robot, backend, model.parameter_values, impl, runtime)
-
-
-def _thread_count(threads: int) -> int:
-    """``threads`` checked: a positive integer."""
-    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
-        raise InputError(f"threads must be a positive integer, got {threads!r}")
-    return int(threads)
 
 
 __all__ = ["Model", "compile_model"]

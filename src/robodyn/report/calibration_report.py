@@ -7,10 +7,9 @@ import math
 from pathlib import Path
 
 import numpy as np
-from markupsafe import Markup
 
 from robodyn.calibration.result import Calibration, ErrorStats
-from robodyn.report.html import figure, html_table, page, render
+from robodyn.report.html import Markup, figure, html_table, page, render
 from robodyn.studies.calibration_study import StudyResult
 
 __all__ = ["calibration_figure", "calibration_html", "study_section"]

@@ -16,7 +16,6 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 import sympy as sp
-from markupsafe import Markup
 
 from robodyn._version import __version__
 from robodyn.report.agreement import (
@@ -30,7 +29,7 @@ from robodyn.report.agreement import (
     derive_all,
     verdict,
 )
-from robodyn.report.html import html_table, render
+from robodyn.report.html import Markup, html_table, render
 from robodyn.report.simulation_sections import simulation_sections
 from robodyn.robot.load import load
 from robodyn.robot.model import Robot

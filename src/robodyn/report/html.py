@@ -16,13 +16,15 @@ from collections.abc import Sequence
 from functools import cache
 from pathlib import Path
 
-import jinja2
-from markupsafe import Markup
-
 from robodyn.robot.errors import InputError
+from robodyn.robot.optional import require
 from robodyn.text import is_number
 
-__all__ = ["CSS", "data_uri", "figure", "html_table", "page", "render", "render_macro"]
+# the ``report`` extra: every report module takes Jinja2 and Markup from here
+jinja2 = require("jinja2", "an HTML report")
+Markup = require("markupsafe", "an HTML report").Markup
+
+__all__ = ["CSS", "Markup", "data_uri", "figure", "html_table", "page", "render", "render_macro"]
 
 #: Media types of the figure files a report embeds, by suffix.
 _MEDIA_TYPES = {".png": "image/png", ".gif": "image/gif", ".svg": "image/svg+xml",

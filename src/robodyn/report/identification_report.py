@@ -13,9 +13,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from markupsafe import Markup
 
-from robodyn.report.html import figure, html_table, page, render, render_macro
+from robodyn.report.html import Markup, figure, html_table, page, render, render_macro
 from robodyn.validation.validation import Validation
 
 __all__ = ["KINOVA_CONTROLLER_GAINS", "combined_relative", "identification_html",

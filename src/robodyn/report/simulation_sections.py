@@ -6,11 +6,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from markupsafe import Markup
 
 from robodyn.codegen.emit import generate
 from robodyn.numeric.model import compile_model
-from robodyn.report.html import figure, render_macro
+from robodyn.report.html import Markup, figure, render_macro
 from robodyn.robot.load import load
 from robodyn.robot.model import Robot
 from robodyn.simulation.controllers import ComputedTorque

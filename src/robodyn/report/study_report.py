@@ -12,9 +12,8 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from markupsafe import Markup
 
-from robodyn.report.html import figure, html_table, render
+from robodyn.report.html import Markup, figure, html_table, render
 
 __all__ = ["result_columns", "study_figures", "study_section"]
 

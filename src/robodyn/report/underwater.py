@@ -22,10 +22,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from markupsafe import Markup
 from matplotlib.figure import Figure
 
-from robodyn.report.html import figure, html_table, page, render_macro
+from robodyn.report.html import Markup, figure, html_table, page, render_macro
 from robodyn.studies.underwater import EffectSeries
 from robodyn.studies.underwater_model_error import ModelErrorStudy
 from robodyn.studies.underwater_sensitivity import Sensitivity

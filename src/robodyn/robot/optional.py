@@ -19,6 +19,7 @@ EXTRAS: dict[str, str] = {
     "dask": "study", "distributed": "study", "cloudpickle": "study", "pyarrow": "study",
     "mcap": "ros", "mcap_ros2": "ros", "zstandard": "ros",
     "yourdfpy": "urdf",
+    "jinja2": "report", "markupsafe": "report",
 }
 
 

@@ -5,6 +5,7 @@ Public entry points::
     from robodyn.simulation import simulate, PD, quintic
     model = rd.compile_model(rd.load("puma560"))
     traj = simulate(model, q0, None, duration=2.0, dt=1e-3, controller=PD(100, 20, q_ref))
+    x, tau = rollout(model, x0, RolloutOptions(steps=2000, dt=1e-3))   # the bare integrator
 
 The AA300 design study and the double-pendulum balance are in
 :mod:`robodyn.studies.aa300` and :mod:`robodyn.studies.balance` (they import matplotlib).
@@ -15,6 +16,7 @@ from robodyn.simulation.energy import frame_origins, potential_energy
 from robodyn.simulation.ik import IKResult, UnreachableError, inverse_kinematics
 from robodyn.simulation.linearization import Linearization, linearize
 from robodyn.simulation.options import SimulateOptions
+from robodyn.simulation.rollouts import FeedbackLaw, RolloutOptions, rollout
 from robodyn.simulation.simulation import ADAPTIVE, FIXED_STEP, Trajectory, simulate
 from robodyn.simulation.trajectory import (
     JointTrajectory,
@@ -36,8 +38,10 @@ __all__ = [
     "PID",
     "ComputedTorque",
     "Controller",
+    "FeedbackLaw",
     "GravityCompensation",
     "Linearization",
+    "RolloutOptions",
     "Trajectory",
     "UnreachableError",
     "cartesian_line",
@@ -47,6 +51,7 @@ __all__ = [
     "linearize",
     "potential_energy",
     "quintic",
+    "rollout",
     "simulate",
     "trapezoidal",
     "via_points",

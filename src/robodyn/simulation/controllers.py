@@ -3,7 +3,7 @@
 Each controller is a frozen dataclass that can be used three ways:
 
 * by :func:`robodyn.simulation.simulate` with a fixed-step method: it translates itself into the
-  arrays of :meth:`Model.integrate <robodyn.numeric.model.Model.integrate>` (``sampled``), so the
+  law of :func:`robodyn.simulation.rollouts.rollout` (``sampled``: a :class:`FeedbackLaw`), so the
   whole run is one call into generated C, with the law held over each step;
 * by :func:`~robodyn.simulation.simulate` with a SciPy method: its continuous law ``law`` is
   evaluated inside the right-hand side (a PID's error integral becomes extra states);
@@ -30,6 +30,7 @@ from robodyn.codegen.fixed_step import law as sampled_law
 from robodyn.numeric.model import Model
 from robodyn.robot.errors import InputError
 from robodyn.simulation.linearization import Linearization, linearize
+from robodyn.simulation.rollouts import FeedbackLaw
 from robodyn.simulation.trajectory import JointTrajectory
 
 Reference = np.ndarray | JointTrajectory
@@ -47,9 +48,9 @@ class Controller:
         return type(self).__name__
 
     # --- to override ---------------------------------------------------------------------------
-    def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
-        """Keyword arguments of ``Model.integrate`` for steps starting at times ``t`` (steps,):
-        the law's inputs (:func:`robodyn.codegen.fixed_step.law`) and its ``mode``."""
+    def sampled(self, model: Model, t: np.ndarray) -> FeedbackLaw:
+        """The law of :func:`~robodyn.simulation.rollouts.rollout` for steps starting at times
+        ``t`` (steps,): its inputs per step (:func:`robodyn.codegen.fixed_step.law`) and mode."""
         raise NotImplementedError
 
     # --- shared --------------------------------------------------------------------------------
@@ -66,14 +67,14 @@ class Controller:
         x = np.asarray(x, dtype=float)
         n = x.size // 2
         inputs = self.sampled(model if model is not None else _Joints(n), np.array([float(t)]))
-        mode = _MODE[inputs["mode"]]
+        mode = _MODE[inputs.mode]
         z = np.zeros(n) if integral is None else np.asarray(integral, dtype=float)
         own = _need_model(self, model) if mode else None
         zero = np.zeros(n)
         terms = {"mass_matrix": lambda q, qd: own.mass_matrix(q),  # type: ignore[union-attr]
                  "bias": lambda q, qd: own.inverse_dynamics(q, qd, zero),  # type: ignore[union-attr]
                  "gravity": lambda q, qd: own.gravity(q)}  # type: ignore[union-attr]
-        return sampled_law({**inputs, "tau_limit": None}, 0, x, z, mode,
+        return sampled_law({**inputs.arrays(), "tau_limit": None}, 0, x, z, mode,
                            lambda name, q, qd: terms[name](q, qd))
 
     @property
@@ -206,8 +207,8 @@ class PD(_Tracking):
     q_ref: Reference
     tau_limit: np.ndarray | None = None
 
-    def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
-        return {**_pd_sampled(self.kp, self.kd, self.q_ref, model.dof, t), "mode": "feedback"}
+    def sampled(self, model: Model, t: np.ndarray) -> FeedbackLaw:
+        return FeedbackLaw("feedback", **_pd_sampled(self.kp, self.kd, self.q_ref, model.dof, t))
 
 
 @dataclass(frozen=True, eq=False)
@@ -255,9 +256,9 @@ class PID(_Tracking):
         x = np.concatenate([q, np.asarray(qd, dtype=float)])
         return self.clip(self.law(self.model, t, x, z))  # type: ignore[arg-type]
 
-    def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
-        return {**_pd_sampled(self.kp, self.kd, self.q_ref, model.dof, t), "mode": "feedback",
-                "integral_gain": self._ki(model.dof)}
+    def sampled(self, model: Model, t: np.ndarray) -> FeedbackLaw:
+        return FeedbackLaw("feedback", integral_gain=self._ki(model.dof),
+                           **_pd_sampled(self.kp, self.kd, self.q_ref, model.dof, t))
 
 
 @dataclass(frozen=True, eq=False)
@@ -275,8 +276,8 @@ class GravityCompensation(_Tracking):
     tau_limit: np.ndarray | None = None
     model: Model | None = field(default=None, repr=False)
 
-    def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
-        return {**_pd_sampled(self.kp, self.kd, self.q_ref, model.dof, t), "mode": "gravity"}
+    def sampled(self, model: Model, t: np.ndarray) -> FeedbackLaw:
+        return FeedbackLaw("gravity", **_pd_sampled(self.kp, self.kd, self.q_ref, model.dof, t))
 
 
 @dataclass(frozen=True, eq=False)
@@ -308,10 +309,10 @@ class ComputedTorque(_Tracking):
     model: Model | None = field(default=None, repr=False)
     _reference_field = "trajectory"
 
-    def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
+    def sampled(self, model: Model, t: np.ndarray) -> FeedbackLaw:
         _, _, qdd_r = _reference_at(self.trajectory, t, model.dof)
-        return {**_pd_sampled(self.kp, self.kd, self.trajectory, model.dof, t),
-                "feedforward": qdd_r, "mode": "computed_torque"}
+        return FeedbackLaw("computed_torque", feedforward=qdd_r,
+                           **_pd_sampled(self.kp, self.kd, self.trajectory, model.dof, t))
 
 
 @dataclass(frozen=True, eq=False)
@@ -416,12 +417,12 @@ class LQR(Controller):
     def _ref(self) -> Reference:
         return self.x_eq[: self.u_eq.size]
 
-    def sampled(self, model: Model, t: np.ndarray) -> dict[str, Any]:
+    def sampled(self, model: Model, t: np.ndarray) -> FeedbackLaw:
         steps, n = t.size, model.dof
         if self.u_eq.size != n:
             raise InputError(f"LQR was built for {self.u_eq.size} joints, the model has {n}")
-        return {"feedforward": np.tile(self.u_eq, (steps, 1)), "reference": np.tile(self.x_eq, (steps, 1)),
-                "gain": np.array(self.K), "mode": "feedback"}
+        return FeedbackLaw("feedback", feedforward=np.tile(self.u_eq, (steps, 1)),
+                           reference=np.tile(self.x_eq, (steps, 1)), gain=np.array(self.K))
 
 
 def _need_model(ctrl: Controller, model: Model | None) -> Model:

@@ -8,15 +8,16 @@ methods; and the diagnosis of a run whose state stopped being finite.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from robodyn.codegen.fixed_step import RK4
 from robodyn.numeric.model import Model
-from robodyn.numeric.rollout import MAX_INTEGRATE_BYTES
 from robodyn.robot.errors import InputError, SimulationError
 from robodyn.simulation.controllers import Controller
+from robodyn.simulation.rollouts import MAX_INTEGRATE_BYTES, FeedbackLaw, RolloutOptions, rollout
 
 #: Steps per call into the generated integrator: long runs are integrated piece by piece so that
 #: memory is bounded by the kept samples, not by the number of steps.
@@ -65,15 +66,15 @@ def _fixed_step_c(model: Model, x0: np.ndarray, steps: int, dt: float, decimate:
         # continuous: the inputs sampled every dt/2, for the RK4 stages
         times = (0.5 * dt * np.arange(2 * k0, 2 * (k0 + m) + 1) if continuous
                  else dt * np.arange(k0, k0 + m))
-        kwargs = {} if controller is None else controller.sampled(model, times)
+        law = None if controller is None else controller.sampled(model, times)
         if integral and k0:
             # tau = Ki (z0 + z_piece) + ...: the earlier pieces' integral as feedforward
-            kwargs["feedforward"] = np.tile(kwargs["integral_gain"] * z, (times.size, 1))
-        xs, taus = model.integrate(x, m, dt, method, tau_limit=limit,
-                                   control="continuous" if continuous else "sampled", **kwargs)
+            law = replace(law, feedforward=np.tile(law.integral_gain * z, (times.size, 1)))
+        options = RolloutOptions(m, dt, method, "continuous" if continuous else "sampled", limit)
+        xs, taus = rollout(model, x, options, law)
         if integral and not continuous:
             # z += dt sum_k (q_ref(t_k) - q_k), as the C loop does
-            z = z + dt * np.sum(kwargs["reference"][:, :n] - xs[:-1, :n], axis=0)
+            z = z + dt * np.sum(law.reference[:, :n] - xs[:-1, :n], axis=0)
         # global step k is kept when k % decimate == 0
         first = -k0 % decimate
         x_out[(k0 + first) // decimate: (k0 + m) // decimate + 1] = xs[first::decimate]
@@ -129,9 +130,9 @@ def _fixed_step_batch(model: Model, x0: np.ndarray, steps: int, dt: float, decim
     for k0 in range(0, steps, chunk):
         m = min(chunk, steps - k0)
         times = dt * np.arange(k0, k0 + m)
-        kwargs = {} if controller is None else controller.sampled(model, times)
-        xs, taus = model.integrate(x, m, dt, method, tau_limit=limit, threads=threads,
-                                   parameters=rows, **kwargs)
+        law = None if controller is None else controller.sampled(model, times)
+        xs, taus = rollout(model, x, RolloutOptions(m, dt, method, tau_limit=limit, threads=threads),
+                           law, rows)
         # global step k is kept when k % decimate == 0
         first = -k0 % decimate
         x_out[:, (k0 + first) // decimate: (k0 + m) // decimate + 1] = xs[:, first::decimate]
@@ -146,7 +147,7 @@ def _fixed_step_batch(model: Model, x0: np.ndarray, steps: int, dt: float, decim
             last = np.zeros(n)
         elif integral:
             # z = dt sum_k (q_ref(t_k) - q_k) over the steps and the final sample
-            z = dt * np.sum(kwargs["reference"][:, :n] - xs[i, :-1, :n], axis=0)
+            z = dt * np.sum(law.reference[:, :n] - xs[i, :-1, :n], axis=0)
             z = z + dt * controller.position_error(t_end, x[i, :n])
             last = controller.law(_member_model(model, rows, i), t_end, x[i], z)
         else:
@@ -201,7 +202,8 @@ def _fixed_step_python(model: Model, x0: np.ndarray, steps: int, dt: float, deci
             # the torque held over the step (zero-order hold), the plant in substeps
             held = np.broadcast_to(tau, (substeps, n))
             try:
-                x = model.integrate(x, substeps, dt / substeps, method, feedforward=held)[0][-1]
+                x = rollout(model, x, RolloutOptions(substeps, dt / substeps, method),
+                            FeedbackLaw(feedforward=held))[0][-1]
             except SimulationError:
                 exc = SimulationError(f"the simulated state stopped being finite at step {k} "
                                       f"(t = {tk:g} s); reduce dt or check the inputs")

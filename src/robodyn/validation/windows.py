@@ -15,6 +15,7 @@ import numpy as np
 
 from robodyn.numeric.model import Model
 from robodyn.robot.errors import InputError
+from robodyn.simulation.rollouts import FeedbackLaw, RolloutOptions, rollout
 
 __all__ = ["WindowDrift", "simulate_windows"]
 
@@ -127,6 +128,7 @@ def simulate_windows(model: Model, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
         raise InputError(f"the recording ({t[-1] - t[0]:.4g} s) is shorter than one simulation "
                          f"window ({span:.4g} s)")
     n = model.dof
+    options = RolloutOptions(steps, dt, "rk4")
     starts, finals, rmss, vfinals, bases = [], [], [], [], []
     failed = 0
     t0 = t[0]
@@ -141,7 +143,7 @@ def simulate_windows(model: Model, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
         qd_end = _interp(grid[-1:], t, qd)[0]
         x0 = np.concatenate([q[i0], qd[i0]])
         try:
-            x, _ = model.integrate(x0, steps, dt, "rk4", feedforward=ff)
+            x, _ = rollout(model, x0, options, FeedbackLaw(feedforward=ff))
         except FloatingPointError:
             failed += 1
             x = np.full((steps + 1, 2 * n), np.nan)
