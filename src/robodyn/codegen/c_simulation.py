@@ -2,7 +2,7 @@
 state-feedback laws, one trajectory or an ensemble of trajectories a block at a time.
 
 Emitted beside the kernels by :class:`robodyn.codegen.c.CPrinter` (``rd_simulate``,
-``rd_simulate_ensemble``); called by :func:`robodyn.numeric.rollout.rollout`.
+``rd_simulate_ensemble``); called by :func:`robodyn.simulation.rollouts.rollout`.
 """
 
 from __future__ import annotations
