@@ -128,7 +128,10 @@ def test_identify_gains_set_the_drives_and_are_checked(files, tmp_path, capsys):
         puma = rd.load("puma560")
     k = np.array([10.0, 20.0, 30.0, 1.0, 2.0, 3.0])
     geared = _with_gains(puma, k)
-    np.testing.assert_allclose(drive_gains(geared), k, rtol=1e-12)
+    # magnitudes as given; the sense stays the drive's (PUMA joints 1 and 3: negative gear ratio)
+    sense = np.sign([float(j.drive.gear_ratio) for j in puma.joints])
+    assert sense.tolist() == [-1, 1, -1, 1, 1, 1]
+    np.testing.assert_allclose(drive_gains(geared), sense * k, rtol=1e-12)
     assert [j.drive.gear_ratio for j in geared.joints] == [j.drive.gear_ratio for j in puma.joints]
     assert geared.description_hash != puma.description_hash
     train, _ = files

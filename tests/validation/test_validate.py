@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import robodyn as rd
+from robodyn.measure.conversions import current_to_torque
 from robodyn.measure.filtering import lowpass
 from robodyn.validation import validate
 from tests.validation.helpers import SLIDER_MASS, puma_run, recording, slider
@@ -48,9 +49,14 @@ def test_torque_scaled_by_a_known_factor_gives_that_relative_error(puma):
 
 def test_current_target_uses_the_drive_gains(puma):
     robot, model, sim = puma
-    gains = np.array([abs(float(j.drive.gear_ratio)) * float(j.drive.torque_constant)
-                      for j in robot.joints])
-    rec = recording(t=sim.t, q=sim.q, qd=sim.qd, qdd=sim.qdd, current=sim.tau / gains,
+    ratio = np.array([float(j.drive.gear_ratio) for j in robot.joints])
+    kt = np.array([float(j.drive.torque_constant) for j in robot.joints])
+    assert np.any(ratio < 0)  # PUMA joints 1 and 3: motors turning against their joints
+    # the motor current that robodyn.measure's conversion turns back into the joint torque
+    current = sim.tau / (ratio * kt)
+    np.testing.assert_allclose(current_to_torque(current, ratio, kt), sim.tau, rtol=1e-12)
+    gains = ratio * kt
+    rec = recording(t=sim.t, q=sim.q, qd=sim.qd, qdd=sim.qdd, current=current,
                     joint_names=robot.joint_names)
     val = validate(robot, rec, target="current", model=model, window=0.25)
     assert val.target == "current" and val.unit == "A"

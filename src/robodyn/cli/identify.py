@@ -255,8 +255,9 @@ def _write_predictions(vals: Sequence[tuple[str, rd.Validation]], out: Path, not
 
 
 def _with_gains(robot: rd.Robot, gains: np.ndarray) -> rd.Robot:
-    """A copy of ``robot`` whose drives give ``gains`` N m/A: ``torque_constant = K / |gear_ratio|``
-    (gear ratio, hence the reflected rotor inertia, unchanged)."""
+    """A copy of ``robot`` whose drives give ``gains`` N m/A in magnitude: ``torque_constant =
+    K / |gear_ratio|`` (gear ratio, hence the reflected rotor inertia and the current's sense,
+    unchanged: the drive gain ``gear_ratio x torque_constant`` is ``sign(gear_ratio) K``)."""
     import dataclasses
 
     import sympy as sp
@@ -375,7 +376,8 @@ def _identify_parser(sub: argparse._SubParsersAction, fmt: type, robot_help: str
                         "(pseudo-inertia LMIs) (default: %(default)s)")
     p.add_argument("--gains", type=floats, metavar="K",
                    help="drive gains, joint torque per motor ampere (N m/A), one or one per joint, "
-                        "for --target current: fixed instead of absorbed per joint")
+                        "for --target current: fixed instead of absorbed per joint (magnitudes: a "
+                        "drive with a negative gear ratio keeps its reversed current)")
     p.add_argument("--payload-data", nargs="+", metavar="FILE",
                    help="recordings made with a known payload on the last link (with --payload): "
                         "for --target current they separate the drive gains from the inertia")

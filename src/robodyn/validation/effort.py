@@ -74,7 +74,12 @@ def _numeric(expr: object, values: Mapping[str, float], where: str) -> float:
 
 
 def drive_gains(robot: Robot, parameters: Mapping[str, float] | None = None) -> np.ndarray:
-    """Joint torque per motor ampere, ``|gear_ratio| * torque_constant`` per joint.
+    """Joint torque per motor ampere, ``gear_ratio * torque_constant`` per joint.
+
+    The gear ratio keeps its sign (the description's convention: motor angle / joint angle), so
+    a drive whose motor turns against its joint draws a current of the opposite sign to the
+    joint torque, as :func:`robodyn.measure.conversions.current_to_torque` and the virtual lab
+    have it.
 
     Parameters
     ----------
@@ -96,8 +101,8 @@ def drive_gains(robot: Robot, parameters: Mapping[str, float] | None = None) -> 
     gains = np.empty(robot.dof)
     for k, j in enumerate(robot.joints):
         where = f"{robot.source}: joints[{k}].drive"
-        # k_j = |N_j| * K_t,j
-        gains[k] = abs(_numeric(j.drive.gear_ratio, values, where)) * _numeric(
+        # k_j = N_j K_t,j (signed: the motor's sense)
+        gains[k] = _numeric(j.drive.gear_ratio, values, where) * _numeric(
             j.drive.torque_constant, values, where)
         if not np.isfinite(gains[k]) or gains[k] == 0:
             raise ValidationError(f"{where}: gear_ratio x torque_constant = {gains[k]:g}; a current "

@@ -189,7 +189,7 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
         ``compile_model(robot)`` when already at hand.
     gains : (n,) array_like, optional
         Joint torque per motor ampere for ``target="current"`` (default: ``ident.gains`` when
-        ``ident`` is given, else the robot's drives, ``|gear_ratio| * torque_constant``).
+        ``ident`` is given, else the robot's drives, ``gear_ratio * torque_constant``, signed).
     window : float or None
         Simulation window, s (None: no simulation check).
     cutoff : float, optional
