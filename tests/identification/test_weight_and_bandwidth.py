@@ -81,6 +81,24 @@ def test_auto_prediction_cutoff_widens_to_the_motion_and_predicts_it_better(fast
     fixed = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False, resonance=False,
                         friction="linear", prediction_cutoff=9.0)
     assert fixed.prediction_settings.cutoff == 9.0 and fixed.preprocess.cutoff == 1.5
+    # a cut-off given to predict alone: the same prediction as a fit whose band it is, closer to
+    # the noise-free torque than the fit's 1.5 Hz band, and the parameters untouched
+    np.testing.assert_array_equal(fit.predict(rec, cutoff=9.0), fixed.predict(rec))
+    wide = float(np.linalg.norm(fit.predict(rec, cutoff=9.0) - tau) / np.linalg.norm(tau))
+    assert wide < 0.5 * err[0]
+    np.testing.assert_array_equal(fit.predict(rec), fit.predict(rec, cutoff=None))
+
+
+@pytest.mark.parametrize("value, message", [("wide", "expected a frequency in Hz"),
+                                            (float("nan"), "expected a frequency in Hz"),
+                                            (-3.0, "must lie in"), (1e6, "must lie in")])
+def test_bad_predict_cutoff_is_refused(fast_run, value, message):
+    robot, model, rec, _ = fast_run
+    short = rec.slice(0.0, 2.0)
+    ident = rd.identify(robot, short, target="tau", model=model, ripple=False, resonance=False,
+                        friction="linear")
+    with pytest.raises(IdentificationError, match=f"prediction_cutoff: {message}"):
+        ident.predict(short, cutoff=value)
 
 
 @pytest.mark.parametrize("value, message", [("wide", "expected a frequency in Hz, 'auto' or 'fit'"),

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
+from robodyn.identification.bandwidth import check_prediction_cutoff
 from robodyn.identification.base import BaseRelations
 from robodyn.identification.choices import Choices
 from robodyn.identification.friction import FrictionFit, without_friction
@@ -18,6 +19,7 @@ from robodyn.identification.resonance import ResonanceFit
 from robodyn.identification.ripple import RippleFit
 from robodyn.identification.thermal import ThermalFit, temperatures
 from robodyn.numeric.model import Model
+from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
 
 __all__ = ["BaseParameters", "Identification"]
@@ -180,7 +182,7 @@ class Identification:
         """Whether the drive gains were identified from the data (a known-payload run)."""
         return self.gains_source == "payload"
 
-    def predict(self, recording: Any, payload: Any = None) -> np.ndarray:
+    def predict(self, recording: Any, payload: Any = None, cutoff: float | None = None) -> np.ndarray:
         """Predicted target at the recording's own samples.
 
         The raw recording is processed as the identification data were, by the same functions
@@ -197,17 +199,35 @@ class Identification:
             ``t`` (N,), ``q`` (N, n) in the robot's joint order.
         payload : Payload, optional
             A known payload on the last link during this recording; its torque is added.
+        cutoff : float, optional
+            The prediction cut-off for this recording, Hz, instead of
+            ``prediction_settings.cutoff`` (below its Nyquist frequency): for a recording that
+            moves more sharply than the identification data (docs/identification.md, "Limits").
+            The parameters and the drive modes are unchanged.
 
         Returns
         -------
         numpy.ndarray, shape (N, n)
             N m (N) for ``target="tau"``, A for ``target="current"``.
+
+        Raises
+        ------
+        IdentificationError
+            A recording that does not fit the robot, or ``cutoff`` outside (0, Nyquist).
         """
         from robodyn.identification.inputs import check_recording
 
         check_recording(self.robot, recording, 0, None)
+        settings = self.prediction_settings
+        if cutoff is not None:
+            if isinstance(cutoff, bool) or not isinstance(cutoff, int | float | np.floating) \
+                    or not np.isfinite(cutoff):
+                raise IdentificationError(f"prediction_cutoff: expected a frequency in Hz, got "
+                                          f"{cutoff!r}")
+            check_prediction_cutoff([recording], float(cutoff))
+            settings = replace(settings, cutoff=float(cutoff))
         temp = temperatures(recording, 0, self.robot.dof) if self.thermal_fit is not None else None
-        s = preprocess(recording, self.prediction_settings, None)
+        s = preprocess(recording, settings, None)
         plain = self.effort(s, temp, payload)
         if self.resonance_fit is None:
             return plain
