@@ -5,14 +5,16 @@ Measured in one run, on one thread:
 * the machine's **peak FP64 rate**: a C loop of 12 independent fused multiply-add chains on
   vectors of one register (8 doubles with AVX-512, else 4; GCC vector extensions),
   compiled with robodyn's own flags (``-O3 -march=native -ffp-contract=fast``): 2 flops per lane
-  per FMA; the best of several runs;
+  per FMA; the best of 25 rounds (5 with ``--quick``), as for every figure here (on a shared
+  machine the minimum over many rounds is the undisturbed time);
 * its **memory bandwidth**: the STREAM triad ``a = b + s c`` over three arrays of 64 MiB each
   (far beyond the caches), same flags, 24 bytes per element counted (write-allocate traffic not
   counted, as STREAM reports it); the best of several runs;
 * robodyn's **inverse dynamics** (PUMA 560 with its friction, numeric parameters, 100,000 random
   states, ``threads=1``): ns per state, min and median over rounds, and its operation count read
   from the generated program (``robodyn.symbolic.opcount.count_ops`` of the kernel's body and
-  outputs after robodyn's CSE: additions and multiplications), plus the sine and cosine of each
+  outputs after robodyn's CSE: additions and multiplications), written into one reused array
+  (``out=``: no allocation per call, as the peak loop has none), plus the sine and cosine of each
   angle the kernel takes, which the generated C evaluates by one branch-free polynomial per
   angle (``robodyn.codegen.c``'s ``sincos_block``: :data:`SINCOS_FLOPS` per angle, counted from
   its source; its compares and selects not counted);
@@ -115,8 +117,10 @@ def inverse_dynamics(count: int, repeat: int) -> dict:
     ops = count_ops([e for _, e in kernel.body]) + count_ops(list(kernel.outputs[0].entries))
     rng = np.random.default_rng(0)
     q, qd, qdd = (rng.uniform(-1, 1, (count, robot.dof)) for _ in range(3))
+    out = np.empty_like(q)  # the result written into one reused array, as the peak loop's
     model.inverse_dynamics(q[:64], qd[:64], qdd[:64])  # loaded, warm
-    t = timing.interleaved({"id": lambda: model.inverse_dynamics(q, qd, qdd, threads=1)}, repeat)["id"]
+    t = timing.interleaved({"id": lambda: model.inverse_dynamics(q, qd, qdd, threads=1, out=out)},
+                           repeat)["id"]
     return {"ns_per_state": results.summary(t, 1e9 / count, 2), "additions": ops.additions,
             "multiplications": ops.multiplications, "sincos_angles": len(_angles(kernel)),
             "sincos_flops_per_angle": SINCOS_FLOPS, "bytes_per_state": 8 * 4 * robot.dof,
@@ -128,7 +132,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="fewer states and repeats")
     results.add_options(parser)
     args = parser.parse_args()
-    repeat = 3 if args.quick else 7
+    repeat = 5 if args.quick else 25
     load_at_start = results.load_average()
     lib, width = _library()
     peak = peak_gflops(lib, width, repeat)

@@ -113,14 +113,18 @@ def robodyn_setup(robot: rd.Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarra
     tau_r, tau_f = rigid.inverse_dynamics(q, qd, qdd), model.inverse_dynamics(q, qd, qdd)
     for m, t in ((rigid, tau_r), (model, tau_f)):  # generated and compiled on first use
         m.forward_dynamics_derivatives(q[:1], qd[:1], t[:1])
+    # results into reused arrays (out=), as every peer writes into memory allocated once
+    o_id, o_fd = np.empty_like(q), np.empty_like(q)
+    o_d = np.empty(q.shape + (3 * q.shape[1],))
     fns = {
-        ("ID", "robodyn"): lambda: rigid.inverse_dynamics(q, qd, qdd),
-        ("FD", "robodyn"): lambda: rigid.forward_dynamics(q, qd, tau_r),
-        ("FD derivatives", "robodyn"): lambda: rigid.forward_dynamics_derivatives(q, qd, tau_r),
-        ("ID", "robodyn (friction)"): lambda: model.inverse_dynamics(q, qd, qdd),
-        ("FD", "robodyn (friction)"): lambda: model.forward_dynamics(q, qd, tau_f),
+        ("ID", "robodyn"): lambda: rigid.inverse_dynamics(q, qd, qdd, out=o_id),
+        ("FD", "robodyn"): lambda: rigid.forward_dynamics(q, qd, tau_r, out=o_fd),
+        ("FD derivatives", "robodyn"):
+            lambda: rigid.forward_dynamics_derivatives(q, qd, tau_r, out=o_d),
+        ("ID", "robodyn (friction)"): lambda: model.inverse_dynamics(q, qd, qdd, out=o_id),
+        ("FD", "robodyn (friction)"): lambda: model.forward_dynamics(q, qd, tau_f, out=o_fd),
         ("FD derivatives", "robodyn (friction)"):
-            lambda: model.forward_dynamics_derivatives(q, qd, tau_f),
+            lambda: model.forward_dynamics_derivatives(q, qd, tau_f, out=o_d),
     }
     d = np.concatenate(rigid.forward_dynamics_derivatives(q, qd, tau_r), axis=-1)
     return fns, {"tau": tau_r, "qdd": rigid.forward_dynamics(q, qd, tau_r), "d": d}
@@ -250,7 +254,8 @@ def peer_descriptions(version: str, wheel_version: str) -> dict[str, str]:
     """What each library row is and how it differs from the others."""
     return {
         "robodyn": f"robodyn {version}: generated C ({' '.join(CFLAGS)}), one call for all "
-                   "states, 1 thread, friction: none (a copy of the PUMA without friction)",
+                   "states into arrays allocated once (out=, as the peers' outputs), 1 thread, "
+                   "friction: none (a copy of the PUMA without friction)",
         "robodyn (friction)": "the same with the PUMA's viscous and Coulomb joint friction "
                               "(more work than the peers, which have none)",
         "pinocchio native": "pinocchio native -O3 -march=native, same flags, 1 thread, friction: "

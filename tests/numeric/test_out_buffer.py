@@ -64,3 +64,39 @@ def test_bad_out_is_refused(model):
     shared = np.empty(300)
     with pytest.raises(ValueError, match="overlaps an input"):
         model.regressor(shared[:10].reshape(5, 2), qd, qdd, out=shared)
+
+
+@pytest.mark.parametrize("count", [1, 17])
+def test_every_batch_kernel_writes_into_out(model, count):
+    """inverse_dynamics, forward_dynamics, state_derivative, mass_matrix, gravity and coriolis
+    take ``out=`` as the regressor does: the same bits as a fresh result, in the caller's
+    memory (the buffer starts as NaN: every entry is written)."""
+    q, qd, qdd = _states(count)
+    x = np.hstack([q, qd])
+    calls = {"inverse_dynamics": (q, qd, qdd), "forward_dynamics": (q, qd, qdd),
+             "state_derivative": (x, qdd), "mass_matrix": (q,), "gravity": (q,),
+             "coriolis": (q, qd)}
+    for name, args in calls.items():
+        fresh = getattr(model, name)(*args)
+        buf = np.full(fresh.size, np.nan)
+        got = getattr(model, name)(*args, out=buf)
+        assert np.shares_memory(got, buf), name
+        assert got.shape == fresh.shape, name
+        np.testing.assert_array_equal(got, fresh, err_msg=name)
+    with pytest.raises(ValueError, match=r"inverse_dynamics\(out=...\)"):
+        model.inverse_dynamics(q, qd, qdd, out=np.empty(q.size + 1))
+
+
+def test_derivatives_write_into_out():
+    """``out=`` of the two derivative kernels receives ``[d/dq | d/dqd (| d/dtau)]``: the returned
+    blocks are views into it, equal to a fresh call's."""
+    model = rd.compile_model(rd.load("planar_2r"))
+    q, qd, qdd = _states(17)
+    for name, width in (("inverse_dynamics_derivatives", 4), ("forward_dynamics_derivatives", 6)):
+        fresh = getattr(model, name)(q, qd, qdd)
+        buf = np.full((17, 2, width), np.nan)
+        got = getattr(model, name)(q, qd, qdd, out=buf)
+        for a, b in zip(got, fresh, strict=True):
+            assert np.shares_memory(a, buf), name
+            np.testing.assert_array_equal(a, b, err_msg=name)
+        assert np.array_equal(np.concatenate(got, axis=-1), buf), name

@@ -140,35 +140,40 @@ class Model:
 
     # --- public kernels ------------------------------------------------------------------------
     def inverse_dynamics(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, *,
-                         threads: int = 1,
-                         parameters: ParameterValues = None) -> np.ndarray:
+                         threads: int = 1, parameters: ParameterValues = None,
+                         out: np.ndarray | None = None) -> np.ndarray:
         """Joint torques ``tau = M qdd + C qd + g + friction``, shape like ``q`` (N m or N).
 
         ``threads``: threads of a batch call (every method takes it; the result bits do not
         depend on it; the NumPy backend uses one). ``parameters``: values of the
         :attr:`runtime_parameters` (every method takes it): a mapping, a sequence of N
         mappings or an array (P,) / (N, P) (one set, or one per state); None: the defaults.
+        ``out``: an array that receives the result (as for :meth:`regressor`; also taken by
+        :meth:`mass_matrix`, :meth:`gravity`, :meth:`coriolis`, :meth:`forward_dynamics` and
+        :meth:`state_derivative`): repeated batches reuse its memory instead of allocating and
+        first touching a new array.
         """
-        return self._call("inverse_dynamics", q, qd, qdd, threads=threads, parameters=parameters)
+        return self._call("inverse_dynamics", q, qd, qdd, threads=threads, parameters=parameters,
+                          out=out)
 
-    def mass_matrix(self, q: np.ndarray, *, threads: int = 1,
-                    parameters: ParameterValues = None) -> np.ndarray:
+    def mass_matrix(self, q: np.ndarray, *, threads: int = 1, parameters: ParameterValues = None,
+                    out: np.ndarray | None = None) -> np.ndarray:
         """Joint-space inertia (rotor inertia included), (n, n) or (N, n, n)."""
-        return self._call("mass_matrix", q, threads=threads, parameters=parameters)
+        return self._call("mass_matrix", q, threads=threads, parameters=parameters, out=out)
 
-    def gravity(self, q: np.ndarray, *, threads: int = 1,
-                parameters: ParameterValues = None) -> np.ndarray:
+    def gravity(self, q: np.ndarray, *, threads: int = 1, parameters: ParameterValues = None,
+                out: np.ndarray | None = None) -> np.ndarray:
         """Gravity load ``g(q)``: the torques that hold the arm still, shape like ``q``."""
-        return self._call("gravity", q, threads=threads, parameters=parameters)
+        return self._call("gravity", q, threads=threads, parameters=parameters, out=out)
 
     def coriolis(self, q: np.ndarray, qd: np.ndarray, *, threads: int = 1,
-                 parameters: ParameterValues = None) -> np.ndarray:
+                 parameters: ParameterValues = None, out: np.ndarray | None = None) -> np.ndarray:
         """Coriolis and centrifugal torques ``C(q, qd) qd``, shape like ``q``."""
-        return self._call("coriolis", q, qd, threads=threads, parameters=parameters)
+        return self._call("coriolis", q, qd, threads=threads, parameters=parameters, out=out)
 
     def forward_dynamics(self, q: np.ndarray, qd: np.ndarray, tau: np.ndarray, *,
-                         threads: int = 1,
-                         parameters: ParameterValues = None) -> np.ndarray:
+                         threads: int = 1, parameters: ParameterValues = None,
+                         out: np.ndarray | None = None) -> np.ndarray:
         """Joint accelerations ``qdd = M^-1 (tau - C qd - g - friction)``, shape like ``q``.
 
         Raises
@@ -177,11 +182,13 @@ class Model:
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
         self._require_dynamics()
-        qdd = self._call("forward_dynamics", q, qd, tau, threads=threads, parameters=parameters)
+        qdd = self._call("forward_dynamics", q, qd, tau, threads=threads, parameters=parameters,
+                         out=out)
         return self._nonsingular(qdd, q, parameters)
 
     def state_derivative(self, x: np.ndarray, tau: np.ndarray, *, threads: int = 1,
-                         parameters: ParameterValues = None) -> np.ndarray:
+                         parameters: ParameterValues = None,
+                         out: np.ndarray | None = None) -> np.ndarray:
         """``[qd, qdd]`` of the state ``x = [q, qd]``, (2 n,) or (N, 2 n).
 
         Raises
@@ -190,7 +197,8 @@ class Model:
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
         self._require_dynamics()
-        xd = self._call("state_derivative", x, tau, threads=threads, parameters=parameters)
+        xd = self._call("state_derivative", x, tau, threads=threads, parameters=parameters,
+                        out=out)
         return self._nonsingular(xd, np.asarray(x, dtype=float)[..., : self.dof], parameters)
 
     def check_mass_matrix(self, q: np.ndarray, parameters: ParameterValues = None) -> None:
@@ -282,6 +290,7 @@ class Model:
     def inverse_dynamics_derivatives(self, q: np.ndarray, qd: np.ndarray,
                                      qdd: np.ndarray, *, threads: int = 1,
                                      parameters: ParameterValues = None,
+                                     out: np.ndarray | None = None,
                                      ) -> tuple[np.ndarray, np.ndarray]:
         """Partial derivatives of the full inverse dynamics ``tau(q, qd, qdd)``.
 
@@ -296,6 +305,8 @@ class Model:
         ----------
         q, qd, qdd : (n,) or (N, n)
             Joint positions (rad, m), velocities, accelerations.
+        out : array of N n 2n float64, optional
+            Receives ``[dtau_dq | dtau_dqd]`` (as ``out=`` of :meth:`regressor`).
 
         Returns
         -------
@@ -304,13 +315,14 @@ class Model:
             one array.
         """
         d = self._derivative_model._call("inverse_dynamics_derivatives", q, qd, qdd, threads=threads,
-                                         parameters=parameters)
+                                         parameters=parameters, out=out)
         n = self.dof
         return d[..., :n], d[..., n:]
 
     def forward_dynamics_derivatives(self, q: np.ndarray, qd: np.ndarray,
                                      tau: np.ndarray, *, threads: int = 1,
                                      parameters: ParameterValues = None,
+                                     out: np.ndarray | None = None,
                                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Partial derivatives of the forward dynamics ``qdd = FD(q, qd, tau)``.
 
@@ -324,6 +336,9 @@ class Model:
         q, qd : (n,) or (N, n)
         tau : (n,) or (N, n)
             Joint torques (N m) or forces (N).
+        out : array of N n 3n float64, optional
+            Receives ``[dqdd_dq | dqdd_dqd | dqdd_dtau]`` (as ``out=`` of :meth:`regressor`):
+            repeated batches reuse its memory.
 
         Returns
         -------
@@ -337,7 +352,7 @@ class Model:
         """
         self._require_dynamics()
         d = self._derivative_model._call("forward_dynamics_derivatives", q, qd, tau, threads=threads,
-                                         parameters=parameters)
+                                         parameters=parameters, out=out)
         d = self._nonsingular(d, q, parameters)
         n = self.dof
         return d[..., :n], d[..., n:2 * n], d[..., 2 * n:]
