@@ -147,12 +147,20 @@ class IdentifyOptions:
             if not any(value is v for v in (False, True)) and value != "auto":
                 raise IdentificationError(f"{name}: expected False, True or 'auto', got {value!r}")
         pc = self.prediction_cutoff
-        if isinstance(pc, str) or isinstance(pc, bool) or not isinstance(pc, (int, float)):
+        if isinstance(pc, str):
             if pc not in ("auto", "fit"):
                 raise IdentificationError(f"prediction_cutoff: expected a frequency in Hz, 'auto' or "
                                           f"'fit', got {pc!r}")
-        elif not (np.isfinite(pc) and pc > 0):
-            raise IdentificationError(f"prediction_cutoff: expected a positive frequency in Hz, got {pc!r}")
+        else:
+            positive_frequency(pc, "prediction_cutoff")
+
+
+def positive_frequency(value: Any, name: str) -> float:
+    """``value`` as a finite positive frequency (Hz), or an error naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(value) and value > 0):
+        raise IdentificationError(f"{name}: expected a positive frequency in Hz, got {value!r}")
+    return float(value)
 
 
 def _choice(name: str, value: Any, choices: tuple[str, ...]) -> None:

@@ -80,12 +80,6 @@ def nominal_standard(robot: Robot) -> np.ndarray:
     return np.array([float(sp.sympify(v).xreplace(subs)) for v in parameter_values(robot)])
 
 
-def _description_gains(robot: Robot) -> np.ndarray:
-    subs = robot.defaults()
-    return np.array([abs(float(sp.sympify(j.drive.gear_ratio * j.drive.torque_constant).xreplace(subs)))
-                     for j in robot.joints])
-
-
 def _stack(samples: Sequence[Samples], y_full: Sequence[np.ndarray], columns: np.ndarray,
            gains: np.ndarray, loads: Sequence[np.ndarray],
            extra: Sequence[np.ndarray] | None = None

@@ -13,13 +13,12 @@ from robodyn.identification.bandwidth import check_prediction_cutoff
 from robodyn.identification.base import BaseRelations
 from robodyn.identification.choices import Choices
 from robodyn.identification.friction import FrictionFit, without_friction
-from robodyn.identification.options import IdentifyOptions
+from robodyn.identification.options import IdentifyOptions, positive_frequency
 from robodyn.identification.preprocess import Preprocess, prediction_rows, preprocess
 from robodyn.identification.resonance import ResonanceFit
 from robodyn.identification.ripple import RippleFit
 from robodyn.identification.thermal import ThermalFit, temperatures
 from robodyn.numeric.model import Model
-from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
 
 __all__ = ["BaseParameters", "Identification"]
@@ -220,12 +219,9 @@ class Identification:
         check_recording(self.robot, recording, 0, None)
         settings = self.prediction_settings
         if cutoff is not None:
-            if isinstance(cutoff, bool) or not isinstance(cutoff, int | float | np.floating) \
-                    or not np.isfinite(cutoff):
-                raise IdentificationError(f"prediction_cutoff: expected a frequency in Hz, got "
-                                          f"{cutoff!r}")
-            check_prediction_cutoff([recording], float(cutoff))
-            settings = replace(settings, cutoff=float(cutoff))
+            cut = positive_frequency(cutoff, "prediction_cutoff")
+            check_prediction_cutoff([recording], cut)
+            settings = replace(settings, cutoff=cut)
         temp = temperatures(recording, 0, self.robot.dof) if self.thermal_fit is not None else None
         s = preprocess(recording, settings, None)
         plain = self.effort(s, temp, payload)

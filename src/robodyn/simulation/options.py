@@ -15,7 +15,7 @@ import numpy as np
 
 from robodyn.robot.errors import InputError
 
-__all__ = ["ADAPTIVE", "FIXED_STEP", "MAX_SAMPLES", "SimulateOptions"]
+__all__ = ["ADAPTIVE", "FIXED_STEP", "MAX_SAMPLES", "SimulateOptions", "positive_int"]
 
 FIXED_STEP = ("rk4", "semi_implicit")
 ADAPTIVE = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
@@ -75,7 +75,7 @@ class SimulateOptions:
         if self.control == "continuous" and self.method == "semi_implicit":
             raise InputError("control='continuous' needs method='rk4' or a SciPy method (semi-implicit "
                              "Euler evaluates the law once per step: use control='sampled')")
-        if not _positive_int(self.substeps):
+        if not positive_int(self.substeps):
             raise InputError(f"simulate: substeps must be a positive integer, got {self.substeps!r}")
         if self.substeps > 1 and (self.control != "sampled" or self.method not in FIXED_STEP):
             raise InputError("simulate: substeps needs a fixed-step method and control='sampled' (a "
@@ -85,10 +85,11 @@ class SimulateOptions:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v) or v <= 0:
                 raise InputError(f"simulate: {name} must be a positive number, got {v!r}")
-        if self.max_samples is not None and not _positive_int(self.max_samples):
+        if self.max_samples is not None and not positive_int(self.max_samples):
             raise InputError(f"simulate: max_samples must be a positive integer or None, got "
                              f"{self.max_samples!r}")
 
 
-def _positive_int(v: Any) -> bool:
+def positive_int(v: Any) -> bool:
+    """Whether ``v`` is an integer (not a bool) of at least 1."""
     return not isinstance(v, bool) and isinstance(v, int | np.integer) and v >= 1

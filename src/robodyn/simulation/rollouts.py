@@ -35,6 +35,7 @@ from robodyn.numeric.integrate_numpy import integrate_numpy
 from robodyn.numeric.model import Model
 from robodyn.numeric.runtime_parameters import ParameterValues, check_physics
 from robodyn.robot.errors import InputError, SimulationError
+from robodyn.simulation.options import positive_int
 
 __all__ = ["MAX_INTEGRATE_BYTES", "FeedbackLaw", "RolloutOptions", "rollout"]
 
@@ -89,7 +90,7 @@ class RolloutOptions:
         if self.control == "continuous" and self.method != "rk4":
             raise InputError(f"control='continuous' needs method='rk4' ({self.method} evaluates the "
                              "law once per step: use control='sampled')")
-        if isinstance(self.steps, bool) or not isinstance(self.steps, int | np.integer) or self.steps < 1:
+        if not positive_int(self.steps):
             raise InputError(f"rollout: steps must be a positive integer, got {self.steps!r}")
         if isinstance(self.dt, bool) or not isinstance(self.dt, int | float | np.floating) \
                 or not math.isfinite(self.dt) or self.dt <= 0:
