@@ -2,7 +2,7 @@
 
 Prints (PUMA 560, 100,000 random states, ns per state):
   0. Against Pinocchio (issue 22; ``kernel_peers.py``): inverse dynamics, forward dynamics and
-     forward-dynamics derivatives on one thread, min and median of 7 rounds (the libraries take
+     forward-dynamics derivatives on one thread, min and median of 20 rounds (the libraries take
      turns in each round, so that load from other processes hits all alike), robodyn (without
      friction, like for like, and with the PUMA's friction) against Pinocchio's templates
      compiled natively with robodyn's compiler and flags (``native_peer.py``,
@@ -270,7 +270,8 @@ def bench_pinocchio(quick: bool, results_path: Path | None, command: str) -> Non
         warnings.simplefilter("ignore")
         robot = rd.load("puma560")
     pmodel, source = pinocchio_puma(robot)
-    count, repeats = (10_000, 3) if quick else (100_000, 7)
+    # many rounds: on a shared machine the minimum is the least disturbed one
+    count, repeats = (10_000, 3) if quick else (100_000, 20)
     entry = kernel_peers.measure(robot, pmodel, count, repeats)
     entry["pinocchio_model"] = f"{source}, with the PUMA's rotor inertia as armature"
     entry["command"] = command

@@ -5,7 +5,7 @@ Measured in one run, on one thread:
 * the machine's **peak FP64 rate**: a C loop of 12 independent fused multiply-add chains on
   vectors of one register (8 doubles with AVX-512, else 4; GCC vector extensions),
   compiled with robodyn's own flags (``-O3 -march=native -ffp-contract=fast``): 2 flops per lane
-  per FMA; the best of 25 rounds (5 with ``--quick``), as for every figure here (on a shared
+  per FMA; the best of 100 rounds (10 with ``--quick``), as for every figure here (on a shared
   machine the minimum over many rounds is the undisturbed time);
 * its **memory bandwidth**: the STREAM triad ``a = b + s c`` over three arrays of 64 MiB each
   (far beyond the caches), same flags, 24 bytes per element counted (write-allocate traffic not
@@ -132,7 +132,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="fewer states and repeats")
     results.add_options(parser)
     args = parser.parse_args()
-    repeat = 5 if args.quick else 25
+    repeat = 10 if args.quick else 100
     load_at_start = results.load_average()
     lib, width = _library()
     peak = peak_gflops(lib, width, repeat)
