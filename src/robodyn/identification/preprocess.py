@@ -45,7 +45,7 @@ from typing import Any, Literal
 import numpy as np
 
 from robodyn.identification.stacking import regressor_rows_of
-from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass
+from robodyn.measure.filtering import CHUNK_BYTES, bandwidth_cutoff, differentiate, lowpass
 from robodyn.robot.errors import IdentificationError
 
 __all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "DEAD_BAND", "MID_RATE", "Preprocess", "Samples",
@@ -271,6 +271,9 @@ def filtered_rows(t: np.ndarray, y: np.ndarray, settings: Preprocess, keep: int)
     # constant column, most of them structural zeros, is its own low-pass)
     varying = np.flatnonzero(np.ptp(flat, axis=0) > 0)
     out = flat[::keep].copy()
-    if varying.size:
-        out[:, varying] = lowpass(t, flat[:, varying], settings.cutoff, order=settings.order)[::keep]
+    # a few columns at a time: no copy of the whole varying matrix, no second one filtered
+    step = max(1, CHUNK_BYTES // (8 * count))
+    for a in range(0, varying.size, step):
+        cols = varying[a:a + step]
+        out[:, cols] = lowpass(t, flat[:, cols], settings.cutoff, order=settings.order)[::keep]
     return out.reshape((-1,) + y.shape[1:])

@@ -34,7 +34,7 @@ from scipy.interpolate import make_interp_spline
 
 from robodyn.robot.errors import RecordingError
 
-__all__ = ["METHODS", "bandwidth_cutoff", "differentiate", "is_uniform", "lowpass"]
+__all__ = ["CHUNK_BYTES", "METHODS", "bandwidth_cutoff", "differentiate", "is_uniform", "lowpass"]
 
 METHODS = ("butter", "savgol")
 _UNIFORM_RTOL = 1e-3  # relative spread of the sample period still treated as uniform
@@ -135,6 +135,32 @@ def _savgol_window(cutoff: float, fs: float, polyorder: int, n: int) -> int:
     return length
 
 
+#: Bytes of one column block's padded copy in :func:`_sosfiltfilt_columns`.
+CHUNK_BYTES = 2 << 20
+
+
+def _sosfiltfilt_columns(sos: np.ndarray, xu: np.ndarray, padlen: int) -> np.ndarray:
+    """``sosfiltfilt`` along axis 0 of ``xu`` (N,) or (N, c), a block of columns at a time.
+
+    Each block is filtered along the last axis of a copy that is contiguous in time (a strided
+    axis-0 filter of a wide array copies every column through a buffer: about 3x slower), and
+    the blocks are small (:data:`CHUNK_BYTES`): SciPy's temporaries (the padded copy, one per
+    pass) then stay in the cache and in memory the allocator reuses, where those of a whole
+    wide matrix (a regressor's hundreds of columns) are fresh pages every call, which the
+    kernel may first have to compact into huge pages (seconds on a fragmented machine). The
+    columns are independent: the result has the bits of one call on the whole matrix.
+    """
+    if xu.ndim == 1:
+        return signal.sosfiltfilt(sos, xu, padlen=padlen)
+    count, cols = xu.shape
+    out = np.empty((count, cols))
+    step = max(1, CHUNK_BYTES // (8 * (count + 2 * padlen)))
+    for a in range(0, cols, step):
+        block = np.ascontiguousarray(xu[:, a:a + step].T)
+        out[:, a:a + step] = signal.sosfiltfilt(sos, block, axis=-1, padlen=padlen).T
+    return out
+
+
 def _filter(tu: np.ndarray, xu: np.ndarray, cutoff: float, order: int, method: str,
             polyorder: int, derivs: int) -> list[np.ndarray]:
     """Filtered signal and its first ``derivs`` derivatives on the uniform grid."""
@@ -147,11 +173,7 @@ def _filter(tu: np.ndarray, xu: np.ndarray, cutoff: float, order: int, method: s
         sos = signal.butter(order, cutoff, btype="low", fs=fs, output="sos")
         # odd extension over ~3 filter time constants keeps value and slope at the ends
         padlen = min(xu.shape[0] - 1, int(3 * fs / cutoff) + 3 * (2 * sos.shape[0] + 1))
-        # along the last axis of a copy that is contiguous in time (a strided axis-0 filter of a
-        # wide array copies every column through a buffer: about 3x slower)
-        xt = np.ascontiguousarray(np.moveaxis(xu, 0, -1))
-        y = np.moveaxis(signal.sosfiltfilt(sos, xt, axis=-1, padlen=padlen), -1, 0)
-        out = [y]
+        out = [_sosfiltfilt_columns(sos, xu, padlen)]
         for _ in range(derivs):
             out.append(np.gradient(out[-1], dt, axis=0, edge_order=2))  # central differences
         return out
