@@ -185,26 +185,8 @@ def rollout(model: Model, x0: np.ndarray, options: RolloutOptions, law: Feedback
         raise InputError(f"rollout: {steps:,} steps of {n} joints need {size / 2**20:,.0f} MiB "
                          f"of output, above {MAX_INTEGRATE_BYTES / 2**20:,.0f} MiB; split the "
                          "run into several calls from the last state (simulate() does so)")
-    rows = 2 * steps + 1 if continuous else steps
-    arrays = {
-        "x0": (x0, (count, nx) if ensemble else (nx,)), "feedforward": (law.feedforward, (rows, n)),
-        "reference": (law.reference, (rows, nx)), "gain": (law.gain, (n, nx)),
-        "integral_gain": (law.integral_gain, (n,)), "tau_limit": (options.tau_limit, (n,)),
-    }
-    checked: dict[str, np.ndarray | None] = {}
-    for key, (val, shape) in arrays.items():
-        if val is None:
-            checked[key] = None
-            continue
-        arr = np.ascontiguousarray(val, dtype=np.float64)
-        if arr.shape != shape:
-            raise InputError(f"rollout: {key} must have shape {shape}, got {arr.shape}")
-        checked[key] = arr
-    checked["params"] = None
-    if model.runtime_parameters or parameters is not None:
-        checked["params"] = model.parameter_input(parameters, (count,) if ensemble else (), "rollout")
-        check_physics(model.robot, model.runtime_parameters, model.parameters, checked["params"],
-                      "rollout(parameters=...)")
+    checked = _checked_inputs(model, x0, options, law, parameters,
+                              (count,) if ensemble else ())
     method, mode = _METHODS[options.method], _MODES[law.mode]
     if ensemble:
         return _ensemble(model, checked, steps, dt, method, mode, threads)
@@ -232,6 +214,37 @@ def rollout(model: Model, x0: np.ndarray, options: RolloutOptions, law: Feedback
         exc.state = x_out[status - 1].copy()
         raise exc
     return x_out, tau_out
+
+
+def _checked_inputs(model: Model, x0: np.ndarray, options: RolloutOptions, law: FeedbackLaw,
+                    parameters: ParameterValues, batch: tuple[int, ...]
+                    ) -> dict[str, np.ndarray | None]:
+    """The integrator's arrays, C-contiguous float64, each of its expected shape (or None),
+    and ``"params"``: the runtime parameter values, one set or one per trajectory of ``batch``
+    (checked like compile-time values)."""
+    n, nx = model.dof, 2 * model.dof
+    steps = int(options.steps)
+    rows = 2 * steps + 1 if options.control == "continuous" else steps
+    arrays = {
+        "x0": (x0, batch + (nx,)), "feedforward": (law.feedforward, (rows, n)),
+        "reference": (law.reference, (rows, nx)), "gain": (law.gain, (n, nx)),
+        "integral_gain": (law.integral_gain, (n,)), "tau_limit": (options.tau_limit, (n,)),
+    }
+    checked: dict[str, np.ndarray | None] = {}
+    for key, (val, shape) in arrays.items():
+        if val is None:
+            checked[key] = None
+            continue
+        arr = np.ascontiguousarray(val, dtype=np.float64)
+        if arr.shape != shape:
+            raise InputError(f"rollout: {key} must have shape {shape}, got {arr.shape}")
+        checked[key] = arr
+    checked["params"] = None
+    if model.runtime_parameters or parameters is not None:
+        checked["params"] = model.parameter_input(parameters, batch, "rollout")
+        check_physics(model.robot, model.runtime_parameters, model.parameters, checked["params"],
+                      "rollout(parameters=...)")
+    return checked
 
 
 def _ensemble(model: Model, a: dict[str, np.ndarray | None], steps: int, dt: float,
