@@ -87,10 +87,9 @@ def test_every_batch_kernel_writes_into_out(model, count):
         model.inverse_dynamics(q, qd, qdd, out=np.empty(q.size + 1))
 
 
-def test_derivatives_write_into_out():
+def test_derivatives_write_into_out(model):
     """``out=`` of the two derivative kernels receives ``[d/dq | d/dqd (| d/dtau)]``: the returned
     blocks are views into it, equal to a fresh call's."""
-    model = rd.compile_model(rd.load("planar_2r"))
     q, qd, qdd = _states(17)
     for name, width in (("inverse_dynamics_derivatives", 4), ("forward_dynamics_derivatives", 6)):
         fresh = getattr(model, name)(q, qd, qdd)
