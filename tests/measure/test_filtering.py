@@ -112,3 +112,40 @@ def test_wide_matrix_is_filtered_a_block_of_columns_at_a_time_with_the_same_bits
     got = lowpass(t, x, cutoff)
     np.testing.assert_array_equal(got, whole)
     np.testing.assert_array_equal(lowpass(t, x[:, cols - 1], cutoff), whole[:, -1])
+
+
+@pytest.mark.parametrize("stamps", ["uniform", "irregular"])
+def test_lowpass_columns_gives_each_column_the_bits_of_lowpass(stamps):
+    """Chosen columns of a matrix wider than one block, filtered into a destination, every third
+    sample kept: each equals ``lowpass`` of that column alone; the other columns of the
+    destination and the input are untouched."""
+    from robodyn.measure.filtering import CHUNK_BYTES, lowpass_columns
+
+    rng = np.random.default_rng(4)
+    count, cutoff = 3000, 9.0
+    step = 1e-3 * (1 + 0.2 * rng.uniform(-1, 1, count)) if stamps == "irregular" else np.full(count, 1e-3)
+    t = np.cumsum(step)
+    cols = 2 * CHUNK_BYTES // (8 * count) + 9  # more than two blocks
+    x = rng.standard_normal((count, cols))
+    x.flags.writeable = False
+    chosen = np.arange(1, cols, 2)
+    out = np.full((-(-count // 3), cols), 7.0)
+    got = lowpass_columns(t, x, cutoff, chosen, out, keep=3)
+    assert got is out
+    for j in (chosen[0], chosen[len(chosen) // 2], chosen[-1]):
+        np.testing.assert_array_equal(out[:, j], lowpass(t, x[:, j], cutoff)[::3])
+    assert np.all(out[:, ::2] == 7.0)  # the columns not chosen are left as they are
+
+
+def test_lowpass_columns_errors_name_the_column_and_shape():
+    from robodyn.measure.filtering import lowpass_columns
+
+    t = np.arange(0.0, 1.0, 1e-3)
+    x = np.zeros((t.size, 4))
+    x[5, 2] = np.inf
+    with pytest.raises(RecordingError, match="non-finite value at row 5, column 2"):
+        lowpass_columns(t, x, 10.0, np.array([0, 2]), np.zeros_like(x))
+    with pytest.raises(RecordingError, match=r"out must have shape \(500, 4\)"):
+        lowpass_columns(t, x, 10.0, np.array([0]), np.zeros_like(x), keep=2)
+    with pytest.raises(RecordingError, match="cutoff: must be in"):
+        lowpass_columns(t, x, 600.0, np.array([0]), np.zeros_like(x))

@@ -45,7 +45,7 @@ from typing import Any, Literal
 import numpy as np
 
 from robodyn.identification.stacking import regressor_rows_of
-from robodyn.measure.filtering import CHUNK_BYTES, bandwidth_cutoff, differentiate, lowpass
+from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass, lowpass_columns
 from robodyn.robot.errors import IdentificationError
 
 __all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "DEAD_BAND", "MID_RATE", "Preprocess", "Samples",
@@ -270,10 +270,6 @@ def filtered_rows(t: np.ndarray, y: np.ndarray, settings: Preprocess, keep: int)
     # H Y: the same zero-phase low-pass as the target, along time, on the columns that vary (a
     # constant column, most of them structural zeros, is its own low-pass)
     varying = np.flatnonzero(np.ptp(flat, axis=0) > 0)
-    out = flat[::keep].copy()
-    # a few columns at a time: no copy of the whole varying matrix, no second one filtered
-    step = max(1, CHUNK_BYTES // (8 * count))
-    for a in range(0, varying.size, step):
-        cols = varying[a:a + step]
-        out[:, cols] = lowpass(t, flat[:, cols], settings.cutoff, order=settings.order)[::keep]
+    out = lowpass_columns(t, flat, settings.cutoff, varying, flat[::keep].copy(),
+                          order=settings.order, keep=keep)
     return out.reshape((-1,) + y.shape[1:])

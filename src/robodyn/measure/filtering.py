@@ -34,7 +34,8 @@ from scipy.interpolate import make_interp_spline
 
 from robodyn.robot.errors import RecordingError
 
-__all__ = ["CHUNK_BYTES", "METHODS", "bandwidth_cutoff", "differentiate", "is_uniform", "lowpass"]
+__all__ = ["CHUNK_BYTES", "METHODS", "bandwidth_cutoff", "differentiate", "is_uniform", "lowpass",
+           "lowpass_columns"]
 
 METHODS = ("butter", "savgol")
 _UNIFORM_RTOL = 1e-3  # relative spread of the sample period still treated as uniform
@@ -47,21 +48,34 @@ def is_uniform(t: np.ndarray, rtol: float = _UNIFORM_RTOL) -> bool:
     return bool(np.all(np.abs(dt - med) <= rtol * med))
 
 
-def _check(t: np.ndarray, x: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray]:
+def _check_stamps(t: np.ndarray, what: str) -> np.ndarray:
     t = np.asarray(t, dtype=float)
-    x = np.asarray(x, dtype=float)
     if t.ndim != 1 or t.size < 2:
         raise RecordingError(f"{what}: t must be a 1-D array of at least 2 times, got shape {t.shape}")
-    if x.ndim not in (1, 2) or x.shape[0] != t.size:
-        raise RecordingError(f"{what}: x must have shape (N,) or (N, n) with N = {t.size} (len(t)), "
-                             f"got {x.shape}")
     if not np.all(np.diff(t) > 0):
         k = int(np.argmin(np.diff(t) > 0)) + 1
         raise RecordingError(f"{what}: t not strictly increasing at row {k}")
+    return t
+
+
+def _check_finite(x: np.ndarray, what: str, columns: np.ndarray | None = None) -> None:
+    """Raise naming the first non-finite value of ``x`` (N,) or (N, c); ``columns`` (c,): the
+    column numbers the message gives for the columns of ``x``."""
     if not np.all(np.isfinite(x)):
         row, *col = np.argwhere(~np.isfinite(x))[0]
+        if col and columns is not None:
+            col = [columns[col[0]]]
         where = f"row {row}" + (f", column {col[0]}" if col else "")
         raise RecordingError(f"{what}: non-finite value at {where}")
+
+
+def _check(t: np.ndarray, x: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray]:
+    t = _check_stamps(t, what)
+    x = np.asarray(x, dtype=float)
+    if x.ndim not in (1, 2) or x.shape[0] != t.size:
+        raise RecordingError(f"{what}: x must have shape (N,) or (N, n) with N = {t.size} (len(t)), "
+                             f"got {x.shape}")
+    _check_finite(x, what)
     return t, x
 
 
@@ -106,10 +120,10 @@ def bandwidth_cutoff(t: np.ndarray, x: np.ndarray, snr: float = 100.0) -> float:
 UNIFORM_GROWTH = 10.0
 
 
-def _uniform(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
-    """``(t_u, x_u, resampled)``: x on a uniform grid at the median period (cubic)."""
+def _grid(t: np.ndarray) -> tuple[np.ndarray, bool]:
+    """``(t_u, resampled)``: ``t`` itself when uniform, else a uniform grid at its median period."""
     if is_uniform(t):
-        return t, x, False
+        return t, False
     steps = np.diff(t)
     dt = float(np.median(steps))
     count = (t[-1] - t[0]) / dt + 1.0
@@ -120,8 +134,13 @@ def _uniform(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool
                              f"would need {count:.3g} samples on the uniform grid that filtering "
                              f"uses, for {t.size} samples recorded; check that time stamp, or split "
                              "the recording at the gap (Recording.slice)")
-    tu = t[0] + dt * np.arange(int(np.floor((t[-1] - t[0]) / dt + 1e-9)) + 1)
-    return tu, make_interp_spline(t, x, k=3, axis=0)(tu), True
+    return t[0] + dt * np.arange(int(np.floor((t[-1] - t[0]) / dt + 1e-9)) + 1), True
+
+
+def _uniform(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
+    """``(t_u, x_u, resampled)``: x on a uniform grid at the median period (cubic)."""
+    tu, resampled = _grid(t)
+    return tu, (make_interp_spline(t, x, k=3, axis=0)(tu) if resampled else x), resampled
 
 
 def _savgol_window(cutoff: float, fs: float, polyorder: int, n: int) -> int:
@@ -139,12 +158,22 @@ def _savgol_window(cutoff: float, fs: float, polyorder: int, n: int) -> int:
 CHUNK_BYTES = 2 << 20
 
 
+def _filtfilt_block(sos: np.ndarray, block: np.ndarray, padlen: int) -> np.ndarray:
+    """``sosfiltfilt`` of ``block`` (N, c) along time, through a copy contiguous in time (a
+    strided axis-0 filter of a wide array copies every column through a buffer: about 3x
+    slower); (N, c)."""
+    return signal.sosfiltfilt(sos, np.ascontiguousarray(block.T), axis=-1, padlen=padlen).T
+
+
+def _block_columns(count: int, padlen: int) -> int:
+    """Columns of ``count`` samples (padded by ``padlen`` at both ends) in one block."""
+    return max(1, CHUNK_BYTES // (8 * (count + 2 * padlen)))
+
+
 def _sosfiltfilt_columns(sos: np.ndarray, xu: np.ndarray, padlen: int) -> np.ndarray:
     """``sosfiltfilt`` along axis 0 of ``xu`` (N,) or (N, c), a block of columns at a time.
 
-    Each block is filtered along the last axis of a copy that is contiguous in time (a strided
-    axis-0 filter of a wide array copies every column through a buffer: about 3x slower), and
-    the blocks are small (:data:`CHUNK_BYTES`): SciPy's temporaries (the padded copy, one per
+    The blocks are small (:data:`CHUNK_BYTES`): SciPy's temporaries (the padded copy, one per
     pass) then stay in the cache and in memory the allocator reuses, where those of a whole
     wide matrix (a regressor's hundreds of columns) are fresh pages every call, which the
     kernel may first have to compact into huge pages (seconds on a fragmented machine). The
@@ -154,11 +183,21 @@ def _sosfiltfilt_columns(sos: np.ndarray, xu: np.ndarray, padlen: int) -> np.nda
         return signal.sosfiltfilt(sos, xu, padlen=padlen)
     count, cols = xu.shape
     out = np.empty((count, cols))
-    step = max(1, CHUNK_BYTES // (8 * (count + 2 * padlen)))
+    step = _block_columns(count, padlen)
     for a in range(0, cols, step):
-        block = np.ascontiguousarray(xu[:, a:a + step].T)
-        out[:, a:a + step] = signal.sosfiltfilt(sos, block, axis=-1, padlen=padlen).T
+        out[:, a:a + step] = _filtfilt_block(sos, xu[:, a:a + step], padlen)
     return out
+
+
+def _butter(cutoff: float, fs: float, order: int, count: int) -> tuple[np.ndarray, int]:
+    """Second-order sections of the Butterworth low-pass and the padding of its zero-phase run
+    over ``count`` samples at ``fs`` Hz."""
+    if not 0.0 < cutoff < 0.5 * fs:
+        raise RecordingError(f"cutoff: must be in (0, {0.5 * fs:g}) Hz (the Nyquist frequency), "
+                             f"got {cutoff:g}")
+    sos = signal.butter(order, cutoff, btype="low", fs=fs, output="sos")
+    # odd extension over ~3 filter time constants keeps value and slope at the ends
+    return sos, min(count - 1, int(3 * fs / cutoff) + 3 * (2 * sos.shape[0] + 1))
 
 
 def _filter(tu: np.ndarray, xu: np.ndarray, cutoff: float, order: int, method: str,
@@ -166,18 +205,16 @@ def _filter(tu: np.ndarray, xu: np.ndarray, cutoff: float, order: int, method: s
     """Filtered signal and its first ``derivs`` derivatives on the uniform grid."""
     dt = float(tu[1] - tu[0])
     fs = 1.0 / dt
-    if not 0.0 < cutoff < 0.5 * fs:
-        raise RecordingError(f"cutoff: must be in (0, {0.5 * fs:g}) Hz (the Nyquist frequency), "
-                             f"got {cutoff:g}")
     if method == "butter":
-        sos = signal.butter(order, cutoff, btype="low", fs=fs, output="sos")
-        # odd extension over ~3 filter time constants keeps value and slope at the ends
-        padlen = min(xu.shape[0] - 1, int(3 * fs / cutoff) + 3 * (2 * sos.shape[0] + 1))
+        sos, padlen = _butter(cutoff, fs, order, xu.shape[0])
         out = [_sosfiltfilt_columns(sos, xu, padlen)]
         for _ in range(derivs):
             out.append(np.gradient(out[-1], dt, axis=0, edge_order=2))  # central differences
         return out
     if method == "savgol":
+        if not 0.0 < cutoff < 0.5 * fs:
+            raise RecordingError(f"cutoff: must be in (0, {0.5 * fs:g}) Hz (the Nyquist "
+                                 f"frequency), got {cutoff:g}")
         length = _savgol_window(cutoff, fs, polyorder, xu.shape[0])
         return [signal.savgol_filter(xu, length, polyorder, deriv=d, delta=dt, axis=0, mode="interp")
                 for d in range(derivs + 1)]
@@ -245,3 +282,60 @@ def differentiate(t: np.ndarray, x: np.ndarray, cutoff: float | None = None, *, 
     """
     x_f, xd, xdd = _run(t, x, cutoff, order, method, polyorder, 2, "differentiate")
     return x_f, xd, xdd
+
+
+def lowpass_columns(t: np.ndarray, x: np.ndarray, cutoff: float, columns: np.ndarray,
+                    out: np.ndarray, *, order: int = 4, keep: int = 1) -> np.ndarray:
+    """Zero-phase Butterworth low-pass of some columns of a wide matrix, into a destination.
+
+    The columns are filtered a block at a time (:data:`CHUNK_BYTES`); the stamps are checked,
+    the filter designed and (for irregular stamps) the uniform grid built once for all blocks.
+    Each column gets the bits of :func:`lowpass` on that column.
+
+    Parameters
+    ----------
+    t : (N,) ndarray
+        Sample times, s, strictly increasing (irregular stamps: see the module notes).
+    x : (N, c) ndarray
+        Signals (a regressor's columns, say); not modified.
+    cutoff : float
+        -3 dB frequency of one pass, Hz.
+    columns : (k,) ndarray of int
+        The columns of ``x`` to filter.
+    out : (ceil(N / keep), c) ndarray
+        Destination: its ``columns`` receive every ``keep``-th filtered sample; its other columns
+        are left as they are.
+    order : int
+        Butterworth order of one pass (forward-backward doubles it).
+    keep : int
+        Keep every ``keep``-th filtered sample (1: all).
+
+    Returns
+    -------
+    (ceil(N / keep), c) ndarray
+        ``out``.
+    """
+    what = "lowpass_columns"
+    t = _check_stamps(t, what)
+    if x.ndim != 2 or x.shape[0] != t.size:
+        raise RecordingError(f"{what}: x must have shape (N, c) with N = {t.size} (len(t)), got {x.shape}")
+    rows = -(-t.size // keep)
+    if out.shape != (rows, x.shape[1]):
+        raise RecordingError(f"{what}: out must have shape {(rows, x.shape[1])}, got {out.shape}")
+    columns = np.asarray(columns, dtype=np.intp)
+    if t.size < 8:
+        raise RecordingError(f"{what}: at least 8 samples are needed, got {t.size}")
+    tu, resampled = _grid(t)
+    sos, padlen = _butter(float(cutoff), 1.0 / float(tu[1] - tu[0]), order, tu.size)
+    step = _block_columns(tu.size, padlen)
+    for a in range(0, columns.size, step):
+        cols = columns[a:a + step]
+        block = x[:, cols]
+        _check_finite(block, what, cols)
+        if resampled:
+            # cubic onto the uniform grid, filtered there, cubic back onto the stamps
+            filtered = _filtfilt_block(sos, make_interp_spline(t, block, k=3, axis=0)(tu), padlen)
+            out[:, cols] = make_interp_spline(tu, filtered, k=3, axis=0)(np.clip(t, tu[0], tu[-1]))[::keep]
+        else:
+            out[:, cols] = _filtfilt_block(sos, block, padlen)[::keep]
+    return out
