@@ -52,12 +52,15 @@ def machine_name() -> str:
     Returns
     -------
     str
-        Lower-case letters, digits and dashes, e.g. ``"intel-xeon-processor-2cpu"``.
+        Lower-case letters, digits and dashes, e.g. ``"intel-xeon-processor-avx512-2cpu"``: the
+        widest vector set (:func:`simd_level`) is part of the name, as a model name such as
+        "AMD EPYC" covers processors with and without AVX-512, whose kernels differ.
     """
     model = re.sub(r"\((r|tm)\)", "", cpu_model().lower())
     model = re.sub(r"\b(cpu|with|radeon graphics)\b", " ", model)
     slug = re.sub(r"[^a-z0-9]+", "-", model).strip("-") or "unknown"
-    return f"{slug}-{os.cpu_count() or 0}cpu"
+    level = simd_level()
+    return f"{slug}-{level + '-' if level else ''}{os.cpu_count() or 0}cpu"
 
 
 def default_path() -> Path:
@@ -123,6 +126,12 @@ def simd() -> list[str]:
     return [f for f in ("avx", "avx2", "fma", "avx512f") if f in flags]
 
 
+def simd_level() -> str:
+    """``"avx512"``, ``"avx2"`` or ``""``: the widest of the two that the CPU reports."""
+    flags = simd()
+    return "avx512" if "avx512f" in flags else "avx2" if "avx2" in flags else ""
+
+
 def machine_record() -> dict[str, Any]:
     """What the file says about the machine (the entry of each benchmark has its own load)."""
     return {"name": machine_name(), "cpu_model": cpu_model(), "simd": simd(),
@@ -135,7 +144,9 @@ def merge(path: Path, name: str, entry: dict[str, Any]) -> Path:
     """Write ``entry`` as benchmark ``name`` into the results file at ``path``.
 
     Other benchmarks' entries in the file are kept; the machine record and this entry are
-    replaced. The entry gets the date and the load average at the time of writing.
+    replaced. The entry gets the date and the load average at the time of writing. A file
+    written on another machine (CPU model, vector set or CPU count) is refused: its other
+    entries would be attributed to this one.
 
     Parameters
     ----------
@@ -154,7 +165,15 @@ def merge(path: Path, name: str, entry: dict[str, Any]) -> Path:
     data: dict[str, Any] = {}
     if path.exists():
         data = json.loads(path.read_text())
-    data["machine"] = machine_record()
+    here, there = machine_record(), data.get("machine", {})
+    differs = [k for k in ("cpu_model", "simd", "logical_cpus") if k in there and there[k] != here[k]]
+    if differs:
+        # the other entries were measured on another processor: one file per machine
+        was = ", ".join(f"{k} {there[k]!r}" for k in differs)
+        now = ", ".join(f"{k} {here[k]!r}" for k in differs)
+        raise SystemExit(f"{path}: written on another machine ({was}; this one: {now}); write "
+                         f"this machine's file ({default_path().name}) or name one with --results")
+    data["machine"] = here
     entry = {"date": datetime.date.today().isoformat(), **entry,
              "load_average_at_end": load_average()}
     data.setdefault("benchmarks", {})[name] = entry
