@@ -315,7 +315,8 @@ def _builders(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol], qdd
 
 def _kernel(name: str, builder: _Builder, reserved: set[str], prm: Sequence[sp.Symbol],
             rename_prm: dict[sp.Symbol, sp.Symbol], values: dict[sp.Symbol, float]) -> Kernel:
-    """One kernel: its outputs recorded, runtime parameters renamed, folded, CSE, safe names."""
+    """One kernel: its outputs recorded, runtime parameters renamed, folded, CSE, ordered depth first
+    from the outputs (:func:`robodyn.codegen.optimize.depth_first`), safe names."""
     summary, ins, out_name, shape, build = builder
     rec = Recorder(reserved)
     outs = build(rec)
@@ -326,6 +327,8 @@ def _kernel(name: str, builder: _Builder, reserved: set[str], prm: Sequence[sp.S
         outs = [sp.sympify(o).xreplace(rename_prm) for o in outs]
     body, outs = opt.fold_parameters(assignments, outs, values)
     body, outs = opt.eliminate_common_subexpressions(body, outs)
+    # each output's inputs computed just before it: short live ranges (fewer register spills)
+    body = opt.depth_first(body, outs)
     rename = opt.safe_names(body, reserved)
     if rename:
         body = [(rename.get(s, s), e.xreplace(rename)) for s, e in body]

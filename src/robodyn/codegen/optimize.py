@@ -107,3 +107,38 @@ def _heaviside_to_piecewise(expr: sp.Expr) -> sp.Expr:
         lambda e: isinstance(e, sp.Heaviside),
         lambda e: sp.Piecewise((sp.Integer(1), e.args[0] > 0), (sp.Integer(0), True)),
     )
+
+
+def depth_first(assignments: Sequence[Assignment], outputs: Sequence[sp.Expr]) -> list[Assignment]:
+    """The assignments reordered depth first from the outputs (each output's inputs just before it).
+
+    Each output, in order, pulls in what it needs and has not been emitted yet, post-order, the
+    arguments of an assignment in their original order. A value is then computed close to its
+    uses: for a forward-mode derivative (one output column per direction) a direction's chain is
+    computed as a whole, where the recording order interleaves every direction assignment by
+    assignment and keeps them all live at once.
+    """
+    position = {s: k for k, (s, _) in enumerate(assignments)}
+    rhs = dict(assignments)
+    emitted: set[sp.Symbol] = set()
+    order: list[Assignment] = []
+    for out in outputs:
+        roots = sorted((s for s in sp.sympify(out).free_symbols if s in position), key=position.__getitem__)
+        for root in roots:
+            if root in emitted:
+                continue
+            # iterative post-order: (symbol, its arguments expanded?)
+            stack: list[tuple[sp.Symbol, bool]] = [(root, False)]
+            while stack:
+                sym, expanded = stack.pop()
+                if sym in emitted:
+                    continue
+                if expanded:
+                    emitted.add(sym)
+                    order.append((sym, rhs[sym]))
+                    continue
+                stack.append((sym, True))
+                args = sorted((a for a in rhs[sym].free_symbols if a in position and a not in emitted),
+                              key=position.__getitem__, reverse=True)
+                stack.extend((a, False) for a in args)
+    return order
