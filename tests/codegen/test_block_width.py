@@ -61,3 +61,17 @@ def test_each_width_has_its_own_cache_entry(tmp_path) -> None:
         found[width] = json.loads(out.stdout.splitlines()[-1])
         assert f"m_ <= {width} states" in found[width]["text"]
     assert found[4]["path"] != found[8]["path"]
+
+
+def test_vector_flags_ask_for_256_bits_on_avx2_without_avx512():
+    """The full AVX2 width is requested where -march=native's tuning may prefer 128 bits (a
+    virtual machine's Zen 3 seen as Zen 1); nothing is added with AVX-512 or without AVX2, and
+    the flag is part of the models' flags on this machine exactly when it has AVX2 alone."""
+    from robodyn.codegen.build import CFLAGS
+    from robodyn.codegen.cpu import cpu_flags, vector_flags
+
+    assert vector_flags(frozenset({"avx", "avx2", "fma"})) == ("-mprefer-vector-width=256",)
+    assert vector_flags(frozenset({"avx", "avx2", "fma", "avx512f"})) == ()
+    assert vector_flags(frozenset({"sse2", "avx"})) == ()
+    here = cpu_flags()
+    assert ("-mprefer-vector-width=256" in CFLAGS) == ("avx2" in here and "avx512f" not in here)

@@ -33,6 +33,7 @@ from pathlib import Path
 
 import cffi
 
+from robodyn.codegen.cpu import vector_flags
 from robodyn.robot.errors import InputError
 
 __all__ = [
@@ -57,9 +58,10 @@ _MANIFEST = ".sha256"
 
 #: Flags: IEEE arithmetic without reassociation (no -ffast-math: results must match the symbolic
 #: model), but with ``a * b + c`` contracted to fused multiply-adds where the CPU has them (one
-#: rounding instead of two; GCC's default outside strict ISO mode, which -std=c99 would turn off).
+#: rounding instead of two; GCC's default outside strict ISO mode, which -std=c99 would turn off);
+#: and on AVX2 processors without AVX-512 the full 256-bit registers (:func:`vector_flags`).
 CFLAGS = ("-O3", "-fPIC", "-shared", "-std=c99", "-fno-math-errno", "-ffp-contract=fast",
-          "-march=native")
+          "-march=native", *vector_flags())
 
 
 class CompilerNotFoundError(RuntimeError):
