@@ -442,3 +442,23 @@ def test_least_squares_writes_a_physical_completion_when_one_exists(puma, tmp_pa
     again = rd.load(str(path), strict=True)
     np.testing.assert_allclose(rd.compile_model(again).inverse_dynamics(q[:200], qd[:200], qdd[:200]),
                                ident.predict(rec)[:200], rtol=1e-6, atol=1e-6)
+
+
+@pytest.mark.parametrize("law", ["stribeck", "load", "polynomial"])
+def test_friction_law_jacobian_matches_central_differences(law):
+    """The analytic Jacobian the nonlinear friction fits use, against central differences of the
+    law itself at random velocities (both signs, near and far from the Stribeck velocity)."""
+    from robodyn.identification.friction import _law, _law_jacobian
+
+    rng = np.random.default_rng(11)
+    v = rng.uniform(-0.5, 0.5, 200)
+    load = rng.uniform(-20, 20, 200)
+    x = {"stribeck": np.array([0.8, 1.3, 0.07, 0.4, -0.1]), "load": np.array([0.8, 0.02, 0.4, -0.1]),
+         "polynomial": np.array([0.8, 0.4, -0.3, 0.2, -0.1])}[law]
+    jac = _law_jacobian(law, x, v, load)
+    h = 1e-6 * np.maximum(np.abs(x), 1e-3)
+    numeric = np.column_stack([(_law(law, x + h[k] * np.eye(x.size)[k], v, load)
+                                - _law(law, x - h[k] * np.eye(x.size)[k], v, load)) / (2 * h[k])
+                               for k in range(x.size)])
+    # central differences: error O(h^2 f''') and rounding ~1e-16 |f| / h, well under 1e-6 here
+    np.testing.assert_allclose(jac, numeric, rtol=1e-6, atol=1e-7)

@@ -65,3 +65,42 @@ def test_pivoted_columns_is_the_one_base_column_rule():
     np.testing.assert_allclose(norms, np.linalg.norm(w, axis=0))
     # excitation design takes its base columns through the same function
     assert excitation.pivoted_columns is pivoted_columns
+
+
+def test_regressor_rows_of_writes_into_a_given_array():
+    """``out=`` (N, n, 15 n) receives the rows that a fresh call returns; a wrong shape is refused."""
+    import pytest
+
+    from robodyn.identification.stacking import regressor_rows_of
+    from robodyn.robot.errors import InputError
+
+    model, q, qd, qdd = _model_and_states(30)
+    buf = np.full((30, model.dof, 15 * model.dof), np.nan)
+    got = regressor_rows_of(model, q, qd, qdd, out=buf)
+    assert got.base is buf or got is buf or np.shares_memory(got, buf)
+    np.testing.assert_array_equal(buf, regressor_rows_of(model, q, qd, qdd))
+    with pytest.raises(InputError, match="regressor_rows_of"):
+        regressor_rows_of(model, q, qd, qdd, out=buf[:, :, :-1])
+
+
+def test_effort_in_chunks_equals_the_effort_of_the_whole_regressor(monkeypatch):
+    """``Identification.effort`` evaluates the regressor a chunk of samples at a time into one
+    buffer; with a chunk smaller than the run (three chunks and a part) it equals ``Y p / K``
+    of the whole run's prediction rows, computed here from the fitted parameters."""
+    from robodyn.identification import result
+    from robodyn.identification.preprocess import prediction_rows, preprocess
+    from tests.identification.helpers import fourier
+
+    robot = rd.load("puma560")
+    model = rd.compile_model(robot)
+    rng = np.random.default_rng(3)
+    t = np.arange(3000) * 2e-3
+    q, qd, qdd = fourier(t, robot.dof, rng, f0=0.2)
+    rec = rd.Recording(t=t, q=q, qd=qd, qdd=qdd, tau=model.inverse_dynamics(q, qd, qdd),
+                       joint_names=robot.joint_names, source="simulated")
+    ident = rd.identify(robot, rec, target="tau", model=model, cutoff=None, method="ols",
+                        friction="linear", resonance=False, ripple=False)
+    s = preprocess(rec, ident.preprocess, None)
+    whole = prediction_rows(model, s, ident.preprocess) @ ident.standard / ident.gains
+    monkeypatch.setattr(result, "EFFORT_CHUNK", 700)
+    np.testing.assert_allclose(ident.effort(s), whole, rtol=0, atol=1e-12 * np.abs(whole).max())

@@ -61,6 +61,29 @@ def _law(model: str, x: np.ndarray, v: np.ndarray, load: np.ndarray) -> np.ndarr
     return s * fc + a1 * v + a2 * v * np.abs(v) + a3 * v**3 + fo
 
 
+def _law_jacobian(model: str, x: np.ndarray, v: np.ndarray, load: np.ndarray) -> np.ndarray:
+    """``d f / d x`` (N, len(x)) of :func:`_law` at velocities ``v`` (N,) and loads (N,)."""
+    s = np.tanh(v / V_EPS)
+    one = np.ones_like(v)
+    if model == "stribeck":
+        fc, fs, vs, _, _ = x
+        e = np.exp(-((v / vs) ** 2))
+        # df/dFc = s (1 - e), df/dFs = s e, df/dvs = s (Fs - Fc) e 2 v^2 / vs^3, df/dFv = v
+        return np.column_stack([s * (1.0 - e), s * e, s * (fs - fc) * e * 2.0 * v**2 / vs**3, v, one])
+    if model == "load":
+        return np.column_stack([s, s * np.abs(load), v, one])
+    return np.column_stack([s, v, v * np.abs(v), v**3, one])
+
+
+def _fit_law(model: str, x0: np.ndarray, bounds: tuple[np.ndarray, np.ndarray], v: np.ndarray,
+             load: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Parameters of ``model`` minimising ``|f(v, load) - r|`` (trust-region reflective within
+    ``bounds``, from ``x0``, with the analytic Jacobian :func:`_law_jacobian`)."""
+    return least_squares(lambda x: _law(model, x, v, load) - r, x0,
+                         jac=lambda x: _law_jacobian(model, x, v, load),
+                         bounds=bounds, method="trf", x_scale="jac").x
+
+
 @dataclass(frozen=True, eq=False)
 class FrictionFit:
     """A nonlinear friction law per joint (module docstring), in target-torque units (N m).
@@ -126,9 +149,7 @@ def fit_friction_samples(ident: Any, samples: Sequence[Samples], y_full: Sequenc
             x[-1] = float(np.mean(r[:, j]))
             params.append(x)
             continue
-        sol = least_squares(lambda x, j=j: _law(model, x, qd[:, j], load[:, j]) - r[:, j], x0,
-                            bounds=bounds, method="trf", x_scale="jac")
-        params.append(sol.x)
+        params.append(_fit_law(model, x0, bounds, qd[:, j], load[:, j], r[:, j]))
     return FrictionFit(model=model, names=_NAMES[model], params=np.array(params))
 
 

@@ -15,10 +15,9 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from robodyn.identification.estimate import FOLDS, paired_se
-from robodyn.identification.friction import _law, _start, without_friction
+from robodyn.identification.friction import _fit_law, _law, _start, without_friction
 from robodyn.identification.preprocess import Samples
 from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
 
@@ -74,9 +73,8 @@ def choose_friction_law(ident: Any, samples: Sequence[Samples], y_full: Sequence
             if np.ptp(qd[train, j]) == 0.0:
                 pred = np.full(int(test.sum()), float(np.mean(r[train, j])))
             else:
-                sol = least_squares(lambda x, j=j, t=train: _law("stribeck", x, qd[t, j], load[t, j])
-                                    - r[t, j], x0, bounds=bounds, method="trf", x_scale="jac")
-                pred = _law("stribeck", sol.x, qd[test, j], load[test, j])
+                x = _fit_law("stribeck", x0, bounds, qd[train, j], load[train, j], r[train, j])
+                pred = _law("stribeck", x, qd[test, j], load[test, j])
             per_block["stribeck"][k] += float(np.sum((r[test, j] - pred) ** 2))
     total = max(float(np.sum(r**2)), 1e-300)
     scores = {law: float(np.sqrt(e.sum() / total)) for law, e in per_block.items()}

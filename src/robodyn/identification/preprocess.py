@@ -220,10 +220,13 @@ def coulomb_dead_band(y: np.ndarray, qd: np.ndarray, band: float) -> np.ndarray:
     return y
 
 
-def prediction_rows(model: Any, s: Samples, settings: Preprocess) -> np.ndarray:
+def prediction_rows(model: Any, s: Samples, settings: Preprocess,
+                    out: np.ndarray | None = None) -> np.ndarray:
     """Regressor (N, n, 15 n) of processed samples for a prediction: the compiled regressor of
-    ``model`` at ``(s.q, s.qd, s.qdd)`` with the Coulomb dead band (:func:`coulomb_dead_band`)."""
-    return coulomb_dead_band(regressor_rows_of(model, s.q, s.qd, s.qdd), s.qd, settings.dead_band)
+    ``model`` at ``(s.q, s.qd, s.qdd)`` with the Coulomb dead band (:func:`coulomb_dead_band`);
+    written into ``out`` (N, n, 15 n), C-contiguous, when given."""
+    y = regressor_rows_of(model, s.q, s.qd, s.qdd, out=out)
+    return coulomb_dead_band(y, s.qd, settings.dead_band)
 
 
 def regressor_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool = True) -> np.ndarray:

@@ -70,12 +70,20 @@ def identification_matrix(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.n
     return out
 
 
-def regressor_rows_of(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+def regressor_rows_of(model: Model, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
+                      out: np.ndarray | None = None) -> np.ndarray:
     """The full stacked regressor as one block per sample, shape (N, n, 15 n).
 
     :func:`identification_matrix` with every column (the path ``benchmarks/bench_identify.py``
-    times), viewed per sample: what :func:`robodyn.identification` filters and fits.
+    times), viewed per sample: what :func:`robodyn.identification` filters and fits. ``out``
+    (N, n, 15 n), C-contiguous float64: written and returned (reuse it across calls).
     """
     q = np.atleast_2d(np.asarray(q, dtype=float))
     count, n = q.shape
-    return identification_matrix(model, q, qd, qdd).reshape(count, n, -1)
+    flat = None
+    if out is not None:
+        if not (isinstance(out, np.ndarray) and out.shape == (count, n, 15 * n) and out.flags.c_contiguous):
+            raise InputError(f"regressor_rows_of(out=...): expected a C-contiguous array of shape "
+                             f"{(count, n, 15 * n)}, got {getattr(out, 'shape', type(out).__name__)}")
+        flat = out.reshape(count * n, 15 * n)  # a view: C-contiguous
+    return identification_matrix(model, q, qd, qdd, out=flat).reshape(count, n, -1)
