@@ -41,6 +41,7 @@ from robodyn.identification.preprocess import (
     DEAD_BAND,
     Preprocess,
     Samples,
+    auto_cutoff,
     prediction_rows,
     preprocess,
     regressor_rows,
@@ -166,7 +167,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
 
     def stacked(c: Candidate) -> Problem:
         data = _prepared(robot, recs, target, opts.friction, c.cutoff, opts.decimate, c.velocity,
-                         c.dead_band, model, c.thermal, opts.sensor)
+                         c.dead_band, model, c.thermal, opts.sensor, rule)
         drive, prior, loads = _gains_and_prior(robot, data, pays, target, opts.gains, opts.friction,
                                                opts.sensor)
         cols = data.relations.independent
@@ -185,8 +186,10 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
                        np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), held,
                        (data, drive, prior, loads))
 
-    cutoffs = _cutoff_candidates(recs, opts.cutoff)
-    reference = _reference_targets(recs, target, cutoffs[0])
+    # the "auto" cut-off's rule, computed once for every candidate that uses it
+    rule = auto_cutoff(recs) if opts.cutoff == "auto" else None
+    cutoffs = _cutoff_candidates(recs, opts.cutoff, rule)
+    reference = _reference_targets(recs, target, cutoffs[0], rule)
     cands = candidates(opts.velocity, opts.dead_band, opts.thermal, measured, temps, DEAD_BAND, cutoffs)
     best, problem, scored = choose(cands, stacked)
     data, drive, prior, loads = problem.payload
@@ -306,13 +309,14 @@ class _LinearStep:
 
 def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff: float | str | None,
               decimate: int | str, velocity: str, dead_band: float, model: Model,
-              thermal: bool = False, sensor: str = "motor") -> _Prepared:
+              thermal: bool = False, sensor: str = "motor", rule: float | None = None) -> _Prepared:
     """Preprocessed samples, filtered regressors and base relations of ``recs`` (steps 2 and 3).
 
-    Raises :class:`IdentificationError` when the
+    ``rule``: the recordings' "auto" cut-off when already computed (Hz). Raises
+    :class:`IdentificationError` when the
     ``sum N_k n`` equations left after decimation are fewer than twice the ``b`` base parameters.
     """
-    settings = resolve_preprocess(recs, cutoff, decimate, velocity, dead_band=dead_band)
+    settings = resolve_preprocess(recs, cutoff, decimate, velocity, dead_band=dead_band, auto=rule)
     full = [preprocess(r, settings, target) for r in recs]
     y_full = [filtered_regressor(model, s, settings) for s in full]
     samples = [_decimated(s, settings) for s in full]
@@ -332,24 +336,26 @@ def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff:
                      thermal_data(recs, full, settings) if thermal else None, full)
 
 
-def _cutoff_candidates(recs: list[Any], cutoff: float | str | None) -> tuple[float | str | None, ...]:
+def _cutoff_candidates(recs: list[Any], cutoff: float | str | None,
+                       rule: float | None = None) -> tuple[float | str | None, ...]:
     """The cut-offs to try: a given one alone; for "auto" its rule's value and ``CUTOFF_WIDER``
     times it (below 0.2 x the slowest sampling rate), for a record whose torque holds more above
     the motion's own bandwidth (a stiff controller, a fast excitation) than its noise."""
     if cutoff != "auto":
         return (cutoff,)
-    rule = resolve_preprocess(recs, "auto", "auto").cutoff
+    rule = resolve_preprocess(recs, "auto", "auto", auto=rule).cutoff
     fs = slowest_rate(recs)
     wide = min(CUTOFF_WIDER * rule, 0.2 * fs)
     return ("auto", wide) if wide > 1.01 * rule else ("auto",)
 
 
-def _reference_targets(recs: list[Any], target: str, cutoff: float | str | None) -> list[np.ndarray]:
+def _reference_targets(recs: list[Any], target: str, cutoff: float | str | None,
+                       rule: float | None = None) -> list[np.ndarray]:
     """The held-out target of the cross-validated choices, (N_k, n) per recording: each
     recording's target low-passed at the first (plain) candidate's cut-off, the same for every
     candidate, so that a wider cut-off wins only by better parameters, not by following the
     target's noise (the raw target when the plain candidate has no filter)."""
-    cut = resolve_preprocess(recs, cutoff, 1).cutoff
+    cut = resolve_preprocess(recs, cutoff, 1, auto=rule).cutoff
     out = []
     for r in recs:
         y = np.asarray(getattr(r, target), float)

@@ -49,8 +49,8 @@ from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass, 
 from robodyn.robot.errors import IdentificationError
 
 __all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "DEAD_BAND", "MID_RATE", "Preprocess", "Samples",
-           "coulomb_dead_band", "evaluation_step", "filtered_rows", "prediction_rows", "preprocess",
-           "regressor_rows", "resolve_preprocess", "slowest_rate"]
+           "auto_cutoff", "coulomb_dead_band", "evaluation_step", "filtered_rows", "prediction_rows",
+           "preprocess", "regressor_rows", "resolve_preprocess", "slowest_rate"]
 
 AUTO_MIN_HZ = 2.0
 AUTO_MAX_HZ = 5.0
@@ -122,10 +122,23 @@ def slowest_rate(recordings: Sequence[Any]) -> float:
     return min(1.0 / float(np.median(np.diff(np.asarray(r.t, float)))) for r in recordings)
 
 
+def auto_cutoff(recordings: Sequence[Any]) -> float:
+    """The cut-off of ``cutoff="auto"`` for these recordings, Hz (the module docstring's rule)."""
+    bands = []
+    for r in recordings:
+        q = np.asarray(r.q, float)
+        moving = np.ptp(q, axis=0) > _MOVING_RAD
+        if np.any(moving) and q.shape[0] >= 16:
+            bands.append(bandwidth_cutoff(np.asarray(r.t, float), q[:, moving]))
+    band = max(bands) if bands else AUTO_MIN_HZ
+    return min(float(np.clip(band, AUTO_MIN_HZ, AUTO_MAX_HZ)), 0.2 * slowest_rate(recordings))
+
+
 def resolve_preprocess(recordings: list[Any], cutoff: float | str | None, decimate: int | str,
                        velocity: str = "position", order: int = 4,
-                       dead_band: float = DEAD_BAND) -> Preprocess:
-    """Settings for these recordings: the ``"auto"`` rules of the module docstring resolved."""
+                       dead_band: float = DEAD_BAND, auto: float | None = None) -> Preprocess:
+    """Settings for these recordings: the ``"auto"`` rules of the module docstring resolved
+    (``auto``: :func:`auto_cutoff` of the recordings when already computed, Hz)."""
     if velocity not in ("position", "measured"):
         raise IdentificationError(f"velocity: expected 'position' or 'measured', got {velocity!r}")
     if not (isinstance(dead_band, (int, float)) and np.isfinite(dead_band) and 0 <= dead_band < 1e3):
@@ -134,15 +147,7 @@ def resolve_preprocess(recordings: list[Any], cutoff: float | str | None, decima
     if isinstance(cutoff, str):
         if cutoff != "auto":
             raise IdentificationError(f"cutoff: expected a frequency in Hz, None or 'auto', got {cutoff!r}")
-        bands = []
-        for r in recordings:
-            q = np.asarray(r.q, float)
-            moving = np.ptp(q, axis=0) > _MOVING_RAD
-            if np.any(moving) and q.shape[0] >= 16:
-                bands.append(bandwidth_cutoff(np.asarray(r.t, float), q[:, moving]))
-        band = max(bands) if bands else AUTO_MIN_HZ
-        cut = float(np.clip(band, AUTO_MIN_HZ, AUTO_MAX_HZ))
-        cut = min(cut, 0.2 * fs)
+        cut = auto_cutoff(recordings) if auto is None else float(auto)
     elif cutoff is None:
         cut = None
     else:
