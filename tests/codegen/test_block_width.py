@@ -1,14 +1,15 @@
 """The generated kernels' block width: chosen from the processor, overridden by ROBODYN_BLOCK.
 
-The kernels themselves are checked at other widths by the CI, which reruns the whole suite with
-ROBODYN_BLOCK=1 (scalar code) and with the width this processor does not get by default; each
-width has its own compiled-model cache entries (checked here), so those reruns test their own
-width's code and not kernels generated for another."""
+The kernels themselves are checked at other widths by the CI, which reruns the suite (less the
+slow tests) with ROBODYN_BLOCK=1 (scalar code) and with the width this processor does not get by
+default; each width has its own compiled-model cache entries (checked here), so those reruns
+test their own width's code and not kernels generated for another."""
 
 from __future__ import annotations
 
 import pytest
 
+import robodyn.codegen.build as build
 import robodyn.codegen.cpu as cpu
 from robodyn.errors import InputError
 
@@ -75,3 +76,24 @@ def test_vector_flags_ask_for_256_bits_on_avx2_without_avx512():
     assert vector_flags(frozenset({"sse2", "avx"})) == ()
     here = cpu_flags()
     assert ("-mprefer-vector-width=256" in CFLAGS) == ("avx2" in here and "avx512f" not in here)
+
+
+@pytest.mark.parametrize(("path", "width", "expected"), [
+    ("/usr/bin/gcc", 1, build.SCALAR_GCC_FLAGS),
+    ("/usr/bin/x86_64-linux-gnu-gcc-12", 1, build.SCALAR_GCC_FLAGS),
+    ("/opt/gcc-13.2/bin/gcc-13.2", 1, build.SCALAR_GCC_FLAGS),
+    ("/usr/bin/x86_64-linux-gnu-gcc-12", 8, ()),
+    ("/usr/bin/clang-15", 1, ()),
+    ("/usr/bin/icx", 1, ()),
+])
+def test_scalar_gcc_builds_skip_the_combine_pass(path: str, width: int, expected) -> None:
+    # (paths that do not exist are their own real path)
+    assert build.compiler_flags(path, width) == expected
+
+
+def test_cc_link_to_gcc_counts_as_gcc(tmp_path) -> None:
+    gcc = tmp_path / "x86_64-linux-gnu-gcc-12"
+    gcc.write_text("")
+    (tmp_path / "cc").symlink_to(gcc)
+    assert build.compiler_flags(str(tmp_path / "cc"), 1) == build.SCALAR_GCC_FLAGS
+    assert build.compiler_flags(str(tmp_path / "cc"), 16) == ()
