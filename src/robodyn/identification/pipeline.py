@@ -4,8 +4,9 @@ Steps (each a function of its own module):
 
 1. check the recordings (joints, shapes, finite values, a target signal);
 2. preprocess each recording (:mod:`robodyn.identification.preprocess`: zero-phase filter, derivatives,
-   the same filter on the target; :func:`filtered_regressor`: the same filter on every column
-   of the regressor, then decimation);
+   the same filter on the target; ``regressor_rows``: the same filter on every column of the
+   regressor, then decimation; candidates that differ only in the dead band share both,
+   :class:`~robodyn.identification.preprocess.SharedRows`);
 3. base parameters of the robot (:mod:`robodyn.identification.base`, Gautier's QR on random states);
 4. identification matrix: the compiled, batched regressor ``Y(q, qd, qdd)`` (N, n, 15 n) of every
    sample, restricted to the base columns and stacked, one row per joint per sample;
@@ -41,10 +42,9 @@ from robodyn.identification.preprocess import (
     DEAD_BAND,
     Preprocess,
     Samples,
+    SharedRows,
     auto_cutoff,
     prediction_rows,
-    preprocess,
-    regressor_rows,
     resolve_preprocess,
     slowest_rate,
 )
@@ -167,7 +167,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
 
     def stacked(c: Candidate) -> Problem:
         data = _prepared(robot, recs, target, opts.friction, c.cutoff, opts.decimate, c.velocity,
-                         c.dead_band, model, c.thermal, opts.sensor, rule)
+                         c.dead_band, model, c.thermal, opts.sensor, rule, shared)
         drive, prior, loads = _gains_and_prior(robot, data, pays, target, opts.gains, opts.friction,
                                                opts.sensor)
         cols = data.relations.independent
@@ -191,7 +191,9 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     cutoffs = _cutoff_candidates(recs, opts.cutoff, rule)
     reference = _reference_targets(recs, target, cutoffs[0], rule)
     cands = candidates(opts.velocity, opts.dead_band, opts.thermal, measured, temps, DEAD_BAND, cutoffs)
+    shared = SharedRows(model)  # samples and rows of the candidates that differ in the band only
     best, problem, scored = choose(cands, stacked)
+    shared.clear()
     data, drive, prior, loads = problem.payload
     # the consistent program's constraints bound what the weight bounds for least squares: its
     # weight is the smallest within one standard error of the best (estimate.cv_weight)
@@ -309,16 +311,17 @@ class _LinearStep:
 
 def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff: float | str | None,
               decimate: int | str, velocity: str, dead_band: float, model: Model,
-              thermal: bool = False, sensor: str = "motor", rule: float | None = None) -> _Prepared:
+              thermal: bool = False, sensor: str = "motor", rule: float | None = None,
+              shared: SharedRows | None = None) -> _Prepared:
     """Preprocessed samples, filtered regressors and base relations of ``recs`` (steps 2 and 3).
 
-    ``rule``: the recordings' "auto" cut-off when already computed (Hz). Raises
+    ``rule``: the recordings' "auto" cut-off when already computed (Hz); ``shared``: the
+    samples and rows of the settings seen before in this identification. Raises
     :class:`IdentificationError` when the
     ``sum N_k n`` equations left after decimation are fewer than twice the ``b`` base parameters.
     """
     settings = resolve_preprocess(recs, cutoff, decimate, velocity, dead_band=dead_band, auto=rule)
-    full = [preprocess(r, settings, target) for r in recs]
-    y_full = [filtered_regressor(model, s, settings) for s in full]
+    full, y_full = (shared or SharedRows(model)).get(recs, settings, target)
     samples = [_decimated(s, settings) for s in full]
     rotor = np.arange(robot.dof) * PER_JOINT + len(INERTIAL_NAMES)
     relations = base_relations(model, at_rest=_at_rest(samples, settings.dead_band),
@@ -522,12 +525,6 @@ def _without_friction_columns(relations: BaseRelations) -> BaseRelations:
     ever combine among themselves, so the other base parameters are unchanged."""
     keep = np.array([c % PER_JOINT <= len(INERTIAL_NAMES) for c in relations.independent])
     return replace(relations, independent=relations.independent[keep], beta=relations.beta[keep])
-
-
-def filtered_regressor(model: Model, s: Samples, settings: Preprocess) -> np.ndarray:
-    """The fit's regressor rows (N / decimate, n, 15 n)
-    (:func:`robodyn.identification.preprocess.regressor_rows`)."""
-    return regressor_rows(model, s, settings)
 
 
 def _decimated(s: Samples, settings: Preprocess) -> Samples:

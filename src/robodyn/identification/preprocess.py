@@ -49,8 +49,9 @@ from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass, 
 from robodyn.robot.errors import IdentificationError
 
 __all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "DEAD_BAND", "MID_RATE", "Preprocess", "Samples",
-           "auto_cutoff", "coulomb_dead_band", "evaluation_step", "filtered_rows", "prediction_rows",
-           "preprocess", "regressor_rows", "resolve_preprocess", "slowest_rate"]
+           "SharedRows", "UnbandedRows", "auto_cutoff", "banded_rows", "coulomb_dead_band",
+           "evaluation_step", "filtered_rows", "prediction_rows", "preprocess", "regressor_rows",
+           "resolve_preprocess", "slowest_rate", "unbanded_rows"]
 
 AUTO_MIN_HZ = 2.0
 AUTO_MAX_HZ = 5.0
@@ -247,20 +248,82 @@ def regressor_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool 
     ``m``-th sample, ``m`` the largest divisor of the decimation factor with at least
     ``MID_RATE`` samples per cut-off period left (the filtered states are smooth there; only the
     timing of a Coulomb step moves, by less than ``1 / (MID_RATE cutoff)``).
+
+    The rows are built without the dead band (:func:`unbanded_rows`), then the band is applied
+    to the Coulomb columns alone (:func:`banded_rows`): each column is filtered on its own, so
+    the result is the filtered rows of the banded regressor, and settings that differ only in
+    the band can share the first step.
     """
+    return banded_rows(unbanded_rows(model, s, settings, decimate), settings)
+
+
+@dataclass(frozen=True, eq=False)
+class UnbandedRows:
+    """A recording's fit rows without the Coulomb dead band, and what a dead band changes.
+
+    Attributes
+    ----------
+    rows : numpy.ndarray, shape (N / decimate, n, 15 n)
+        :func:`regressor_rows` of the samples with no dead band.
+    t : numpy.ndarray, shape (M,)
+        Times of the samples the regressor was evaluated at (every ``m``-th, see
+        :func:`evaluation_step`), s.
+    qd : numpy.ndarray, shape (M, n)
+        Velocities at those samples, rad/s (m/s).
+    coulomb : numpy.ndarray, shape (M, n, 2)
+        Joint j's unfiltered Coulomb columns (``Fcp``, ``Fcn``) of its own row, at those samples.
+    keep : int
+        ``rows`` keeps every ``keep``-th of the M samples after filtering.
+    """
+
+    rows: np.ndarray
+    t: np.ndarray
+    qd: np.ndarray
+    coulomb: np.ndarray
+    keep: int
+
+
+def unbanded_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool = True) -> UnbandedRows:
+    """:func:`regressor_rows` of samples ``s`` without the dead band (``settings.dead_band`` is
+    not used), with the Coulomb columns :func:`banded_rows` needs."""
+    from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
+
     d = settings.decimate if decimate else 1
-    band = settings.dead_band
-    if settings.cutoff is None:
-        return coulomb_dead_band(regressor_rows_of(model, s.q[::d], s.qd[::d], s.qdd[::d]), s.qd[::d],
-                                 band)
     m = evaluation_step(s.t, settings, d)
-    y = coulomb_dead_band(regressor_rows_of(model, s.q[::m], s.qd[::m], s.qdd[::m]), s.qd[::m], band)
-    return filtered_rows(s.t[::m], y, settings, d // m)
+    y = regressor_rows_of(model, s.q[::m], s.qd[::m], s.qdd[::m])
+    n = y.shape[1]
+    first = len(INERTIAL_NAMES) + 2  # Fcp, then Fcn, of each joint's parameter group
+    coulomb = np.stack([y[:, j, PER_JOINT * j + first:PER_JOINT * j + first + 2] for j in range(n)],
+                       axis=1)
+    rows = filtered_rows(s.t[::m], y, settings, d // m)
+    return UnbandedRows(rows, s.t[::m], s.qd[::m], coulomb, d // m)
+
+
+def banded_rows(u: UnbandedRows, settings: Preprocess) -> np.ndarray:
+    """The fit rows (N / decimate, n, 15 n) with the dead band ``settings.dead_band``: ``u.rows``
+    itself when no sample is inside the band (not a copy: do not modify it), else a copy whose
+    Coulomb columns of the joints with samples inside are zeroed there, then filtered and
+    decimated as the other columns were (:func:`filtered_rows`)."""
+    from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
+
+    still = np.abs(u.qd) < settings.dead_band
+    joints = np.flatnonzero(still.any(axis=0))
+    if joints.size == 0:
+        return u.rows
+    cols = u.coulomb[:, joints, :].copy()
+    cols[still[:, joints]] = 0.0  # |qd_j| < band: joint j's Coulomb terms are zero
+    cols = filtered_rows(u.t, cols, settings, u.keep)
+    out = u.rows.copy()
+    first = len(INERTIAL_NAMES) + 2
+    for i, j in enumerate(joints):
+        out[:, j, PER_JOINT * j + first:PER_JOINT * j + first + 2] = cols[:, i]
+    return out
 
 
 def evaluation_step(t: np.ndarray, settings: Preprocess, d: int) -> int:
     """The step ``m`` (a divisor of the decimation ``d``) at which rows are evaluated and filtered:
-    the largest with at least ``MID_RATE`` samples per cut-off period (:func:`regressor_rows`)."""
+    the largest with at least ``MID_RATE`` samples per cut-off period (:func:`regressor_rows`);
+    ``d`` itself without a filter."""
     if settings.cutoff is None:
         return d
     fs = 1.0 / float(np.median(np.diff(t)))
@@ -281,3 +344,37 @@ def filtered_rows(t: np.ndarray, y: np.ndarray, settings: Preprocess, keep: int)
     out = lowpass_columns(t, flat, settings.cutoff, varying, flat[::keep].copy(),
                           order=settings.order, keep=keep)
     return out.reshape((-1,) + y.shape[1:])
+
+
+class SharedRows:
+    """Processed samples and fit rows of the recordings of one identification, per setting.
+
+    The candidates of ``rd.identify``'s choices that differ only in the dead band (or in thermal
+    friction, which adds columns of its own) have the same samples and the same rows but for
+    the Coulomb columns: the samples and the unbanded rows are made once per velocity source
+    and cut-off (:func:`unbanded_rows`), and each candidate gets its band applied
+    (:func:`banded_rows`). The memo holds those arrays until :meth:`clear`.
+
+    Parameters
+    ----------
+    model : Model
+        The compiled model whose regressor is evaluated.
+    """
+
+    def __init__(self, model: Any) -> None:
+        self._model = model
+        self._memo: dict[tuple[Any, ...], tuple[list[Samples], list[UnbandedRows]]] = {}
+
+    def get(self, recs: Sequence[Any], settings: Preprocess, target: str | None
+            ) -> tuple[list[Samples], list[np.ndarray]]:
+        """:func:`preprocess` of each recording and its :func:`regressor_rows`."""
+        key = (settings.cutoff, settings.order, settings.decimate, settings.velocity, target)
+        if key not in self._memo:
+            full = [preprocess(r, settings, target) for r in recs]
+            self._memo[key] = (full, [unbanded_rows(self._model, s, settings) for s in full])
+        full, base = self._memo[key]
+        return full, [banded_rows(u, settings) for u in base]
+
+    def clear(self) -> None:
+        """Forget every setting's arrays."""
+        self._memo.clear()
