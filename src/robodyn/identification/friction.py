@@ -32,7 +32,7 @@ from scipy.optimize import least_squares
 
 from robodyn.identification.preprocess import Samples, preprocess, regressor_rows
 from robodyn.robot.errors import IdentificationError
-from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
+from robodyn.symbolic.regressor import PER_JOINT, joint_columns
 
 __all__ = ["FRICTION_MODELS", "NONLINEAR", "V_EPS", "FrictionFit", "fit_friction"]
 
@@ -110,7 +110,7 @@ def without_friction(standard: np.ndarray) -> np.ndarray:
     """The standard vector (15 n,) with the friction entries (Fv, Fcp, Fcn, Fo) set to zero."""
     p = standard.copy()
     for j in range(p.size // PER_JOINT):
-        p[PER_JOINT * j + len(INERTIAL_NAMES) + 1:PER_JOINT * (j + 1)] = 0.0
+        p[joint_columns(j, "Fv")] = 0.0
     return p
 
 
@@ -141,7 +141,7 @@ def fit_friction_samples(ident: Any, samples: Sequence[Samples], y_full: Sequenc
     r = np.vstack([s.y for s in samples]) * ident.gains[None, :] - load  # r = K H y - H Y p_nf
     params = []
     for j in range(n):
-        b = PER_JOINT * j + len(INERTIAL_NAMES) + 1
+        b = joint_columns(j, "Fv").start
         x0, bounds = _start(model, ident.standard[b:b + 4])
         x0 = np.clip(x0, bounds[0] + 1e-12, bounds[1] - 1e-12)
         if np.ptp(qd[:, j]) == 0.0:  # a joint held still: only the offset is seen

@@ -19,7 +19,7 @@ import numpy as np
 from robodyn.identification.estimate import FOLDS, paired_se
 from robodyn.identification.friction import _fit_law, _law, _start, without_friction
 from robodyn.identification.preprocess import Samples
-from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
+from robodyn.symbolic.regressor import joint_columns
 
 __all__ = ["LAWS", "choose_friction_law"]
 
@@ -57,7 +57,7 @@ def choose_friction_law(ident: Any, samples: Sequence[Samples], y_full: Sequence
     n = qd.shape[1]
     per_block = {law: np.zeros(FOLDS) for law in LAWS}
     for j in range(n):
-        first = PER_JOINT * j + len(INERTIAL_NAMES) + 1
+        first = joint_columns(j, "Fv").start
         cols = np.vstack([y[:, j, first:first + 4] for y in y_full])  # Fv, Fcp, Fcn, Fo columns
         x0, bounds = _start("stribeck", ident.standard[first:first + 4])
         x0 = np.clip(x0, bounds[0] + 1e-12, bounds[1] - 1e-12)

@@ -61,7 +61,7 @@ from robodyn.measure.filtering import lowpass
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
-from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT, parameter_values
+from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT, joint_columns, parameter_values
 
 __all__ = ["check_recording", "identify", "nominal_standard"]
 
@@ -414,7 +414,7 @@ def _payload_gains(robot: Robot, data: _Prepared, loads: list[np.ndarray], drive
     # the prior's drive and friction terms were fitted in the units of the absorbed gains
     prior = prior.copy()
     for j in range(robot.dof):
-        prior[PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)] *= est.gains[j] / k[j]
+        prior[joint_columns(j)] *= est.gains[j] / k[j]
     return _Drive(est.gains, "payload", est.std), prior
 
 
@@ -551,7 +551,7 @@ def _split_coulomb(relations: BaseRelations, p: np.ndarray) -> np.ndarray:
     k = relations.matrix
     out = p.copy()
     for j in range(p.size // PER_JOINT):
-        idx = PER_JOINT * j + len(INERTIAL_NAMES) + np.array([2, 3, 4])  # Fcp, Fcn, Fo
+        idx = np.arange(p.size)[joint_columns(j, "Fcp", "Fo")]  # Fcp, Fcn, Fo
         _, sv, vt = np.linalg.svd(k[:, idx])
         null = vt[np.sum(sv > 1e-9 * max(sv[0], 1e-300)):]
         if null.shape[0] != 1:

@@ -47,6 +47,7 @@ import numpy as np
 from robodyn.identification.stacking import regressor_rows_of
 from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass, lowpass_columns
 from robodyn.robot.errors import IdentificationError
+from robodyn.symbolic.regressor import joint_columns
 
 __all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "DEAD_BAND", "MID_RATE", "Preprocess", "Samples",
            "SharedRows", "UnbandedRows", "auto_cutoff", "banded_rows", "coulomb_dead_band",
@@ -214,15 +215,12 @@ def preprocess(rec: Any, settings: Preprocess, target: str | None) -> Samples:
 def coulomb_dead_band(y: np.ndarray, qd: np.ndarray, band: float) -> np.ndarray:
     """The regressor ``y`` (N, n, 15 n) with joint j's Coulomb columns (``Fcp``, ``Fcn``) zero
     wherever ``|qd_j| < band`` (``qd`` (N, n), rad/s); ``y`` is changed in place and returned."""
-    from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
-
     if band <= 0:
         return y
     for j in range(qd.shape[1]):
         still = np.abs(qd[:, j]) < band
         if np.any(still):
-            c = PER_JOINT * j + len(INERTIAL_NAMES) + 2  # Fcp, then Fcn
-            y[still, j, c:c + 2] = 0.0
+            y[still, j, joint_columns(j, "Fcp", "Fcn")] = 0.0
     return y
 
 
@@ -286,15 +284,10 @@ class UnbandedRows:
 def unbanded_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool = True) -> UnbandedRows:
     """:func:`regressor_rows` of samples ``s`` without the dead band (``settings.dead_band`` is
     not used), with the Coulomb columns :func:`banded_rows` needs."""
-    from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
-
     d = settings.decimate if decimate else 1
     m = evaluation_step(s.t, settings, d)
     y = regressor_rows_of(model, s.q[::m], s.qd[::m], s.qdd[::m])
-    n = y.shape[1]
-    first = len(INERTIAL_NAMES) + 2  # Fcp, then Fcn, of each joint's parameter group
-    coulomb = np.stack([y[:, j, PER_JOINT * j + first:PER_JOINT * j + first + 2] for j in range(n)],
-                       axis=1)
+    coulomb = np.stack([y[:, j, joint_columns(j, "Fcp", "Fcn")] for j in range(y.shape[1])], axis=1)
     rows = filtered_rows(s.t[::m], y, settings, d // m)
     return UnbandedRows(rows, s.t[::m], s.qd[::m], coulomb, d // m)
 
@@ -304,8 +297,6 @@ def banded_rows(u: UnbandedRows, settings: Preprocess) -> np.ndarray:
     itself when no sample is inside the band (not a copy: do not modify it), else a copy whose
     Coulomb columns of the joints with samples inside are zeroed there, then filtered and
     decimated as the other columns were (:func:`filtered_rows`)."""
-    from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
-
     still = np.abs(u.qd) < settings.dead_band
     joints = np.flatnonzero(still.any(axis=0))
     if joints.size == 0:
@@ -314,9 +305,8 @@ def banded_rows(u: UnbandedRows, settings: Preprocess) -> np.ndarray:
     cols[still[:, joints]] = 0.0  # |qd_j| < band: joint j's Coulomb terms are zero
     cols = filtered_rows(u.t, cols, settings, u.keep)
     out = u.rows.copy()
-    first = len(INERTIAL_NAMES) + 2
     for i, j in enumerate(joints):
-        out[:, j, PER_JOINT * j + first:PER_JOINT * j + first + 2] = cols[:, i]
+        out[:, j, joint_columns(j, "Fcp", "Fcn")] = cols[:, i]
     return out
 
 

@@ -35,7 +35,7 @@ import sympy as sp
 from robodyn.identification.preprocess import Samples
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
-from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
+from robodyn.symbolic.regressor import joint_columns
 
 __all__ = ["GAIN_MODES", "REVERSED_CORRELATION", "IdentificationWarning", "current_directions",
            "description_gains", "joint_prior"]
@@ -60,7 +60,7 @@ def description_gains(robot: Robot) -> np.ndarray:
 def _joint_columns(y: np.ndarray, j: int) -> np.ndarray:
     """Joint ``j``'s own regressor columns (Ia, Fv, Fcp, Fcn, Fo) of its row, (N, 5)."""
     # Ia qdd + Fv qd + Fcp H(qd) - Fcn H(-qd) + Fo
-    return y[:, j, PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)]
+    return y[:, j, joint_columns(j)]
 
 
 def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.ndarray],
@@ -91,7 +91,7 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
     n = robot.dof
     rigid = nominal.copy()
     for j in range(n):
-        rigid[PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)] = 0.0
+        rigid[joint_columns(j)] = 0.0
     desc = description_gains(robot)
     if target == "tau":
         fixed, source = np.ones(n), "none"
@@ -125,7 +125,7 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
             gains[j] = 1.0 / coef[0]
             coef = coef[1:]
         ia, fv, fcp, fcn, fo = coef * gains[j]
-        prior[PER_JOINT * j + len(INERTIAL_NAMES):PER_JOINT * (j + 1)] = (
+        prior[joint_columns(j)] = (
             max(ia, 0.0), fv, max(fcp, 0.0), max(fcn, 0.0), fo)
         return True
 

@@ -32,6 +32,7 @@ import numpy as np
 from scipy import signal
 from scipy.interpolate import make_interp_spline
 
+from robodyn.measure.filtfilt_columns import filtfilt_columns
 from robodyn.robot.errors import RecordingError
 
 __all__ = ["CHUNK_BYTES", "METHODS", "bandwidth_cutoff", "differentiate", "is_uniform", "lowpass",
@@ -154,15 +155,9 @@ def _savgol_window(cutoff: float, fs: float, polyorder: int, n: int) -> int:
     return length
 
 
-#: Bytes of one column block's padded copy in :func:`_sosfiltfilt_columns`.
+#: Bytes of the columns resampled onto the uniform grid at a time in :func:`lowpass_columns`
+#: (irregular stamps).
 CHUNK_BYTES = 2 << 20
-
-
-def _filtfilt_block(sos: np.ndarray, block: np.ndarray, padlen: int) -> np.ndarray:
-    """``sosfiltfilt`` of ``block`` (N, c) along time, through a copy contiguous in time (a
-    strided axis-0 filter of a wide array copies every column through a buffer: about 3x
-    slower); (N, c)."""
-    return signal.sosfiltfilt(sos, np.ascontiguousarray(block.T), axis=-1, padlen=padlen).T
 
 
 def _block_columns(count: int, padlen: int) -> int:
@@ -171,22 +166,12 @@ def _block_columns(count: int, padlen: int) -> int:
 
 
 def _sosfiltfilt_columns(sos: np.ndarray, xu: np.ndarray, padlen: int) -> np.ndarray:
-    """``sosfiltfilt`` along axis 0 of ``xu`` (N,) or (N, c), a block of columns at a time.
-
-    The blocks are small (:data:`CHUNK_BYTES`): SciPy's temporaries (the padded copy, one per
-    pass) then stay in the cache and in memory the allocator reuses, where those of a whole
-    wide matrix (a regressor's hundreds of columns) are fresh pages every call, which the
-    kernel may first have to compact into huge pages (seconds on a fragmented machine). The
-    columns are independent: the result has the bits of one call on the whole matrix.
-    """
-    if xu.ndim == 1:
-        return signal.sosfiltfilt(sos, xu, padlen=padlen)
-    count, cols = xu.shape
-    out = np.empty((count, cols))
-    step = _block_columns(count, padlen)
-    for a in range(0, cols, step):
-        out[:, a:a + step] = _filtfilt_block(sos, xu[:, a:a + step], padlen)
-    return out
+    """``sosfiltfilt`` along axis 0 of ``xu`` (N,) or (N, c): every column, by
+    :func:`robodyn.measure.filtfilt_columns.filtfilt_columns` (the columns side by side)."""
+    x2 = xu.reshape(xu.shape[0], -1)
+    out = np.empty(x2.shape)
+    filtfilt_columns(sos, padlen, x2, np.arange(x2.shape[1]), out)
+    return out.reshape(xu.shape)
 
 
 def _butter(cutoff: float, fs: float, order: int, count: int) -> tuple[np.ndarray, int]:
@@ -327,15 +312,19 @@ def lowpass_columns(t: np.ndarray, x: np.ndarray, cutoff: float, columns: np.nda
         raise RecordingError(f"{what}: at least 8 samples are needed, got {t.size}")
     tu, resampled = _grid(t)
     sos, padlen = _butter(float(cutoff), 1.0 / float(tu[1] - tu[0]), order, tu.size)
+    if not resampled:
+        filtfilt_columns(sos, padlen, x, columns, out, keep)
+        # a non-finite input spreads through its column's recursion (both passes)
+        bad = np.flatnonzero(~np.isfinite(out[:, columns]).all(axis=0))
+        if bad.size:
+            _check_finite(x[:, columns[bad]], what, columns[bad])
+        return out
     step = _block_columns(tu.size, padlen)
     for a in range(0, columns.size, step):
         cols = columns[a:a + step]
         block = x[:, cols]
         _check_finite(block, what, cols)
-        if resampled:
-            # cubic onto the uniform grid, filtered there, cubic back onto the stamps
-            filtered = _filtfilt_block(sos, make_interp_spline(t, block, k=3, axis=0)(tu), padlen)
-            out[:, cols] = make_interp_spline(tu, filtered, k=3, axis=0)(np.clip(t, tu[0], tu[-1]))[::keep]
-        else:
-            out[:, cols] = _filtfilt_block(sos, block, padlen)[::keep]
+        # cubic onto the uniform grid, filtered there, cubic back onto the stamps
+        filtered = _sosfiltfilt_columns(sos, make_interp_spline(t, block, k=3, axis=0)(tu), padlen)
+        out[:, cols] = make_interp_spline(tu, filtered, k=3, axis=0)(np.clip(t, tu[0], tu[-1]))[::keep]
     return out

@@ -40,6 +40,13 @@ PER_JOINT = len(INERTIAL_NAMES) + len(JOINT_NAMES)
 _INERTIA_INDEX = {"XX": (0, 0), "XY": (0, 1), "XZ": (0, 2), "YY": (1, 1), "YZ": (1, 2), "ZZ": (2, 2)}
 
 
+def joint_columns(j: int, first: str = "Ia", last: str = "Fo") -> slice:
+    """Columns (of the 15 n) of joint ``j``'s drive parameters ``first`` to ``last`` (both
+    included, in :data:`JOINT_NAMES` order: Ia, Fv, Fcp, Fcn, Fo)."""
+    start = PER_JOINT * j + len(INERTIAL_NAMES)
+    return slice(start + JOINT_NAMES.index(first), start + JOINT_NAMES.index(last) + 1)
+
+
 def parameter_names(n: int) -> tuple[str, ...]:
     """Names of the 15 n parameters, in regressor column order."""
     return tuple(f"{name}{j + 1}" for j in range(n) for name in INERTIAL_NAMES + JOINT_NAMES)
