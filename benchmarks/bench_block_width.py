@@ -57,17 +57,23 @@ model.forward_dynamics(q[:64], qd[:64], tau[:64], threads=1)
 t = timing.interleaved({"ID": lambda: model.inverse_dynamics(q, qd, qdd, threads=1),
                         "FD": lambda: model.forward_dynamics(q, qd, tau, threads=1)}, repeat)
 check = {"tau": tau[:200].tolist(), "qdd": model.forward_dynamics(q[:200], qd[:200], tau[:200]).tolist()}
+import os
+from robodyn.codegen.build import compiler_flags, find_compiler
 from robodyn.codegen.cpu import BLOCK
-print(json.dumps({"times": t, "check": check, "block": BLOCK}))
+print(json.dumps({"times": t, "check": check, "block": BLOCK,
+                  "added": list(compiler_flags(os.environ.get("CC") or find_compiler(), BLOCK))}))
 """
 
 
 def _compiler_wrapper(folder: Path, extra: tuple[str, ...]) -> str:
-    """A ``CC`` script that runs the real compiler with ``extra`` flags after robodyn's."""
-    from robodyn.codegen.build import find_compiler
+    """A ``CC`` script that runs the real compiler with ``extra`` flags after robodyn's (named
+    ``...-gcc`` when that compiler is GCC, so that robodyn adds GCC's flags as for GCC itself:
+    :func:`robodyn.codegen.build.compiler_flags`)."""
+    from robodyn.codegen.build import compiler_flags, find_compiler
 
     real = find_compiler()
-    script = folder / f"cc-{'-'.join(f.strip('-') for f in extra)}"
+    gcc = "-gcc" if compiler_flags(real, 1) else ""
+    script = folder / f"cc-{'-'.join(f.strip('-') for f in extra)}{gcc}"
     script.write_text(f'#!/bin/sh\nexec {shlex.quote(real)} "$@" {" ".join(extra)}\n')
     script.chmod(0o755)
     return str(script)
@@ -89,6 +95,7 @@ def _run_worker(width: int, cc: str | None, cache: Path, count: int, repeat: int
 def sweep(count: int, passes: int, repeat: int) -> tuple[list[dict], float]:
     """Time every (flags, width) pair; rows and the largest deviation from scalar code."""
     times: dict[tuple[str, int], dict[str, list[float]]] = {}
+    added: dict[tuple[str, int], list[str]] = {}
     reference, deviation = None, 0.0
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
@@ -99,6 +106,7 @@ def sweep(count: int, passes: int, repeat: int) -> tuple[list[dict], float]:
             for isa, width in (pairs if k % 2 == 0 else pairs[::-1]):  # turns, both orders
                 out = _run_worker(width, ccs[isa], folder / "cache", count, repeat)
                 slot = times.setdefault((isa, width), {"ID": [], "FD": []})
+                added[(isa, width)] = out["added"]
                 for kernel in slot:
                     slot[kernel] += out["times"][kernel]
                 got = {key: np.array(v) for key, v in out["check"].items()}
@@ -107,7 +115,7 @@ def sweep(count: int, passes: int, repeat: int) -> tuple[list[dict], float]:
                 for key, ref in reference.items():
                     deviation = max(deviation, float(np.max(np.abs(got[key] - ref))
                                                      / np.max(np.abs(ref))))
-    rows = [{"isa": isa, "width": w,
+    rows = [{"isa": isa, "width": w, "added_flags": added[(isa, w)],
              **{kernel: results.summary(t, 1e9 / count, 1) for kernel, t in slot.items()}}
             for (isa, w), slot in sorted(times.items(), key=lambda kv: (list(ISAS).index(kv[0][0]),
                                                                         kv[0][1]))]

@@ -321,7 +321,11 @@ def render_block_width(data: dict[str, Any]) -> str:
         f"{isa} {kernel}: fastest at width {v['best_width']}, robodyn's {v['chosen_width']} "
         f"takes {v['chosen_over_best']:.2f}x its time"
         for isa, kernels in e["verdict"].items() for kernel, v in kernels.items())
-    lines += [""] + rc.wrap(f"Code: {'; '.join(f'{k}: {v}' for k, v in e['isas'].items())}. "
+    added = sorted({(r["width"], " ".join(r.get("added_flags", []))) for r in e["rows"]
+                    if r.get("added_flags")})
+    extra = "".join(f" Width {w} builds also get {f} (robodyn.codegen.build.compiler_flags)."
+                    for w, f in added)
+    lines += [""] + rc.wrap(f"Code: {'; '.join(f'{k}: {v}' for k, v in e['isas'].items())}.{extra} "
                             f"By the minima: {verdicts}.")
     return "\n".join(lines) + "\n"
 
