@@ -233,10 +233,12 @@ METHODS: Sequence[tuple[str, dict, str]] = (
      "rd.identify(robot, fit, target=...): the physically consistent program with the Tikhonov "
      "weight, velocity source, cut-off, friction law (linear or Stribeck), position ripple and "
      "drive modes (one second-order mode per joint) chosen by held-out time blocks of the fit "
-     "data"),
+     "data, and the predictions' Coulomb step smoothed over the fit data's velocity noise"),
+    ("no Coulomb smoothing", {"coulomb_width": 0.0},
+     "the default with the Coulomb step kept in predictions (coulomb_width=0): the default of "
+     "the previous version"),
     ("no drive modes", {"resonance": False},
-     "the default without the drive modes (resonance=False): the default of the previous "
-     "version"),
+     "the default without the drive modes (resonance=False)"),
     ("wls", {"method": "wls"},
      "method='wls' (weight of least held-out error; the same velocity, friction and ripple "
      "choices)"),
@@ -263,7 +265,8 @@ def _choices(ident: Any) -> dict[str, Any] | None:
         return None
     return {"velocity": c.velocity, "cutoff_hz": c.cutoff, "regularization": c.regularization,
             "friction": c.friction, "ripple": c.ripple, "candidates": len(c.candidates),
-            "modes": [[name, f0, zeta, round(gain, 3)] for name, f0, zeta, gain in c.resonance_modes]}
+            "modes": [[name, f0, zeta, round(gain, 3)] for name, f0, zeta, gain in c.resonance_modes],
+            "coulomb_width": [float(f"{w:.3g}") for w in np.atleast_1d(ident.coulomb_width)]}
 
 
 def run_case(case: Case, rows: list[list[str]]) -> dict[str, Any]:

@@ -69,8 +69,11 @@ def _choices(c: dict[str, Any] | None) -> str:
     modes = c.get("modes")
     drive = "" if modes is None else (", no drive mode" if not modes else ", drive modes on "
                                       + ", ".join(f"{m[0]} ({m[1]:g} Hz, share {m[3]:.2g})" for m in modes))
+    widths = [w for w in c.get("coulomb_width", []) if w > 0]
+    smooth = ("" if not widths else f", Coulomb step smoothed over {min(widths):.2g}"
+              + ("" if max(widths) == min(widths) else f"-{max(widths):.2g}") + " rad/s")
     return (f"{c['velocity']} velocity, {cut}, weight {c['regularization']:.3g}{friction}{ripple}"
-            f"{drive} (of {c['candidates']} preprocessing candidates)")
+            f"{drive}{smooth} (of {c['candidates']} preprocessing candidates)")
 
 
 def _best_other(models: dict[str, Any], figure: str) -> str:

@@ -147,33 +147,42 @@ def test_consistent_estimate_satisfies_the_lmis_and_loads_strict(tmp_path):
     assert np.all(np.abs(ident.base_parameters.values - true) <= 5 * ols.base_parameters.std + 1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rate", ["100Hz-irregular", "1kHz"])
 def test_defaults_on_a_noisy_log(rate):
     """rd.identify(robot, recordings) with no options: positions with encoder-like noise,
     no velocities or accelerations, noisy torque (2 % of each joint's peak); 100 Hz with 10-12 ms
     stamps, or 1 kHz. Without filtering the regressor like the target (parallel filtering) the
-    smoothed Coulomb steps biased this to 0.044."""
+    smoothed Coulomb steps biased this to 0.044.
+
+    Four runs, the error pooled over them: a run's error against the noise-free torque is
+    decided by the few samples near velocity reversals (a Coulomb step of 25 N m predicted with
+    the wrong sign, or smoothed where the sign was right), so one run alone ranges 0.0015-0.012
+    here with the default and 0.0008-0.0135 with the step kept (``coulomb_width=0``)."""
     robot = load_quiet("puma560")
     model = rd.compile_model(robot)
-    rng = np.random.default_rng(11)
-    if rate == "1kHz":
-        t = np.arange(0.0, 20.0, 1e-3)
-    else:
-        t = np.cumsum(rng.uniform(0.010, 0.012, 1800))
     from tests.identification.helpers import fourier
 
-    q, qd, qdd = fourier(t, robot.dof, rng)
-    tau = model.inverse_dynamics(q, qd, qdd)
-    noise_tau = 0.02 * np.abs(tau).max(axis=0)
-    rec = rd.Recording(t=t, q=q + rng.normal(0, 1e-4, q.shape),
-                       tau=tau + rng.standard_normal(tau.shape) * noise_tau, source=rate)
-    ident = rd.identify(robot, rec, model=model)
-    assert ident.preprocess.cutoff is not None and ident.preprocess.decimate >= 1
-    pred = ident.predict(rec)
-    inner = slice(t.size // 20, -t.size // 20)  # away from the filter's end effects
-    err = np.linalg.norm(pred[inner] - tau[inner]) / np.linalg.norm(tau[inner])
-    print(f"{rate}: {ident.preprocess}, relative error against the noise-free torque {err:.4f}")
-    assert err < 0.01  # measured 0.0029 (100 Hz) and 0.0044 (1 kHz)
+    err, ref = 0.0, 0.0
+    for seed in (11, 12, 13, 14):
+        rng = np.random.default_rng(seed)
+        if rate == "1kHz":
+            t = np.arange(0.0, 20.0, 1e-3)
+        else:
+            t = np.cumsum(rng.uniform(0.010, 0.012, 1800))
+        q, qd, qdd = fourier(t, robot.dof, rng)
+        tau = model.inverse_dynamics(q, qd, qdd)
+        noise_tau = 0.02 * np.abs(tau).max(axis=0)
+        rec = rd.Recording(t=t, q=q + rng.normal(0, 1e-4, q.shape),
+                           tau=tau + rng.standard_normal(tau.shape) * noise_tau, source=rate)
+        ident = rd.identify(robot, rec, model=model)
+        assert ident.preprocess.cutoff is not None and ident.preprocess.decimate >= 1
+        inner = slice(t.size // 20, -t.size // 20)  # away from the filter's end effects
+        err += float(np.sum((ident.predict(rec)[inner] - tau[inner]) ** 2))
+        ref += float(np.sum(tau[inner] ** 2))
+    rel = np.sqrt(err / ref)
+    print(f"{rate}: pooled relative error against the noise-free torque {rel:.4f}")
+    assert rel < 0.01  # measured 0.0065 (100 Hz) and 0.0065 (1 kHz)
 
 
 def test_coulomb_split_is_non_negative_and_keeps_the_base_parameters():

@@ -134,7 +134,8 @@ def _cmd_identify(args: argparse.Namespace) -> int:
         ident = rd.identify(robot, recs + loaded, target=args.target, method=args.method,
                             model=model,
                             friction=args.friction, velocity=args.velocity,
-                            dead_band=args.dead_band, spikes=args.spikes, cutoff=args.cutoff,
+                            dead_band=args.dead_band, coulomb_width=args.coulomb_width,
+                            spikes=args.spikes, cutoff=args.cutoff,
                             regularization=args.regularization, decimate=args.decimate,
                             sensor=args.sensor, ripple=args.ripple, resonance=args.resonance,
                             prediction_cutoff=args.prediction_cutoff, **extra)
@@ -158,17 +159,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                                                                       strict=True))
         print(f"drive gains from the payload run(s), N m/A: {gain_text}")
     paths["metrics"] = _write_metrics([v for _, v in vals], out / "validation.csv")
-    pre = ident.prediction_settings
-    note = ("predicted by the identified model at states processed as the identification's: "
-            + ("measured velocity" if pre.velocity == "measured" else "velocity from positions")
-            + ("" if pre.cutoff is None else f", zero-phase low-pass at {pre.cutoff:.3g} Hz")
-            + (f", Coulomb dead band {pre.dead_band:g} rad/s" if pre.dead_band else ""))
-    if pre.velocity == "position" and not pre.dead_band and ident.friction_fit is None \
-            and ident.thermal_fit is None and ident.ripple_fit is None and pre.cutoff is not None \
-            and ident.resonance_fit is None \
-            and ident.prediction is None:
-        note += (f"; robodyn validate {paths['yaml']} --target {ident.target} --cutoff "
-                 f"{pre.cutoff:.17g} reproduces these figures from the written description")
+    note = _prediction_note(ident, paths["yaml"])
     for k, path in enumerate(_write_predictions(vals, out, note)):
         paths[f"predictions{k + 1}"] = path
     if not args.no_report:
@@ -187,6 +178,32 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     for kind, path in paths.items():
         print(f"wrote {kind:<10} {path}")
     return _check_loadable(paths["yaml"])
+
+
+def _prediction_note(ident: Any, yaml_path: Path) -> str:
+    """How the written predictions were made, and the ``robodyn validate`` command that
+    reproduces them from the written description where the description alone does."""
+    pre = ident.prediction_settings
+    note = ("predicted by the identified model at states processed as the identification's: "
+            + ("measured velocity" if pre.velocity == "measured" else "velocity from positions")
+            + ("" if pre.cutoff is None else f", zero-phase low-pass at {pre.cutoff:.3g} Hz")
+            + (f", Coulomb dead band {pre.dead_band:g} rad/s" if pre.dead_band else "")
+            + _smoothing_note(ident.coulomb_width))
+    fits = (ident.friction_fit, ident.thermal_fit, ident.ripple_fit, ident.resonance_fit,
+            ident.prediction)
+    if pre.velocity == "position" and pre.cutoff is not None and not pre.dead_band \
+            and not np.any(ident.coulomb_width) and all(f is None for f in fits):
+        note += (f"; robodyn validate {yaml_path} --target {ident.target} --cutoff "
+                 f"{pre.cutoff:.17g} reproduces these figures from the written description")
+    return note
+
+
+def _smoothing_note(width: float | np.ndarray) -> str:
+    """The predictions' Coulomb smoothing as the note says it ("" without one)."""
+    if not np.any(width):
+        return ""
+    text = ", ".join(f"{w:.2g}" for w in np.atleast_1d(width))
+    return f", Coulomb step smoothed over {text} rad/s"
 
 
 def _compiled(robot: rd.Robot) -> rd.Model:
@@ -422,6 +439,19 @@ def _auto_on_off(text: str) -> bool | str:
     return values[text]
 
 
+def _width(text: str) -> float | str:
+    """``--coulomb-width``: "auto" or a finite velocity >= 0."""
+    if text == "auto":
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected auto or a velocity in rad/s, got {text!r}") from None
+    if not (np.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"expected auto or a finite velocity >= 0, got {text!r}")
+    return value
+
+
 def _prediction_cutoff(text: str) -> float | str:
     """``--prediction-cutoff``: "fit", "auto" or a frequency in Hz."""
     if text in ("fit", "auto"):
@@ -445,6 +475,12 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
                    help="Coulomb dead band in rad/s, in the fit and the prediction alike (below "
                         "it a joint carries only its friction offset), or auto: 0 or 1e-3 chosen "
                         "by held-out time blocks (default: %(default)s)")
+    p.add_argument("--coulomb-width", type=_width, default="auto", metavar="{auto,RAD_S}",
+                   help="velocity in rad/s over which the predictions smooth the Coulomb step "
+                        "(tanh(qd / width)): the expected friction where the estimated velocity's "
+                        "sign is uncertain (joints held still, slow reversals); the fit keeps the "
+                        "step; 0: none; auto: per joint, from the noise of the identification "
+                        "data's processed velocity (default: %(default)s)")
     p.add_argument("--spikes", choices=SPIKES, default="keep",
                    help="one-sample glitches (a position or target sample far off the line "
                         "through its neighbours) in the identification recordings: keep them, or "

@@ -57,6 +57,13 @@ class IdentifyOptions:
         Coulomb dead band, rad/s (m/s): below it a joint's Coulomb columns are zero and only the
         friction offset acts, in the fit and in :meth:`Identification.predict` alike; 0: none;
         "auto": 0 or ``DEAD_BAND`` (1e-3), chosen by time-block cross-validation.
+    coulomb_width : "auto" or float
+        Velocity, rad/s (m/s), over which :meth:`Identification.predict` smooths the linear
+        law's Coulomb step: where the joint moves, ``H(qd)`` becomes ``(1 + tanh(qd / w)) / 2``,
+        the expected step where the estimated velocity's sign is uncertain (a joint held still
+        or creeping through a reversal); the fit and the other choices keep the step. "auto"
+        (the default): per joint, from the noise of the identification recordings' processed
+        velocity (:mod:`robodyn.identification.coulomb_width`); 0: no smoothing.
     gains : {"auto", "description", "absorbed"}
         Drive gains for ``target="current"`` (:func:`robodyn.identification.prior.joint_prior`).
     bounds : mapping of str to (float, float), optional
@@ -115,6 +122,7 @@ class IdentifyOptions:
     decimate: int | str = "auto"
     velocity: str = "auto"
     dead_band: float | str = 0.0
+    coulomb_width: float | str = "auto"
     gains: str = "auto"
     bounds: Mapping[str, tuple[float, float]] | None = None
     weights: str = "residual"
@@ -140,6 +148,12 @@ class IdentifyOptions:
         if isinstance(self.dead_band, str) and self.dead_band != "auto":
             raise IdentificationError(f"dead_band: expected a velocity in rad/s or 'auto', got "
                                       f"{self.dead_band!r}")
+        cw = self.coulomb_width
+        if cw != "auto" and (isinstance(cw, (bool, str))
+                             or not isinstance(cw, (int, float, np.integer, np.floating))
+                             or not (np.isfinite(cw) and 0 <= cw < 1e3)):
+            raise IdentificationError(f"coulomb_width: expected 'auto' or a velocity in "
+                                      f"[0, 1000) rad/s, got {cw!r}")
         _choice("gains", self.gains, ("auto", "description", "absorbed"))
         _choice("spikes", self.spikes, SPIKES)
         for name in ("ripple", "resonance"):

@@ -31,6 +31,7 @@ from robodyn.identification.bandwidth import check_prediction_cutoff, with_predi
 from robodyn.identification.base import BaseRelations, base_relations
 from robodyn.identification.choices import Candidate, Choices, Problem, candidates, choose
 from robodyn.identification.completion import consistent_completion
+from robodyn.identification.coulomb_width import auto_coulomb_width
 from robodyn.identification.drive_gains import estimate_drive_gains
 from robodyn.identification.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identification.friction import NONLINEAR, fit_friction_samples, without_friction
@@ -104,7 +105,8 @@ def _stack(samples: Sequence[Samples], y_full: Sequence[np.ndarray], columns: np
 def identify(robot: Robot, recordings: Any, target: str | None = None, method: str = "consistent", *,
              friction: str = "auto", regularization: float | str | None = "auto",
              cutoff: float | str | None = "auto", decimate: int | str = "auto",
-             velocity: str = "auto", dead_band: float | str = 0.0, gains: str = "auto",
+             velocity: str = "auto", dead_band: float | str = 0.0,
+             coulomb_width: float | str = "auto", gains: str = "auto",
              bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None,
              payloads: Sequence[Payload | None] | None = None, weights: str = "residual",
              state_noise: Any = None, thermal: bool | str = False, sensor: str = "motor",
@@ -123,11 +125,12 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         ``tau`` or ``current`` (N, n).
     target : {"tau", "current"}, optional
         Default: ``"tau"`` when every recording has torques, else ``"current"``.
-    method, friction, regularization, cutoff, decimate, velocity, dead_band, gains, bounds
+    method, friction, regularization, cutoff, decimate, velocity, dead_band, coulomb_width
         The choices: the attributes of the same names of
         :class:`~robodyn.identification.options.IdentifyOptions` (what each does, its values
         and default). ``method``: "ols", "wls" or "consistent" (default).
-    weights, state_noise, thermal, sensor, spikes, ripple, resonance, prediction_cutoff
+    gains, bounds, weights, state_noise, thermal, sensor, spikes, ripple, resonance,
+    prediction_cutoff
         Likewise.
     model : Model, optional
         A compiled model of ``robot`` to reuse (default ``rd.compile_model(robot)``).
@@ -153,9 +156,10 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     """
     opts = resolve(IdentifyOptions, options, dict(
         method=method, friction=friction, regularization=regularization, cutoff=cutoff,
-        decimate=decimate, velocity=velocity, dead_band=dead_band, gains=gains, bounds=bounds,
-        weights=weights, state_noise=state_noise, thermal=thermal, sensor=sensor, spikes=spikes,
-        ripple=ripple, resonance=resonance, prediction_cutoff=prediction_cutoff),
+        decimate=decimate, velocity=velocity, dead_band=dead_band, coulomb_width=coulomb_width,
+        gains=gains, bounds=bounds, weights=weights, state_noise=state_noise, thermal=thermal,
+        sensor=sensor, spikes=spikes, ripple=ripple, resonance=resonance,
+        prediction_cutoff=prediction_cutoff),
         IdentificationError)
     recs, target, pays = checked_inputs(robot, recordings, target, opts.sensor, payloads)
     check_prediction_cutoff(recs, opts.prediction_cutoff)
@@ -225,7 +229,10 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
                          opts.ripple)
     result = with_prediction_cutoff(result, recs, pays, target, opts.prediction_cutoff)
     result = with_resonance(result, recs, pays, target, opts.resonance)
-    return replace(result, options=opts)
+    # last: the prediction's Coulomb step smoothed (the fit and every choice made with the step)
+    width = (auto_coulomb_width(recs, result.preprocess) if opts.coulomb_width == "auto"
+             else float(opts.coulomb_width))
+    return replace(result, options=opts, coulomb_width=width)
 
 
 @dataclass(frozen=True, eq=False)

@@ -147,6 +147,12 @@ class Identification:
     ripple_fit : RippleFit or None
         The position ripple (:mod:`robodyn.identification.ripple`): :meth:`predict` adds its
         torque; ``robot`` does not carry it.
+    coulomb_width : float or numpy.ndarray, shape (n,)
+        Velocity per joint (rad/s, m/s) over which :meth:`predict` smooths the linear law's
+        Coulomb step (where the joint moves, ``H(qd)`` becomes ``(1 + tanh(qd / w)) / 2``,
+        :mod:`robodyn.identification.coulomb_width`); 0: the step itself. The fit and the
+        other choices are made with the step (option ``coulomb_width`` of
+        :func:`robodyn.identify`).
     prediction : Preprocess or None
         The processing :meth:`predict` uses when it differs from ``preprocess``: the same with
         the prediction cut-off chosen from the data (:mod:`robodyn.identification.bandwidth`).
@@ -180,6 +186,7 @@ class Identification:
     ripple_fit: RippleFit | None = None
     prediction: Preprocess | None = None
     resonance_fit: ResonanceFit | None = None
+    coulomb_width: float | np.ndarray = 0.0
 
     @property
     def gains_identified(self) -> bool:
@@ -190,7 +197,8 @@ class Identification:
         """Predicted target at the recording's own samples.
 
         The raw recording is processed as the identification data were, by the same functions
-        (same filter order, same derivative estimates, the same Coulomb dead band), without
+        (same filter order, same derivative estimates, the same Coulomb dead band; the Coulomb
+        step smoothed over :attr:`coulomb_width` when it is not 0), without
         decimation, at the prediction cut-off (:attr:`prediction_settings`: the fit's, or a
         wider one chosen from the data by :mod:`robodyn.identification.bandwidth`); the
         prediction is the model's effort ``Y(q, qd, qdd) p`` at the processed states
@@ -261,7 +269,8 @@ class Identification:
         for a in range(0, count, EFFORT_CHUNK):
             b = min(a + EFFORT_CHUNK, count)
             part = Samples(s.t[a:b], s.q[a:b], s.qd[a:b], s.qdd[a:b], None, s.source)
-            y = prediction_rows(self._model, part, self.preprocess, out=buf[:b - a])
+            y = prediction_rows(self._model, part, self.preprocess, out=buf[:b - a],
+                                coulomb_width=self.coulomb_width)
             out[a:b] = self._effort_of(part, y, None if temperature is None else temperature[a:b], pay)
         return out
 

@@ -157,8 +157,10 @@ def _choices_html(ident: Any) -> str:
         table = html_table(["candidate", "held-out blocks, relative", "best weight", ""],
                            [(c.label, f"{c.score:.4f}", f"{c.lam:g}", "chosen" if c.key == chosen else "")
                             for c in ch.candidates])
+    width = np.atleast_1d(getattr(ident, "coulomb_width", 0.0))
+    widths = ", ".join(f"{w:.2g}" for w in width) if np.any(width) else ""
     return render("choices.html.j2", ch=ch, cutoff=_cutoff(ident), table=Markup(table),
-                  scores=lambda pairs: ", ".join(f"{k} {v:.4f}" for k, v in pairs))
+                  widths=widths, scores=lambda pairs: ", ".join(f"{k} {v:.4f}" for k, v in pairs))
 
 
 def _cutoff(ident: Any) -> str:
