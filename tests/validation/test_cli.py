@@ -301,11 +301,11 @@ def test_validate_and_underwater_without_a_c_compiler(files, tmp_path, monkeypat
 def test_validate_on_the_written_description_gives_identify_figures(files, tmp_path, capsys):
     # issue 25 item 3: one model, one verdict
     train, held = files
-    # a written description carries no drive modes (nor a nonlinear friction law): only a model
-    # without them is reproduced from it, so they are switched off
+    # a written description carries no drive modes, nonlinear friction law or smoothed Coulomb
+    # step: only a model without them is reproduced from it, so they are switched off
     rc = main(["identify", "puma560", "--data", str(train), "--validate", str(held), "--method",
                "consistent", "--velocity", "position", "--friction", "linear", "--resonance", "off",
-               "--no-report", "-o", str(tmp_path / "id")])
+               "--coulomb-width", "0", "--no-report", "-o", str(tmp_path / "id")])
     out = capsys.readouterr().out
     assert rc in (0, 1)
     hint = out.split("robodyn validate ")[1].split(" reproduces")[0].split()
