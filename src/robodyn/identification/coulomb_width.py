@@ -30,14 +30,13 @@ from typing import Any
 
 import numpy as np
 
+from robodyn.identification.preprocess import MOVING_RAD
 from robodyn.measure.filtering import differentiate, lowpass
 
 __all__ = ["WIDTH_PER_NOISE", "auto_coulomb_width", "velocity_noise"]
 
 #: ``w / s``: tanh(x / w) and erf(x / (sqrt(2) s)) have the same slope at 0 (module docstring).
 WIDTH_PER_NOISE = float(np.sqrt(np.pi / 2.0))
-#: A joint whose position spans less than this (rad or m) is held still (as in preprocess).
-_MOVING = 1e-3
 #: Fewest samples for a noise estimate of a recording.
 _MIN_SAMPLES = 64
 #: The five samples of a window of :func:`_white_std`.
@@ -94,7 +93,7 @@ def velocity_noise(rec: Any, settings: Any) -> np.ndarray:
         source = q
         gain = np.linalg.norm(differentiate(t, impulse, settings.cutoff, order=settings.order)[1])
     s = _white_std(t, source) * gain  # white noise through the prediction's linear operator
-    s[np.ptp(q, axis=0) < _MOVING] = 0.0
+    s[np.ptp(q, axis=0) < MOVING_RAD] = 0.0  # held still: processed velocity exactly 0
     return s
 
 

@@ -22,20 +22,24 @@ from typing import Any
 import numpy as np
 
 from robodyn.identification.estimate import truncated_lstsq
-from robodyn.identification.preprocess import Preprocess, preprocess, resolve_preprocess
+from robodyn.identification.preprocess import (
+    MOVING_RAD,
+    Preprocess,
+    preprocess,
+    resolve_preprocess,
+)
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
 
 __all__ = ["JOINT_PARAMETERS", "JointIdentification", "identify_joint", "moving_joint"]
 
 JOINT_PARAMETERS = ("J", "Gs", "Gc", "Fv", "Fcp", "Fcn", "Fo")
-_MOVING_RAD = 1e-3  # as in preprocess: a joint spanning less never moves (rad or m)
 
 
 def moving_joint(rec: Any) -> int | None:
     """The one joint whose position spans at least 1 mrad while the others do not (else None)."""
     span = np.ptp(np.asarray(rec.q, float), axis=0)
-    moving = np.flatnonzero(span >= _MOVING_RAD)
+    moving = np.flatnonzero(span >= MOVING_RAD)
     return int(moving[0]) if moving.size == 1 else None
 
 
@@ -127,15 +131,15 @@ def identify_joint(robot: Robot, recording: Any, joint: int | str | None = None,
     if joint is None:
         j = moving_joint(recording)
         if j is None:
-            moving = [robot.joint_names[k] for k in np.flatnonzero(span >= _MOVING_RAD)]
+            moving = [robot.joint_names[k] for k in np.flatnonzero(span >= MOVING_RAD)]
             raise IdentificationError(f"{src}: q: per-joint identification needs exactly one moving "
                                       f"joint, found {moving or 'none'}; pass joint=")
     else:
         j = robot.joint_names.index(joint) if isinstance(joint, str) else int(joint)
     name = robot.joint_names[j]
-    if span[j] < _MOVING_RAD:
+    if span[j] < MOVING_RAD:
         raise IdentificationError(
-            f"{src}: q: joint {name!r} never moves (position span {span[j]:.3g} < {_MOVING_RAD:g}): "
+            f"{src}: q: joint {name!r} never moves (position span {span[j]:.3g} < {MOVING_RAD:g}): "
             f"its inertia, gravity and friction are unidentifiable from this recording")
     settings = resolve_preprocess([recording], cutoff, decimate)
     s = preprocess(recording, settings, target)

@@ -49,15 +49,16 @@ from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass, 
 from robodyn.robot.errors import IdentificationError
 from robodyn.symbolic.regressor import joint_columns
 
-__all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "DEAD_BAND", "MID_RATE", "Preprocess", "Samples",
-           "SharedRows", "UnbandedRows", "auto_cutoff", "banded_rows", "coulomb_dead_band",
-           "coulomb_smoothing",
-           "evaluation_step", "filtered_rows", "prediction_rows", "preprocess", "regressor_rows",
-           "resolve_preprocess", "slowest_rate", "unbanded_rows"]
+__all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "DEAD_BAND", "MID_RATE", "MOVING_RAD", "Preprocess",
+           "Samples", "SharedRows", "UnbandedRows", "auto_cutoff", "banded_rows",
+           "coulomb_dead_band", "coulomb_smoothing", "evaluation_step", "filtered_rows",
+           "prediction_rows", "preprocess", "regressor_rows", "resolve_preprocess",
+           "slowest_rate", "unbanded_rows"]
 
 AUTO_MIN_HZ = 2.0
 AUTO_MAX_HZ = 5.0
-_MOVING_RAD = 1e-3  # a joint whose position spans less than this never moves (rad or m)
+#: A joint whose position spans less than this never moves (rad or m).
+MOVING_RAD = 1e-3
 #: Coulomb dead band, rad/s (m/s): below it a joint's Coulomb columns are zero.
 DEAD_BAND = 1e-3
 #: Samples per cut-off period kept for the parallel filtering of the regressor.
@@ -130,7 +131,7 @@ def auto_cutoff(recordings: Sequence[Any]) -> float:
     bands = []
     for r in recordings:
         q = np.asarray(r.q, float)
-        moving = np.ptp(q, axis=0) > _MOVING_RAD
+        moving = np.ptp(q, axis=0) > MOVING_RAD
         if np.any(moving) and q.shape[0] >= 16:
             bands.append(bandwidth_cutoff(np.asarray(r.t, float), q[:, moving]))
     band = max(bands) if bands else AUTO_MIN_HZ
@@ -206,7 +207,7 @@ def preprocess(rec: Any, settings: Preprocess, target: str | None) -> Samples:
         # qd = H qd_measured, qdd = d qd / dt
         qd_f, qdd, _ = differentiate(t, np.asarray(rec.qd, float), cut, order=order)
         qd = qd_f
-    held = np.ptp(q, axis=0) < _MOVING_RAD
+    held = np.ptp(q, axis=0) < MOVING_RAD
     qd[:, held] = 0.0  # a joint held still: its filtered encoder noise is no motion
     qdd[:, held] = 0.0
     y_f = None if y is None else lowpass(t, y, cut, order=order)  # the same H on the target
