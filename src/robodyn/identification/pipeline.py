@@ -27,18 +27,17 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from robodyn.identification.bandwidth import check_prediction_cutoff, with_prediction_cutoff
+from robodyn.identification.bandwidth import check_prediction_cutoff
 from robodyn.identification.base import BaseRelations, base_relations
 from robodyn.identification.choices import Candidate, Choices, Problem, candidates, choose
 from robodyn.identification.completion import consistent_completion
-from robodyn.identification.coulomb_width import auto_coulomb_width
 from robodyn.identification.drive_gains import estimate_drive_gains
 from robodyn.identification.estimate import FOLDS, LinearFit, fit_linear
-from robodyn.identification.friction import NONLINEAR, fit_friction_samples, without_friction
-from robodyn.identification.friction_choice import choose_friction_law
+from robodyn.identification.friction import without_friction
 from robodyn.identification.inputs import check_recording, checked_inputs
 from robodyn.identification.options import IdentifyOptions
 from robodyn.identification.payload import Payload, payload_standard, payload_torque
+from robodyn.identification.prediction_terms import with_prediction_terms
 from robodyn.identification.preprocess import (
     DEAD_BAND,
     Preprocess,
@@ -50,9 +49,7 @@ from robodyn.identification.preprocess import (
     slowest_rate,
 )
 from robodyn.identification.prior import joint_prior
-from robodyn.identification.resonance import with_resonance
 from robodyn.identification.result import BaseParameters, Identification
-from robodyn.identification.ripple import gravity_free_joints, with_ripple
 from robodyn.identification.spikes import drop_spikes
 from robodyn.identification.state_noise import state_noise_std, torque_variance
 from robodyn.identification.thermal import ThermalData, ThermalFit, thermal_data
@@ -213,26 +210,8 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     result = replace(result, choices=Choices(best.velocity, best.dead_band, data.settings.cutoff,
                                              step.fit.lam, tuple(scored), reason, best.thermal, best),
                      thermal_fit=thermal_fit)
-    law = opts.friction
-    if opts.friction == "auto":
-        # thermal friction scales the linear law's columns: with it the linear law stays
-        law, scores = (("linear", {}) if thermal_fit is not None
-                       else choose_friction_law(result, data.samples, data.y_full))
-        result = replace(result, choices=replace(result.choices, friction=law,
-                                                 friction_scores=tuple(scores.items())))
-    if law in NONLINEAR:
-        result = replace(result, friction_fit=fit_friction_samples(result, data.samples, data.y_full,
-                                                                    law))
-    revolute = np.array([j.type == "revolute" for j in robot.joints])
-    result = with_ripple(result, data.full, data.samples, data.y_full, data.settings,
-                         gravity_free_joints(model, revolute),
-                         opts.ripple)
-    result = with_prediction_cutoff(result, recs, pays, target, opts.prediction_cutoff)
-    result = with_resonance(result, recs, pays, target, opts.resonance)
-    # last: the prediction's Coulomb step smoothed (the fit and every choice made with the step)
-    width = (auto_coulomb_width(recs, result.preprocess) if opts.coulomb_width == "auto"
-             else float(opts.coulomb_width))
-    return replace(result, options=opts, coulomb_width=width)
+    return with_prediction_terms(result, recs, pays, target, opts, data.samples, data.y_full,
+                                 data.full, data.settings)
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,0 +1,83 @@
+"""What a prediction adds to the linear fit, each term chosen on the identification data.
+
+After the linear step (:func:`robodyn.identification.identify`: base parameters, drive gains,
+linear friction), in this order:
+
+1. the friction law (:mod:`robodyn.identification.friction_choice`; a nonlinear law fitted by
+   :mod:`robodyn.identification.friction`);
+2. the position ripple (:mod:`robodyn.identification.ripple`);
+3. the prediction's cut-off (:mod:`robodyn.identification.bandwidth`);
+4. the drive modes (:mod:`robodyn.identification.resonance`);
+5. last, the smoothed Coulomb step (:mod:`robodyn.identification.coulomb_width`): the fit and every
+   choice above are made with the step.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from robodyn.identification.bandwidth import with_prediction_cutoff
+from robodyn.identification.coulomb_width import auto_coulomb_width
+from robodyn.identification.friction import NONLINEAR, fit_friction_samples
+from robodyn.identification.friction_choice import choose_friction_law
+from robodyn.identification.options import IdentifyOptions
+from robodyn.identification.preprocess import Preprocess, Samples
+from robodyn.identification.resonance import with_resonance
+from robodyn.identification.result import Identification
+from robodyn.identification.ripple import gravity_free_joints, with_ripple
+
+__all__ = ["with_prediction_terms"]
+
+
+def with_prediction_terms(result: Identification, recs: Sequence[Any], pays: Sequence[Any],
+                          target: str, opts: IdentifyOptions, samples: Sequence[Samples],
+                          y_full: Sequence[np.ndarray], full: Sequence[Samples],
+                          settings: Preprocess) -> Identification:
+    """``result`` (the linear step, its choices set) with the terms of the module docstring.
+
+    Parameters
+    ----------
+    result : Identification
+        The linear step's identification.
+    recs, pays : sequence
+        The fit's recordings and their payloads (None: none).
+    target : {"tau", "current"}
+    opts : IdentifyOptions
+        The run's options (``friction``, ``ripple``, ``prediction_cutoff``, ``resonance``,
+        ``coulomb_width``); stored as ``result.options``.
+    samples : sequence of Samples
+        The fit's processed, decimated samples, (N_k, n).
+    y_full : sequence of numpy.ndarray, shape (N_k, n, 15 n)
+        Their filtered regressor rows.
+    full : sequence of Samples
+        The processed samples before decimation.
+    settings : Preprocess
+        The fit's processing.
+
+    Returns
+    -------
+    Identification
+    """
+    law = opts.friction
+    if opts.friction == "auto":
+        # thermal friction scales the linear law's columns: with it the linear law stays
+        law, scores = (("linear", {}) if result.thermal_fit is not None
+                       else choose_friction_law(result, samples, y_full))
+        result = replace(result, choices=replace(result.choices, friction=law,
+                                                 friction_scores=tuple(scores.items())))
+    if law in NONLINEAR:
+        result = replace(result, friction_fit=fit_friction_samples(result, samples, y_full, law))
+    model = result._model
+    revolute = np.array([j.type == "revolute" for j in result.robot.joints])
+    result = with_ripple(result, full, samples, y_full, settings,
+                         gravity_free_joints(model, revolute), opts.ripple)
+    result = with_prediction_cutoff(result, recs, pays, target, opts.prediction_cutoff)
+    result = with_resonance(result, recs, pays, target, opts.resonance)
+    # last: the prediction's Coulomb step smoothed (the fit and every choice made with the step)
+    width = (auto_coulomb_width(recs, result.preprocess) if opts.coulomb_width == "auto"
+             else float(opts.coulomb_width))
+    return replace(result, options=opts, coulomb_width=width)
