@@ -147,13 +147,22 @@ def test_consistent_estimate_satisfies_the_lmis_and_loads_strict(tmp_path):
     assert np.all(np.abs(ident.base_parameters.values - true) <= 5 * ols.base_parameters.std + 1e-9)
 
 
+#: Stamps of the noisy logs of ``test_defaults_on_a_noisy_log`` (issue 20 item 3: 50 Hz to 4 kHz),
+#: and the bound on the pooled error. The error is the Coulomb steps placed about one sample off
+#: at velocity reversals (over 90 % of it lies where |qd| < 0.05 rad/s at 50 Hz), so its bound
+#: grows with the sample period below 100 Hz.
+RATES = {"50Hz-irregular": ((0.018, 0.022, 1500), 0.02), "100Hz-irregular": ((0.010, 0.012, 1800), 0.01),
+         "1kHz": (1e-3, 0.01), "4kHz": (2.5e-4, 0.01)}
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("rate", ["100Hz-irregular", "1kHz"])
+@pytest.mark.parametrize("rate", list(RATES))
 def test_defaults_on_a_noisy_log(rate):
     """rd.identify(robot, recordings) with no options: positions with encoder-like noise,
-    no velocities or accelerations, noisy torque (2 % of each joint's peak); 100 Hz with 10-12 ms
-    stamps, or 1 kHz. Without filtering the regressor like the target (parallel filtering) the
-    smoothed Coulomb steps biased this to 0.044.
+    no velocities or accelerations, noisy torque (2 % of each joint's peak); 50 Hz with 18-22 ms
+    stamps, 100 Hz with 10-12 ms stamps, 1 kHz (20 s) or 4 kHz (10 s). Without filtering the
+    regressor like the target (parallel filtering) the smoothed Coulomb steps biased this to
+    0.044 at 100 Hz.
 
     Four runs, the error pooled over them: a run's error against the noise-free torque is
     decided by the few samples near velocity reversals (a Coulomb step of 25 N m predicted with
@@ -163,13 +172,14 @@ def test_defaults_on_a_noisy_log(rate):
     model = rd.compile_model(robot)
     from tests.identification.helpers import fourier
 
+    stamps, bound = RATES[rate]
     err, ref = 0.0, 0.0
     for seed in (11, 12, 13, 14):
         rng = np.random.default_rng(seed)
-        if rate == "1kHz":
-            t = np.arange(0.0, 20.0, 1e-3)
+        if isinstance(stamps, tuple):  # irregular: periods drawn uniformly in [lo, hi]
+            t = np.cumsum(rng.uniform(*stamps))
         else:
-            t = np.cumsum(rng.uniform(0.010, 0.012, 1800))
+            t = np.arange(0.0, 20.0 if stamps >= 1e-3 else 10.0, stamps)
         q, qd, qdd = fourier(t, robot.dof, rng)
         tau = model.inverse_dynamics(q, qd, qdd)
         noise_tau = 0.02 * np.abs(tau).max(axis=0)
@@ -182,7 +192,8 @@ def test_defaults_on_a_noisy_log(rate):
         ref += float(np.sum(tau[inner] ** 2))
     rel = np.sqrt(err / ref)
     print(f"{rate}: pooled relative error against the noise-free torque {rel:.4f}")
-    assert rel < 0.01  # measured 0.0065 (100 Hz) and 0.0065 (1 kHz)
+    # measured 0.012 (50 Hz), 0.0065 (100 Hz), 0.0065 (1 kHz), 0.0070 (4 kHz)
+    assert rel < bound
 
 
 def test_coulomb_split_is_non_negative_and_keeps_the_base_parameters():
