@@ -80,8 +80,10 @@ _SINCOS = """\
  * (nearbyint, unlike floor, vectorises without -fno-trapping-math.) */
 static void PREFIXsincos_block(int count, const double *restrict x, double *restrict s,
                                double *restrict c) {
+    int big = 0; /* any |x| beyond the polynomials' range (or not a number) */
     for (int k = 0; k < count; ++k) {
         const double a = x[k];
+        big |= !(fabs(a) <= LIMIT);
         const double n = nearbyint(a * 6.36619772367581382433e-01);
         const double r = (((a - n * 1.57079632673412561417e+00) - n * 6.07710050630396597660e-11)
                           - n * 2.02226624871116645580e-21) - n * 8.47842766036889956997e-32;
@@ -101,7 +103,7 @@ static void PREFIXsincos_block(int count, const double *restrict x, double *rest
         s[k] = m == 0.0 ? sr : m == 1.0 ? cr : m == -1.0 ? -cr : -sr;
         c[k] = m == 0.0 ? cr : m == 1.0 ? -sr : m == -1.0 ? sr : -cr;
     }
-    for (int k = 0; k < count; ++k) {
+    for (int k = 0; big && k < count; ++k) {
         if (!(fabs(x[k]) <= LIMIT)) {
             s[k] = sin(x[k]);
             c[k] = cos(x[k]);
@@ -244,8 +246,8 @@ class CPrinter(Printer):
                       direct: dict[str, tuple[int, list[int]]] | None = None) -> str:
         """``PREFIXk_range`` (states [begin, end), a block at a time) and ``PREFIXk_batch``.
 
-        Per block: the inputs are transposed into structure-of-arrays buffers; then one
-        vector loop per angle gives the sines and cosines, the core runs, and the outputs are
+        Per block: the inputs are transposed into structure-of-arrays buffers; then vector
+        loops give the sines and cosines (:func:`_trig_lines`), the core runs, and the outputs are
         transposed back (:func:`robodyn.codegen.c_outputs.output_lines`). ``stream_`` (set
         by the batch functions for large batches) makes staged outputs use streaming stores.
         """
@@ -261,8 +263,7 @@ class CPrinter(Printer):
         arrays = [f"{a.name}_b_[{sizes.get(a.name, a.size) * BLOCK}]"
                   for a in (*gathered, *kernel.outputs) if a.name not in direct]
         arrays += [f"sin_[{na * BLOCK}]", f"cos_[{na * BLOCK}]"] if na else []
-        trig = [f"        {self.prefix}sincos_block(m_, {name}_b_ + {BLOCK * idx}, sin_ + {BLOCK * i}, "
-                f"cos_ + {BLOCK * i});" for i, (_, name, idx) in enumerate(angles)]
+        trig = _trig_lines(self.prefix, angles)
         args = [a.name if a.name in ("sin_", "cos_") else f"{a.name}_b_"
                 for a in core.inputs]
         args += [f"{a.name} + {direct[a.name][0]} * k0_" if a.name in direct else f"{a.name}_b_"
@@ -404,6 +405,33 @@ class CPrinter(Printer):
                                            "mass_matrix" in kset.names, runtime))
             parts.append(ensemble_source(kset.dof, self.prefix, runtime))
         return "\n".join(parts)
+
+
+def _trig_lines(prefix: str, angles: list[tuple[sp.Symbol, str, int]]) -> list[str]:
+    """The calls of ``PREFIXsincos_block`` in a block of ``m_`` states: angle ``i`` (entry
+    ``idx`` of input ``name``) gives ``sin_``/``cos_`` at ``BLOCK i``. Angles that are consecutive
+    entries of one input lie one after another in its buffer as in ``sin_``/``cos_``, so a full
+    block takes one loop over all of them (5 x 8 states of the PUMA 560: 5 % of its inverse
+    dynamics against a loop per angle, measured on an AMD EPYC with AVX2); a partial block, whose
+    buffers have unused lanes between the angles, one loop per angle."""
+    runs: list[list[tuple[int, str, int]]] = []
+    for i, (_, name, idx) in enumerate(angles):
+        if runs and runs[-1][-1][1] == name and runs[-1][-1][2] == idx - 1:
+            runs[-1].append((i, name, idx))
+        else:
+            runs.append([(i, name, idx)])
+    lines = []
+    for run in runs:
+        each = [f"{prefix}sincos_block(m_, {name}_b_ + {BLOCK * idx}, sin_ + {BLOCK * i}, "
+                f"cos_ + {BLOCK * i});" for i, name, idx in run]
+        if len(run) == 1:
+            lines.append(f"        {each[0]}")
+            continue
+        i, name, idx = run[0]
+        lines += [f"        if (m_ == {BLOCK}) {prefix}sincos_block({len(run) * BLOCK}, {name}_b_ + "
+                  f"{BLOCK * idx}, sin_ + {BLOCK * i}, cos_ + {BLOCK * i});",
+                  "        else {", *(f"            {e}" for e in each), "        }"]
+    return lines
 
 
 def sincos_source(prefix: str) -> str:
