@@ -100,8 +100,11 @@ static void PREFIXsincos_block(int count, const double *restrict x, double *rest
         const double v = 1.0 - hz;
         const double cr = v + (((1.0 - v) - hz) + z * pc);
         const double m = n - 4.0 * nearbyint(0.25 * n); /* n mod 4 as -2, -1, 0, 1 or 2 */
-        s[k] = m == 0.0 ? sr : m == 1.0 ? cr : m == -1.0 ? -cr : -sr;
-        c[k] = m == 0.0 ? cr : m == 1.0 ? -sr : m == -1.0 ? sr : -cr;
+        /* odd quadrants swap sine and cosine; sin > 0 for m = 0, 1, cos > 0 for m = -1, 0 */
+        const int odd = fabs(m) == 1.0;
+        const double ts = odd ? cr : sr, tc = odd ? sr : cr;
+        s[k] = (m >= 0.0 && m <= 1.0) ? ts : -ts;
+        c[k] = (m >= -1.0 && m <= 0.0) ? tc : -tc;
     }
     for (int k = 0; big && k < count; ++k) {
         if (!(fabs(x[k]) <= LIMIT)) {
