@@ -183,9 +183,10 @@ def _with_hump(lab: Any, coulomb: np.ndarray) -> rd.Recording:
     return replace(lab.recording, current=lab.recording.current + extra / lab.truth.drive_gain)
 
 
-def _virtual_6dof(hump: bool = False) -> Case:
-    """A 6-DOF arm like the current-driven cobot: ~94 Hz (10/12 ms stamps), 4 decimals, currents
-    (``hump``: the plant's friction with a Stribeck hump the description does not have)."""
+def _virtual_6dof() -> list[Case]:
+    """A 6-DOF arm like the current-driven cobot: ~94 Hz (10/12 ms stamps), 4 decimals, currents;
+    twice from the same three lab runs: as measured, and with the current of a Stribeck hump in
+    the plant's friction that the description does not have."""
     from robodyn.studies.testprog import jointwise
     from robodyn.studies.virtual_lab import Sensors, virtual_lab
 
@@ -194,32 +195,26 @@ def _virtual_6dof(hump: bool = False) -> Case:
     subs = puma.defaults()
     coulomb = np.array([0.5 * float((j.friction.coulomb_positive + j.friction.coulomb_negative)
                                     .xreplace(subs)) for j in puma.joints])
-
-    def measured(lab: Any) -> rd.Recording:
-        return _rounded(_with_hump(lab, coulomb) if hump else lab.recording, 4)
-
     duration = 40.0
     sens = Sensors(sample_period=0.0106, jitter=0.001, counts_per_rev=4096.0, current_noise=0.03,
                    current_offset=0.02, torque_constant_error=0.03, torque_noise=None,
                    tracker_period=0.0)
-    fit_runs, check_runs = [], []
-    for seed in (1, 2):
-        ex = rd.excitation(model, harmonics=4, base_frequency=1.0 / duration, starts=1, seed=seed,
-                           max_iterations=10, dt=0.0106)
-        lab = virtual_lab(model, ex, sensors=sens, seed=seed)
-        (fit_runs if seed == 1 else check_runs).append(measured(lab))
-    prog = jointwise(model, speeds=(0.5,), stroke=0.8)
-    check_runs.append(measured(virtual_lab(model, prog, sensors=sens, seed=3)))
-    if hump:
-        return Case("virtual 6-DOF as above, the plant's friction with a Stribeck hump", puma, None,
-                    fit_runs, check_runs, "current",
-                    f"the same runs, the plant's Coulomb friction Fc with a Stribeck hump (static "
-                    f"friction {1 + HUMP_EXCESS:g} Fc, Stribeck velocity {HUMP_VELOCITY:g} rad/s) "
-                    "that the description does not have, the drive supplying it (added to the "
-                    "current at the exact velocity through the actual drive gains)")
-    return Case("virtual 6-DOF, 94 Hz, 4 decimals, current -> other run + jointwise", puma, None,
-                fit_runs, check_runs, "current", "PUMA 560 as the plant, like the issue's "
-                "current-driven cobot: 10/12 ms stamps, values printed to 4 decimals")
+    labs = [virtual_lab(model, rd.excitation(model, harmonics=4, base_frequency=1.0 / duration,
+                                             starts=1, seed=seed, max_iterations=10, dt=0.0106),
+                        sensors=sens, seed=seed) for seed in (1, 2)]
+    labs.append(virtual_lab(model, jointwise(model, speeds=(0.5,), stroke=0.8), sensors=sens, seed=3))
+    plain = [_rounded(lab.recording, 4) for lab in labs]
+    humped = [_rounded(_with_hump(lab, coulomb), 4) for lab in labs]
+    # fit on the first excitation run; check on the other one and the jointwise run
+    return [Case("virtual 6-DOF, 94 Hz, 4 decimals, current -> other run + jointwise", puma, None,
+                 plain[:1], plain[1:], "current", "PUMA 560 as the plant, like the issue's "
+                 "current-driven cobot: 10/12 ms stamps, values printed to 4 decimals"),
+            Case("virtual 6-DOF as above, the plant's friction with a Stribeck hump", puma, None,
+                 humped[:1], humped[1:], "current",
+                 f"the same runs, the plant's Coulomb friction Fc with a Stribeck hump (static "
+                 f"friction {1 + HUMP_EXCESS:g} Fc, Stribeck velocity {HUMP_VELOCITY:g} rad/s) "
+                 "that the description does not have, the drive supplying it (added to the "
+                 "current at the exact velocity through the actual drive gains)")]
 
 
 def virtual_cases(quick: bool) -> list[Case]:
@@ -227,7 +222,7 @@ def virtual_cases(quick: bool) -> list[Case]:
     Stribeck hump); ``quick``: only the 7-DOF one, on a shorter period."""
     from robodyn.studies.virtual_lab import Sensors, virtual_lab
 
-    cases = [] if quick else [_virtual_6dof(), _virtual_6dof(hump=True)]
+    cases = [] if quick else _virtual_6dof()
     # a 7-DOF torque-sensing arm: 1 kHz with gaps, periodic excitation, held-out part of the period
     gen3 = rd.load("kinova_gen3")
     model7 = rd.compile_model(gen3)
