@@ -32,7 +32,13 @@ from typing import Any
 
 import numpy as np
 
-from robodyn.codegen.build import CFLAGS, CompilerNotFoundError, find_compiler
+from robodyn.codegen.build import (
+    CFLAGS,
+    SCALAR_GCC_FLAGS,
+    CompilerNotFoundError,
+    compiler_flags,
+    find_compiler,
+)
 
 HERE = Path(__file__).resolve().parent
 SOURCE = HERE / "native" / "pinocchio_bench.cpp"
@@ -144,9 +150,15 @@ def cxx_compiler() -> tuple[str, str]:
 
 
 def native_flags() -> tuple[str, ...]:
-    """robodyn's optimisation flags for C++, ``-std=c++17 -DNDEBUG`` and Pinocchio's defines."""
+    """robodyn's optimisation flags for C++ (with those it adds for its compiler's vector code,
+    :func:`robodyn.codegen.build.compiler_flags`), ``-std=c++17 -DNDEBUG`` and Pinocchio's
+    defines."""
     robodyn = tuple(f for f in CFLAGS if f not in _NOT_FOR_EXECUTABLE)
-    return (*robodyn, "-std=c++17", "-DNDEBUG", *(f"-D{d}" for d in PINOCCHIO_DEFINES))
+    try:
+        added = tuple(f for f in compiler_flags(find_compiler()) if f not in SCALAR_GCC_FLAGS)
+    except CompilerNotFoundError:
+        added = ()
+    return (*robodyn, *added, "-std=c++17", "-DNDEBUG", *(f"-D{d}" for d in PINOCCHIO_DEFINES))
 
 
 def include_dirs() -> list[Path]:

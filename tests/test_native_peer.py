@@ -15,7 +15,7 @@ from types import ModuleType
 import numpy as np
 import pytest
 
-from robodyn.codegen.build import CFLAGS
+from robodyn.codegen.build import CFLAGS, SCALAR_GCC_FLAGS, compiler_flags, find_compiler
 
 BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
 
@@ -50,6 +50,9 @@ def test_flags_are_robodyns_optimisation_flags(peer):
     robodyn = [f for f in CFLAGS if f not in ("-fPIC", "-shared", "-std=c99")]
     assert list(flags[:len(robodyn)]) == robodyn
     assert {"-O3", "-march=native", "-DNDEBUG", "-std=c++17"} <= set(flags)
+    # and what robodyn adds for its compiler's vector code (GCC: the loop alignment)
+    added = [f for f in compiler_flags(find_compiler()) if f not in SCALAR_GCC_FLAGS]
+    assert list(flags[len(robodyn):len(robodyn) + len(added)]) == added
 
 
 def test_model_text_carries_the_pinocchio_model(peer):

@@ -79,14 +79,14 @@ def test_vector_flags_ask_for_256_bits_on_avx2_without_avx512():
 
 
 @pytest.mark.parametrize(("path", "width", "expected"), [
-    ("/usr/bin/gcc", 1, build.SCALAR_GCC_FLAGS),
-    ("/usr/bin/x86_64-linux-gnu-gcc-12", 1, build.SCALAR_GCC_FLAGS),
-    ("/opt/gcc-13.2/bin/gcc-13.2", 1, build.SCALAR_GCC_FLAGS),
-    ("/usr/bin/x86_64-linux-gnu-gcc-12", 8, ()),
+    ("/usr/bin/gcc", 1, build.GCC_FLAGS + build.SCALAR_GCC_FLAGS),
+    ("/usr/bin/x86_64-linux-gnu-gcc-12", 1, build.GCC_FLAGS + build.SCALAR_GCC_FLAGS),
+    ("/opt/gcc-13.2/bin/gcc-13.2", 1, build.GCC_FLAGS + build.SCALAR_GCC_FLAGS),
+    ("/usr/bin/x86_64-linux-gnu-gcc-12", 8, build.GCC_FLAGS),
     ("/usr/bin/clang-15", 1, ()),
     ("/usr/bin/icx", 1, ()),
 ])
-def test_scalar_gcc_builds_skip_the_combine_pass(path: str, width: int, expected) -> None:
+def test_gcc_builds_align_loops_and_scalar_ones_skip_combine(path: str, width: int, expected) -> None:
     # (paths that do not exist are their own real path)
     assert build.compiler_flags(path, width) == expected
 
@@ -95,5 +95,5 @@ def test_cc_link_to_gcc_counts_as_gcc(tmp_path) -> None:
     gcc = tmp_path / "x86_64-linux-gnu-gcc-12"
     gcc.write_text("")
     (tmp_path / "cc").symlink_to(gcc)
-    assert build.compiler_flags(str(tmp_path / "cc"), 1) == build.SCALAR_GCC_FLAGS
-    assert build.compiler_flags(str(tmp_path / "cc"), 16) == ()
+    assert build.compiler_flags(str(tmp_path / "cc"), 1) == build.GCC_FLAGS + build.SCALAR_GCC_FLAGS
+    assert build.compiler_flags(str(tmp_path / "cc"), 16) == build.GCC_FLAGS

@@ -20,7 +20,8 @@ instruction. The outputs are transposed back.
 
 The sines and cosines of the joint angles come from ``PREFIXsincos_block``: one branch-free loop
 of polynomial code per angle (Cody-Waite reduction by pi/2 in three parts and fdlibm's minimax
-kernels, within 2 ulp of libm; beyond 1e5 rad, infinities and NaN go to libm). Coulomb
+kernels, within 2 ulp of libm; beyond 1e5 rad, infinities and NaN go to libm; the quadrant's
+swap and signs are bit operations on the sum that rounded the quadrant number). Coulomb
 friction's ``qd > 0`` switches are computed while the block is transposed, as selects rather than
 mispredicted branches.
 
@@ -70,21 +71,31 @@ THREAD_CHUNK = 64 * BLOCK
 
 #: Beyond this |angle| (rad), and for infinities and NaN, the block's sine and cosine come from libm.
 _POLY_LIMIT = "1.0e5"
+#: 1.5 2^52 (see :data:`_SINCOS`).
+_ROUND = "6755399441055744.0"
 
 # Constants from fdlibm (e_rem_pio2.c, k_sin.c, k_cos.c): pi/2 in three 33-bit parts plus a
 # tail, and the minimax coefficients of sin and cos on [-pi/4, pi/4] (errors below 2^-58).
+# ROUND is 1.5 2^52: for |y| < 2^51, y + ROUND rounds y to the nearest integer (ties to even, as
+# nearbyint) and leaves that integer's low bits in the last bits of the sum's representation.
 _SINCOS = """\
+#include <stdint.h>
+#include <string.h>
+
 /* s[k] = sin(x[k]), c[k] = cos(x[k]) for k < count: branch-free, so the loop vectorises.
  * x = n pi/2 + r, |r| <= pi/4, with pi/2 in three exact parts (|x| <= 1e5); fdlibm's polynomials
- * for sin r and cos r, then the quadrant n mod 4. Larger |x|, infinities and NaN: libm.
- * (nearbyint, unlike floor, vectorises without -fno-trapping-math.) */
+ * for sin r and cos r, then the quadrant n mod 4, read from the bits of the sum that rounded
+ * n (memcpy: the compiler's vector bit operations, no integer conversion). Larger |x|,
+ * infinities and NaN: libm. */
 static void PREFIXsincos_block(int count, const double *restrict x, double *restrict s,
                                double *restrict c) {
     int big = 0; /* any |x| beyond the polynomials' range (or not a number) */
     for (int k = 0; k < count; ++k) {
         const double a = x[k];
         big |= !(fabs(a) <= LIMIT);
-        const double n = nearbyint(a * 6.36619772367581382433e-01);
+        /* n = a 2/pi rounded to an integer, also held in the low bits of t */
+        const double t = a * 6.36619772367581382433e-01 + ROUND;
+        const double n = t - ROUND;
         const double r = (((a - n * 1.57079632673412561417e+00) - n * 6.07710050630396597660e-11)
                           - n * 2.02226624871116645580e-21) - n * 8.47842766036889956997e-32;
         const double z = r * r;
@@ -99,12 +110,17 @@ static void PREFIXsincos_block(int count, const double *restrict x, double *rest
         const double hz = 0.5 * z;
         const double v = 1.0 - hz;
         const double cr = v + (((1.0 - v) - hz) + z * pc);
-        const double m = n - 4.0 * nearbyint(0.25 * n); /* n mod 4 as -2, -1, 0, 1 or 2 */
-        /* odd quadrants swap sine and cosine; sin > 0 for m = 0, 1, cos > 0 for m = -1, 0 */
-        const int odd = fabs(m) == 1.0;
-        const double ts = odd ? cr : sr, tc = odd ? sr : cr;
-        s[k] = (m >= 0.0 && m <= 1.0) ? ts : -ts;
-        c[k] = (m >= -1.0 && m <= 0.0) ? tc : -tc;
+        /* quadrant n mod 4 (t's last two bits): odd ones swap sine and cosine; the sine changes
+         * sign in quadrants 2 and 3, the cosine in 1 and 2 (the sign bit flipped) */
+        uint64_t qb, sb, cb;
+        memcpy(&qb, &t, sizeof qb);
+        const double ts = (qb & 1) ? cr : sr, tc = (qb & 1) ? sr : cr;
+        memcpy(&sb, &ts, sizeof sb);
+        memcpy(&cb, &tc, sizeof cb);
+        sb ^= (qb & 2) << 62;
+        cb ^= ((qb + 1) & 2) << 62;
+        memcpy(&s[k], &sb, sizeof sb);
+        memcpy(&c[k], &cb, sizeof cb);
     }
     for (int k = 0; big && k < count; ++k) {
         if (!(fabs(x[k]) <= LIMIT)) {
@@ -444,7 +460,8 @@ def sincos_source(prefix: str) -> str:
     the compiler vectorises (see the module docstring), within 2 ulp of libm (1 ulp for
     |x| <= 100).
     """
-    return _SINCOS.replace("PREFIX", prefix).replace("LIMIT", _POLY_LIMIT)
+    return (_SINCOS.replace("PREFIX", prefix).replace("LIMIT", _POLY_LIMIT)
+            .replace("ROUND", _ROUND))
 
 
 def _angles(kernel: Kernel) -> list[tuple[sp.Symbol, str, int]]:
