@@ -59,7 +59,8 @@ from typing import Any
 import numpy as np
 
 import robodyn as rd
-from robodyn.codegen.build import CFLAGS
+from robodyn.codegen.build import applied_flags
+from robodyn.numeric.model_cache import openmp_flags
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import results  # noqa: E402
@@ -191,8 +192,9 @@ def rows_of(times: dict[str, list[float]], count: int, loops: int) -> list[dict[
 
 def peer_descriptions(pin_version: str, loops: int, source: str) -> dict[str, str]:
     """What each side is and how it differs from the other."""
+    flags = " ".join(applied_flags(openmp_flags()))
     return {
-        "robodyn": f"robodyn {rd.__version__}: generated C ({' '.join(CFLAGS)}), one call for "
+        "robodyn": f"robodyn {rd.__version__}: generated C ({flags}), one call for "
                    "all states, 1 thread, the PUMA as described: rigid body, rotor inertia and "
                    "joint friction (viscous and Coulomb: more work than the peer)",
         "Pinocchio": f"Pinocchio {pin_version}, the pip wheel as users get it (generic build), "

@@ -46,9 +46,11 @@ import results  # noqa: E402
 import timing  # noqa: E402
 
 #: Flops of one angle's sine and cosine in the generated ``sincos_block`` (robodyn.codegen.c):
-#: range reduction 1 + 8, z and z^2 2, sine polynomial 8 + 5, cosine polynomial 12 + 2 + 5,
-#: quadrant 3 (an FMA counts 2, as in the peak).
-SINCOS_FLOPS = 46
+#: range reduction 3 + 8 (the quadrant number rounded by adding and subtracting 1.5 2^52, then
+#: pi/2 in four parts), z and z^2 2, sine polynomial 8 + 5, cosine polynomial 12 + 2 + 5; the
+#: quadrant's swap and signs are bit operations, not counted (an FMA counts 2, as in the peak).
+#: 46 before 2026-12-06, when the quadrant took 3 flops and the rounding 1.
+SINCOS_FLOPS = 45
 
 #: Independent FMA chains of the peak loop (at least latency x FMA ports on current x86 cores,
 #: few enough to stay in the vector registers).

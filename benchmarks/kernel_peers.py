@@ -37,7 +37,8 @@ from typing import Any
 import numpy as np
 
 import robodyn as rd
-from robodyn.codegen.build import CFLAGS
+from robodyn.codegen.build import applied_flags
+from robodyn.numeric.model_cache import openmp_flags
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import native_peer  # noqa: E402
@@ -252,8 +253,9 @@ def ratios(rows: list[Row]) -> list[dict[str, Any]]:
 
 def peer_descriptions(version: str, wheel_version: str) -> dict[str, str]:
     """What each library row is and how it differs from the others."""
+    flags = " ".join(applied_flags(openmp_flags()))
     return {
-        "robodyn": f"robodyn {version}: generated C ({' '.join(CFLAGS)}), one call for all "
+        "robodyn": f"robodyn {version}: generated C ({flags}), one call for all "
                    "states into arrays allocated once (out=, as the peers' outputs), 1 thread, "
                    "friction: none (a copy of the PUMA without friction)",
         "robodyn (friction)": "the same with the PUMA's viscous and Coulomb joint friction "
@@ -341,7 +343,7 @@ def measure(robot: rd.Robot, pmodel: Any, count: int, repeats: int,
                       "states_timed": r.count, "max_rel_error": r.error, "note": r.note}
                      for r in rows]
     entry.update(ratios=ratios(rows), peers=peer_descriptions(rd.__version__, pin.__version__),
-                 robodyn_flags=list(CFLAGS), tolerance=TOLERANCE,
+                 robodyn_flags=list(applied_flags(openmp_flags())), tolerance=TOLERANCE,
                  wall_s=round(time.perf_counter() - t0, 1))
     return entry
 

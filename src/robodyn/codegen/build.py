@@ -48,6 +48,7 @@ __all__ = [
     "clear_cache",
     "compile_library",
     "GCC_FLAGS",
+    "applied_flags",
     "compiler_flags",
     "find_compiler",
 ]
@@ -98,6 +99,15 @@ def compiler_flags(compiler: str, width: int = BLOCK) -> tuple[str, ...]:
     if re.search(r"(^|-)gcc(-[\d.]+)?$", name) is None:
         return ()
     return (*GCC_FLAGS, *(SCALAR_GCC_FLAGS if width == 1 else ()))
+
+
+def applied_flags(flags: tuple[str, ...] = CFLAGS) -> tuple[str, ...]:
+    """What :func:`compile_library` gives this machine's compiler for ``flags``: ``flags`` and
+    :func:`compiler_flags` (``flags`` alone where there is no compiler)."""
+    try:
+        return (*flags, *compiler_flags(find_compiler()))
+    except CompilerNotFoundError:
+        return tuple(flags)
 
 
 class CompilerNotFoundError(RuntimeError):
