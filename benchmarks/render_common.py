@@ -58,6 +58,11 @@ def x(r: dict[str, float], digits: int = 1) -> str:
 
 
 
+def and_list(items: list[str]) -> str:
+    """``a``, ``a and b``, ``a, b and c``."""
+    return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} and {items[-1]}"
+
+
 def table(header: list[str], rows: list[list[str]], text_last: bool = True) -> list[str]:
     """A Markdown table: first column left-aligned, the others right-aligned (but the last,
     with ``text_last``)."""

@@ -321,10 +321,14 @@ def render_block_width(data: dict[str, Any]) -> str:
         f"{isa} {kernel}: fastest at width {v['best_width']}, robodyn's {v['chosen_width']} "
         f"takes {v['chosen_over_best']:.2f}x its time"
         for isa, kernels in e["verdict"].items() for kernel, v in kernels.items())
-    added = sorted({(r["width"], " ".join(r.get("added_flags", []))) for r in e["rows"]
-                    if r.get("added_flags")})
-    extra = "".join(f" Width {w} builds also get {f} (robodyn.codegen.build.compiler_flags)."
-                    for w, f in added)
+    added: dict[str, set[int]] = {}
+    for r in e["rows"]:
+        if r.get("added_flags"):
+            added.setdefault(" ".join(r["added_flags"]), set()).add(r["width"])
+    groups = [(sorted(ws), f) for f, ws in sorted(added.items(), key=lambda kv: min(kv[1]))]
+    extra = "".join(
+        f" {'Width' if len(ws) == 1 else 'Widths'} {rc.and_list([str(w) for w in ws])} builds also "
+        f"get {f} (robodyn.codegen.build.compiler_flags)." for ws, f in groups)
     lines += [""] + rc.wrap(f"Code: {'; '.join(f'{k}: {v}' for k, v in e['isas'].items())}.{extra} "
                             f"By the minima: {verdicts}.")
     return "\n".join(lines) + "\n"
