@@ -19,9 +19,10 @@ Data sets:
 * virtual lab (the robot's own description is the plant: a result obtained with the plant's own
   model structure), configured like the two held-out arms of issue 20: a 6-DOF arm logged at
   ~94 Hz with 10/12 ms stamps and values printed to 4 decimals, motor currents, validated on
-  other excitation and on jointwise runs with static holds (twice: the plain plant, and a plant
-  whose friction has a Stribeck hump the description lacks); and a 7-DOF torque-sensing arm at
-  1 kHz with gaps in the stamps, a held-out part of the period.
+  other excitation and on jointwise runs with static holds (three times: the plain plant, a plant
+  whose friction has a Stribeck hump the description lacks, and a plant whose parameters are off
+  the description's, :data:`PLANT_SPREAD`); and a 7-DOF torque-sensing arm at 1 kHz with gaps in
+  the stamps, a held-out part of the period (twice: the plain plant and one off the description).
 
 Speed (``--only speed``): 10^5 samples x 7 joints (Gen3, 1 kHz, a simulated run with noise and
 a measured velocity) identified by the default ``rd.identify`` (physically consistent, velocity
@@ -183,10 +184,47 @@ def _with_hump(lab: Any, coulomb: np.ndarray) -> rd.Recording:
     return replace(lab.recording, current=lab.recording.current + extra / lab.truth.drive_gain)
 
 
+#: The perturbed plants of two virtual rows: each moving link's mass x U(1 - s, 1 + s), its
+#: inertia x U(1 - 1.5 s, 1 + 1.5 s), its centre of mass + N(0, (0.1 s m)^2) per axis, and each
+#: joint's viscous and Coulomb friction x U(1 - s, 1 + s), with s this spread: a description off
+#: the arm as a URDF is off a real one, so that the prior the default pulls towards is wrong.
+PLANT_SPREAD = 0.2
+
+
+def _perturbed(robot: rd.Robot, seed: int) -> rd.Robot:
+    """``robot`` with its parameters drawn around the description's (:data:`PLANT_SPREAD`)."""
+    import sympy as sp
+
+    rng = np.random.default_rng(seed)
+    s = PLANT_SPREAD
+    links = [robot.links[0]]
+    for link in robot.links[1:]:
+        links.append(replace(link, mass=sp.Float(float(link.mass) * rng.uniform(1 - s, 1 + s)),
+                             com=sp.Matrix([float(c) + rng.normal(0, 0.1 * s) for c in link.com]),
+                             inertia=link.inertia * rng.uniform(1 - 1.5 * s, 1 + 1.5 * s)))
+    joints = []
+    for j in robot.joints:
+        f, k = j.friction, rng.uniform(1 - s, 1 + s, 3)
+        joints.append(replace(j, friction=replace(f, viscous=f.viscous * k[0],
+                                                  coulomb_positive=f.coulomb_positive * k[1],
+                                                  coulomb_negative=f.coulomb_negative * k[2])))
+    return replace(robot, links=tuple(links), joints=tuple(joints), name=robot.name + "_plant",
+                   description_hash="")
+
+
+def _perturbed_note(seed: int) -> str:
+    s = PLANT_SPREAD
+    return (f"the plant's parameters drawn around the description's (seed {seed}): masses and "
+            f"friction x U({1 - s:g}, {1 + s:g}), inertias x U({1 - 1.5 * s:g}, {1 + 1.5 * s:g}), "
+            f"centres of mass + N(0, ({100 * 0.1 * s:g} cm)^2) per axis; the description, and so "
+            "the prior, as given")
+
+
 def _virtual_6dof() -> list[Case]:
     """A 6-DOF arm like the current-driven cobot: ~94 Hz (10/12 ms stamps), 4 decimals, currents;
-    twice from the same three lab runs: as measured, and with the current of a Stribeck hump in
-    the plant's friction that the description does not have."""
+    three rows from the same three programs: as measured, with the current of a Stribeck hump in
+    the plant's friction that the description does not have, and run by a plant whose parameters
+    are off the description's (:func:`_perturbed`)."""
     from robodyn.studies.testprog import jointwise
     from robodyn.studies.virtual_lab import Sensors, virtual_lab
 
@@ -199,12 +237,15 @@ def _virtual_6dof() -> list[Case]:
     sens = Sensors(sample_period=0.0106, jitter=0.001, counts_per_rev=4096.0, current_noise=0.03,
                    current_offset=0.02, torque_constant_error=0.03, torque_noise=None,
                    tracker_period=0.0)
-    labs = [virtual_lab(model, rd.excitation(model, harmonics=4, base_frequency=1.0 / duration,
-                                             starts=1, seed=seed, max_iterations=10, dt=0.0106),
-                        sensors=sens, seed=seed) for seed in (1, 2)]
-    labs.append(virtual_lab(model, jointwise(model, speeds=(0.5,), stroke=0.8), sensors=sens, seed=3))
+    programs = [rd.excitation(model, harmonics=4, base_frequency=1.0 / duration, starts=1,
+                              seed=seed, max_iterations=10, dt=0.0106) for seed in (1, 2)]
+    programs.append(jointwise(model, speeds=(0.5,), stroke=0.8))
+    labs = [virtual_lab(model, p, sensors=sens, seed=seed) for seed, p in enumerate(programs, 1)]
     plain = [_rounded(lab.recording, 4) for lab in labs]
     humped = [_rounded(_with_hump(lab, coulomb), 4) for lab in labs]
+    plant = rd.compile_model(_perturbed(puma, 1))
+    off = [_rounded(virtual_lab(plant, p, sensors=sens, seed=seed).recording, 4)
+           for seed, p in enumerate(programs, 1)]
     # fit on the first excitation run; check on the other one and the jointwise run
     return [Case("virtual 6-DOF, 94 Hz, 4 decimals, current -> other run + jointwise", puma, None,
                  plain[:1], plain[1:], "current", "PUMA 560 as the plant, like the issue's "
@@ -214,12 +255,16 @@ def _virtual_6dof() -> list[Case]:
                  f"the same runs, the plant's Coulomb friction Fc with a Stribeck hump (static "
                  f"friction {1 + HUMP_EXCESS:g} Fc, Stribeck velocity {HUMP_VELOCITY:g} rad/s) "
                  "that the description does not have, the drive supplying it (added to the "
-                 "current at the exact velocity through the actual drive gains)")]
+                 "current at the exact velocity through the actual drive gains)"),
+            Case("virtual 6-DOF as above, the plant's parameters off the description's", puma,
+                 None, off[:1], off[1:], "current", "the same programs and sensors, "
+                 + _perturbed_note(1))]
 
 
 def virtual_cases(quick: bool) -> list[Case]:
-    """The two virtual arms of issue 20, the 6-DOF one twice (its plant's friction plain and with a
-    Stribeck hump); ``quick``: only the 7-DOF one, on a shorter period."""
+    """The two virtual arms of issue 20: the 6-DOF one three times (:func:`_virtual_6dof`), the
+    7-DOF one twice (its plant the description, and one off it); ``quick``: only the 7-DOF one as
+    described, on a shorter period."""
     from robodyn.studies.virtual_lab import Sensors, virtual_lab
 
     cases = [] if quick else _virtual_6dof()
@@ -232,14 +277,21 @@ def virtual_cases(quick: bool) -> list[Case]:
                     torque_noise=TORQUE_NOISE_7DOF, tracker_period=0.0)
     ex = rd.excitation(model7, harmonics=4, base_frequency=1.0 / period, starts=1, seed=4,
                        max_iterations=10, dt=1e-3)
-    rec = _gapped(virtual_lab(model7, ex, sensors=sens7, seed=4).recording, np.random.default_rng(4),
-                  gaps=20, length=15)
-    k = int(0.75 * rec.n_samples)
-    cases.append(Case("virtual 7-DOF, 1 kHz with gaps, torque, 75/25 of the period", gen3, None,
-                      [rec.slice(rec.t[0], rec.t[k - 1])], [rec.slice(rec.t[k], rec.t[-1])], "tau",
-                      f"Gen3 as the plant, like the issue's torque-sensing arm: a {period:g} s "
-                      f"period, 20 gaps of 15 samples, torque noise {TORQUE_NOISE_7DOF:g} N m (the "
-                      "arm's noise floor)"))
+    plants = [model7] if quick else [model7, rd.compile_model(_perturbed(gen3, 1))]
+    for plant in plants:
+        rec = _gapped(virtual_lab(plant, ex, sensors=sens7, seed=4).recording,
+                      np.random.default_rng(4), gaps=20, length=15)
+        k = int(0.75 * rec.n_samples)
+        fit, check = [rec.slice(rec.t[0], rec.t[k - 1])], [rec.slice(rec.t[k], rec.t[-1])]
+        if plant is model7:
+            cases.append(Case("virtual 7-DOF, 1 kHz with gaps, torque, 75/25 of the period", gen3,
+                              None, fit, check, "tau", f"Gen3 as the plant, like the issue's "
+                              f"torque-sensing arm: a {period:g} s period, 20 gaps of 15 samples, "
+                              f"torque noise {TORQUE_NOISE_7DOF:g} N m (the arm's noise floor)"))
+        else:
+            cases.append(Case("virtual 7-DOF as above, the plant's parameters off the "
+                              "description's", gen3, None, fit, check, "tau",
+                              "the same period, gaps and sensors, " + _perturbed_note(1)))
     return cases
 
 

@@ -142,8 +142,9 @@ def render_identification_quality(data: dict[str, Any]) -> str:
     lines = rc.wrap(rc.run(data, e, (
         "Held-out prediction error of the default `rd.identify` against a textbook "
         "least-squares script, on every real data set here and two virtual arms configured like "
-        "issue 20's held-out arms (the 6-DOF one also with a plant whose friction the description "
-        f"cannot express), {len(e['rows'])} rows")) + (
+        "issue 20's held-out arms (each also with a plant whose parameters are off the "
+        "description's, and the 6-DOF one with a plant whose friction the description cannot "
+        f"express), {len(e['rows'])} rows")) + (
         f" Figures: {e['error']}; each cell raw / filtered (one figure where they agree to three "
         "digits); one run (the figures do not depend on load). Targets are issue 20's, judged on "
         "the figures below."))
@@ -162,7 +163,8 @@ def render_identification_quality(data: dict[str, Any]) -> str:
     lines += [""] + rc.wrap(
         "The issue's targets for its two held-out arms (0.11 and 0.013 filtered) cannot be judged "
         "here: their recordings are not in the repository; the virtual rows are configured like "
-        "them, with the description as the plant (in one row with friction the description lacks). "
+        "them, with the description as the plant, or a plant with friction the description lacks, "
+        "or a plant whose parameters are drawn around the description's. "
         "Why some rows lose, and the frequency bands "
         "of the Kinova current: docs/identification.md.")
     lines += [""] + rc.wrap(_speed(e))
