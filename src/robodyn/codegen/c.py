@@ -42,7 +42,9 @@ largest entry). Within full blocks, the bits depend neither on a state's positio
 nor on the number of threads. Threads (OpenMP, when compiled with ``-fopenmp``)
 take pieces of whole blocks. All of it is plain C99 with ordinary IEEE arithmetic, no special
 flags (vectorisation needs only -O3 and a SIMD target); the one pragma is OpenMP's, inside
-``#ifdef _OPENMP``. The one use of intrinsics moves no value through arithmetic: large outputs
+``#ifdef _OPENMP``; the compiler-specific attributes (GCC's ``noinline`` on large cores and its
+scheduling ``optimize`` on the sine/cosine loop) sit under ``#if defined(__GNUC__)`` and change no
+result. The one use of intrinsics moves no value through arithmetic: large outputs
 with constant entries (the regressor) are staged and, for batches too large for the cache,
 copied out with streaming stores under ``#if defined(__SSE2__)`` (:mod:`robodyn.codegen.c_outputs`).
 """
