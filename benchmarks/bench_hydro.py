@@ -48,7 +48,7 @@ REPEATS = 5
 def wet_dry() -> dict[str, Any]:
     """Inverse and forward dynamics of underwater_2r wet against dry; the ``wet_dry`` entry."""
     wet = rd.load("underwater_2r")
-    dry = dataclasses.replace(wet, fluid=None, description_hash="",
+    dry = dataclasses.replace(wet, fluid=None,
                               links=tuple(dataclasses.replace(lk, hydro=None) for lk in wet.links))
     m_wet, m_dry = rd.compile_model(wet), rd.compile_model(dry)
     rng = np.random.default_rng(0)

@@ -94,8 +94,8 @@ def relative_error(theirs: np.ndarray, ours: np.ndarray) -> float:
 def without_friction(robot: rd.Robot) -> rd.Robot:
     """The same robot with every joint's friction removed (rigid body + rotor inertia only)."""
     joints = tuple(dataclasses.replace(j, friction=type(j.friction)()) for j in robot.joints)
-    # description_hash "" is recomputed from the new description (the compiled-model cache key)
-    return dataclasses.replace(robot, joints=joints, name=robot.name + "_nofriction", description_hash="")
+    # the copy gets its own description_hash (the compiled-model cache key)
+    return dataclasses.replace(robot, joints=joints, name=robot.name + "_nofriction")
 
 
 def robodyn_setup(robot: rd.Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,

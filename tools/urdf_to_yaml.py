@@ -47,7 +47,7 @@ def convert(
     if source:
         changes["source"] = source
     if changes:
-        robot = dataclasses.replace(robot, description_hash="", **changes)
+        robot = dataclasses.replace(robot, **changes)
     text = dump_yaml(robot)
     if licence is not None:
         text = comment_block(licence.read_text(encoding="utf-8")) + "#\n" + text

@@ -8,6 +8,7 @@ each target offset.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -119,8 +120,8 @@ def test_single_target_shape_and_multi_target_first_column_agree(puma_truth):
 def test_gravity_shaped_basis_without_masses():
     """A description without masses: the documented point-mass basis, checked by a closed form."""
     r = robot("puma560")
-    massless = rd.Robot(**{**r.__dict__, "links": tuple(
-        type(link)(**{**link.__dict__, "mass": 0 * link.mass}) for link in r.links)})
+    massless = dataclasses.replace(r, links=tuple(dataclasses.replace(link, mass=0 * link.mass)
+                                                  for link in r.links))
     from robodyn.calibration.nominal import robot_geometry
     from robodyn.calibration.nongeometric import build_nongeometric, nominal_frames
 

@@ -141,7 +141,7 @@ def test_options_actuators_limits_and_friction():
                 friction=Friction(sp.Float(0.3), sp.Float(0.2), sp.Float(0.2))),
         replace(j1, upper=sp.Float(1.0), friction=Friction(sp.Float(0.1), sp.Float(0.2), sp.Float(0.3))),
         j2,
-    ), description_hash="")
+    ))
     with pytest.warns(DescriptionWarning) as caught:
         text = to_mjcf(robot, timestep=0.002, integrator="implicitfast")
     messages = " ".join(str(w.message) for w in caught)
@@ -180,8 +180,7 @@ def test_parameters_are_substituted():
 def test_names_that_collide_with_mujoco_names_are_made_unique():
     robot = builtin("trolley_double_pendulum")
     names = ("world", "base", "tool")
-    robot = replace(robot, links=tuple(replace(lk, name=n) for lk, n in zip(robot.links, names, strict=True)),
-                    description_hash="")
+    robot = replace(robot, links=tuple(replace(lk, name=n) for lk, n in zip(robot.links, names, strict=True)))
     model, data = load(to_mjcf(robot))
     assert [model.body(k).name for k in range(model.nbody)] == ["world", "base_", "world_", "base", "tool"]
     q = np.array([0.3, -0.4, 1.1])
@@ -252,8 +251,7 @@ def test_bad_options_are_rejected(options, match):
 
 def test_negative_mass_is_rejected():
     robot = builtin("trolley_double_pendulum")
-    robot = replace(robot, links=(replace(robot.links[0], mass=sp.Integer(-1)), *robot.links[1:]),
-                    description_hash="")
+    robot = replace(robot, links=(replace(robot.links[0], mass=sp.Integer(-1)), *robot.links[1:]))
     with pytest.raises(ValueError, match=r"joints\[0\] \(x\)\.link\.mass: negative mass -1\.0 kg"):
         to_mjcf(robot)
 

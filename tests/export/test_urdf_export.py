@@ -56,7 +56,7 @@ def urdf_expected(robot: Robot) -> Robot:
         coulomb = f.coulomb_positive if symmetric else sp.Integer(0)
         joints.append(replace(joint, drive=Drive(), friction=Friction(f.viscous, coulomb, coulomb)))
     gravity = sp.ImmutableMatrix([0, 0, sp.Rational(-981, 100)])
-    return replace(robot, joints=tuple(joints), gravity=gravity, description_hash="")
+    return replace(robot, joints=tuple(joints), gravity=gravity)
 
 
 def assert_same_frames(original: Robot, loaded: Robot, rng: np.random.Generator) -> float:
@@ -118,7 +118,7 @@ def test_limits_and_friction_that_map_exactly_come_back(tmp_path):
         replace(j1, upper=sp.Float(1.0), friction=Friction(sp.Float(0.1), sp.Float(0.2), sp.Float(0.3),
                                                            sp.Float(0.05))),
         j2,
-    ), description_hash="")
+    ))
     loaded, messages, text = export_and_load(robot, tmp_path)
     a, b, c = loaded.joints
     assert [float(v) for v in (a.lower, a.upper, a.effort_limit, a.velocity_limit)] == [-0.5, 0.75, 40, 1.5]
@@ -150,8 +150,7 @@ def test_parameters_are_substituted_and_listed(tmp_path):
 def test_names_that_collide_with_the_frame_links_are_made_unique(tmp_path):
     robot = builtin("trolley_double_pendulum")
     names = ("world", "base", "tool")
-    robot = replace(robot, links=tuple(replace(lk, name=n) for lk, n in zip(robot.links, names, strict=True)),
-                    description_hash="")
+    robot = replace(robot, links=tuple(replace(lk, name=n) for lk, n in zip(robot.links, names, strict=True)))
     loaded, _, text = export_and_load(robot, tmp_path)
     assert [lk.name for lk in loaded.links] == list(names)
     root = etree.fromstring(text.encode())
@@ -165,7 +164,7 @@ def test_names_that_collide_with_the_frame_links_are_made_unique(tmp_path):
 def test_hydro_data_is_dropped_with_a_warning(tmp_path):
     robot = builtin("planar_2r")
     link = replace(robot.links[0], hydro={"shape": "cylinder", "radius": 0.05})
-    robot = replace(robot, links=(link, robot.links[1]), description_hash="")
+    robot = replace(robot, links=(link, robot.links[1]))
     with pytest.warns(DescriptionWarning, match="hydrodynamic link data is dropped.*link1"):
         to_urdf(robot)
 
@@ -233,15 +232,14 @@ def test_non_finite_parameter_is_rejected():
 def test_undeclared_symbol_is_rejected():
     robot = builtin("trolley_double_pendulum")
     link = replace(robot.links[0], mass=sp.Symbol("mystery", real=True))
-    robot = replace(robot, links=(link, *robot.links[1:]), description_hash="")
+    robot = replace(robot, links=(link, *robot.links[1:]))
     with pytest.raises(ValueError, match=r"joints\[0\] \(x\)\.link\.mass.*mystery.*not a declared parameter"):
         to_urdf(robot)
 
 
 def test_duplicate_names_are_rejected():
     robot = builtin("planar_2r")
-    robot = replace(robot, links=(robot.links[0], replace(robot.links[1], name="link1")),
-                    description_hash="")
+    robot = replace(robot, links=(robot.links[0], replace(robot.links[1], name="link1")))
     with pytest.raises(ValueError, match="two links named 'link1'"):
         to_urdf(robot)
 

@@ -213,6 +213,22 @@ def test_parameters_override_the_defaults():
         rd.compile_model(robot, parameters={"nonexistent": 1.0})
 
 
+def test_a_replaced_copy_is_compiled_as_itself():
+    # dataclasses.replace on a Robot recomputes its hash, so the model cache (keyed by it)
+    # cannot hand back the original's model: once it did, silently
+    import dataclasses
+
+    robot = load_quiet("planar_2r")
+    base = rd.compile_model(robot)
+    heavier = dataclasses.replace(robot, links=(robot.links[0], dataclasses.replace(
+        robot.links[1], mass=2 * robot.links[1].mass)))
+    assert heavier.description_hash != robot.description_hash
+    assert dataclasses.replace(robot).description_hash == robot.description_hash
+    q = np.array([0.3, 0.2])
+    g, g2 = base.gravity(q), rd.compile_model(heavier).gravity(q)
+    # link 2's gravity torque is its mass times g times its lever arm: linear in its mass
+    np.testing.assert_allclose(g2[1], 2 * g[1], rtol=1e-12)
+
 def test_bad_shapes_and_backend_are_clear_errors():
     model = rd.compile_model(load_quiet("planar_2r"))
     with pytest.raises(ValueError, match=r"q must have shape \(2,\) or \(N, 2\)"):

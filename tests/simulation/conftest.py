@@ -56,7 +56,7 @@ def puma_rigid():
         warnings.simplefilter("ignore")
         robot = rd.load("puma560")
     joints = tuple(dataclasses.replace(j, friction=rd.Friction()) for j in robot.joints)
-    return rd.compile_model(dataclasses.replace(robot, joints=joints, description_hash=""))
+    return rd.compile_model(dataclasses.replace(robot, joints=joints))
 
 
 @pytest.fixture(scope="session")

@@ -236,7 +236,7 @@ def test_identified_description_with_non_physical_inertia_exits_1(tmp_path, caps
     robot = rd.load("planar_2r")
     links = list(robot.links)
     links[1] = dataclasses.replace(links[1], inertia=sp.ImmutableMatrix(sp.diag(1, 1, 5)))
-    bad = dataclasses.replace(robot, links=tuple(links), description_hash="")
+    bad = dataclasses.replace(robot, links=tuple(links))
     path = tmp_path / "bad.yaml"
     path.write_text(dump_yaml(bad), encoding="utf-8")
     assert _check_loadable(path) == 1

@@ -286,7 +286,7 @@ def _with_gains(robot: rd.Robot, gains: np.ndarray) -> rd.Robot:
             raise InputError(f"--gains: joint {j.name} has gear ratio 0 in {robot.source}")
         drive = dataclasses.replace(j.drive, torque_constant=sp.Float(float(k) / ratio))
         joints.append(dataclasses.replace(j, drive=drive))
-    return dataclasses.replace(robot, joints=tuple(joints), description_hash="")
+    return dataclasses.replace(robot, joints=tuple(joints))
 
 
 def _check_loadable(path: Path) -> int:

@@ -194,7 +194,7 @@ def _prepare(robot: Robot, parameters: Mapping[str, float] | None) -> tuple[Robo
         where = f"{robot.source}: joints[{k}] ({joint.name})"
         joints.append(_joint(joint, values, where, dropped))
         links.append(_link(link, axis, values, f"{where}.link", dropped))
-    out = replace(robot, joints=tuple(joints), links=tuple(links), description_hash="")
+    out = replace(robot, joints=tuple(joints), links=tuple(links))
     notes = [f"{_WHY[kind]}: {', '.join(whats)}" for kind, whats in dropped.items()]
     return out, notes
 

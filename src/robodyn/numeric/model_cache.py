@@ -34,7 +34,7 @@ def _code_hash(robot: Robot) -> str:
     compiled model with the same geometry without corrections."""
     if robot.corrections is None:
         return robot.description_hash
-    return dataclasses.replace(robot, corrections=None, description_hash="").description_hash
+    return dataclasses.replace(robot, corrections=None).description_hash
 
 
 def _from_cache(paths: Sequence[Path], write: Callable[[], None], load: Callable[[], Any]) -> Any:

@@ -138,4 +138,4 @@ def with_parameters(robot: Robot, values: Mapping[str, float]) -> Robot:
     if unknown:
         raise InputError(f"{robot.source}: unknown parameter(s) {sorted(unknown)}")
     merged = {**robot.parameters, **{k: float(v) for k, v in values.items()}}
-    return replace(robot, parameters=merged, description_hash="")
+    return replace(robot, parameters=merged)

@@ -203,6 +203,10 @@ class Robot:
         Joint-reading corrections of a kinematic calibration (compliance, transmission errors),
         honoured by forward kinematics (:mod:`robodyn.robot.corrections`); None for a rigid,
         exactly transmitted arm.
+    description_hash : str
+        SHA-256 of everything above (not an argument: always computed from the content, so a
+        copy made with :func:`dataclasses.replace` has its own); compiled models are cached by
+        it.
     """
 
     name: str
@@ -213,9 +217,9 @@ class Robot:
     gravity: sp.ImmutableMatrix = sp.ImmutableMatrix([0, 0, sp.Rational(-981, 100)])
     parameters: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
     source: str = "<memory>"
-    description_hash: str = ""
     fluid: Fluid | None = None
     corrections: JointCorrections | None = None
+    description_hash: str = field(init=False, default="")
 
     def __post_init__(self) -> None:
         if len(self.joints) != len(self.links):
@@ -228,9 +232,10 @@ class Robot:
                              f"robot {self.name!r} has {len(self.joints)}")
         if not isinstance(self.parameters, MappingProxyType):
             object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
-        if not self.description_hash:
-            digest = hashlib.sha256(_canonical_text(self).encode()).hexdigest()
-            object.__setattr__(self, "description_hash", digest)
+        # always from the content: a copy made by dataclasses.replace gets its own hash, so that
+        # no cache keyed by it can hand back the model of the robot it was copied from
+        digest = hashlib.sha256(_canonical_text(self).encode()).hexdigest()
+        object.__setattr__(self, "description_hash", digest)
 
     @property
     def dof(self) -> int:

@@ -273,7 +273,7 @@ class _Reader:
         if "corrections" in top:
             extra["corrections"] = corrections_from_plain(top["corrections"], robot.joint_names,
                                                           self.source)
-        return dataclasses.replace(robot, **extra, description_hash="") if extra else robot
+        return dataclasses.replace(robot, **extra) if extra else robot
 
     def check_immersion(self, fluid: Any, elements: Sequence[ChainElement]) -> None:
         """A fluid block needs a link with hydro data (hydro alone means still fresh water)."""

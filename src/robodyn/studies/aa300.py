@@ -174,7 +174,7 @@ def with_payload(robot: Robot, mass: float) -> Robot:
     new_link = Link(link.name, m, sp.ImmutableMatrix(c),
                     sp.ImmutableMatrix(inertia), link.hydro)
     return dataclasses.replace(robot, name=f"{robot.name}+{mass:g}kg",
-                               links=robot.links[:-1] + (new_link,), description_hash="")
+                               links=robot.links[:-1] + (new_link,))
 
 
 def _point(radius: float, azimuth_deg: float, height: float) -> np.ndarray:

@@ -210,7 +210,7 @@ def effect_variant(robot: Robot, effect: str, *, current: Sequence[float] | None
     level = EFFECTS.index(effect)
     if level == 0:
         links = tuple(dataclasses.replace(lk, hydro=None) for lk in robot.links)
-        return dataclasses.replace(robot, links=links, fluid=None, description_hash="")
+        return dataclasses.replace(robot, links=links, fluid=None)
     links = []
     for lk in robot.links:
         if lk.hydro is None:
@@ -229,7 +229,7 @@ def effect_variant(robot: Robot, effect: str, *, current: Sequence[float] | None
         fluid = with_current(fluid, [0.0, 0.0, 0.0])
     elif current is not None:
         fluid = with_current(fluid, current)
-    return dataclasses.replace(robot, links=tuple(links), fluid=fluid, description_hash="")
+    return dataclasses.replace(robot, links=tuple(links), fluid=fluid)
 
 
 def _series_current(robot: Robot, parameters: Mapping[str, float],

@@ -92,10 +92,10 @@ def model_without(full: Robot, effect: str) -> Robot:
         return effect_variant(full, "dry")
     if effect == "current":
         fluid = with_current(fluid_of(full), [0.0, 0.0, 0.0])
-        return dataclasses.replace(full, fluid=fluid, description_hash="")
+        return dataclasses.replace(full, fluid=fluid)
     links = tuple(lk if lk.hydro is None else dataclasses.replace(
         lk, hydro=with_values(lk.hydro, dict.fromkeys(_KEYS[effect], 0.0))) for lk in full.links)
-    return dataclasses.replace(full, links=links, description_hash="")
+    return dataclasses.replace(full, links=links)
 
 
 def model_error_study(robot: Robot, reference: JointTrajectory, duration: float, *,

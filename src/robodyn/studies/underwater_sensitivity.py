@@ -79,7 +79,7 @@ def with_drag_coefficient(robot: Robot, cd: float) -> Robot:
     links = tuple(lk if lk.hydro is None
                   else dataclasses.replace(lk, hydro=with_values(lk.hydro, {"drag": cd}))
                   for lk in robot.links)
-    return dataclasses.replace(robot, links=links, description_hash="")
+    return dataclasses.replace(robot, links=links)
 
 
 def _values(values: Sequence[float], name: str) -> np.ndarray:
