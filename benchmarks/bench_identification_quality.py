@@ -53,7 +53,6 @@ import sys  # noqa: E402
 import time  # noqa: E402
 import warnings  # noqa: E402
 from collections.abc import Callable, Sequence  # noqa: E402
-from dataclasses import dataclass, replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
@@ -68,11 +67,8 @@ sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent))
 import results  # noqa: E402
 import textbook  # noqa: E402
+from quality_cases import KINOVA, Case, kinova_cases, kuka_cases, virtual_cases  # noqa: E402
 
-from tests.identification.kinova import DATA as KINOVA  # noqa: E402
-from tests.identification.kinova import JOINTWISE_FILES, WHOLE_ARM, WHOLE_ARM_FILES, read, split  # noqa: E402
-
-KUKA = KINOVA.parent / "kuka-lwr4"
 #: Rows of ``--quick`` (the virtual 7-DOF arm on a shorter period).
 QUICK_ROWS = ("KUKA run 1 -> run 2", "Kinova 70/30 pooled",
               "virtual 7-DOF, 1 kHz with gaps, torque, 75/25 of the period")
@@ -93,206 +89,6 @@ PEERS = {
                 "5 Hz, acceleration by central differences of the filtered velocity; QR base "
                 "columns; OLS; for currents the gains absorbed per joint (the fit in amperes)",
 }
-
-
-@dataclass
-class Case:
-    """One row group: fit on ``fit``, predict ``check`` (pooled)."""
-
-    name: str
-    robot: rd.Robot
-    urdf: str | None
-    fit: list
-    check: list
-    target: str
-    note: str = ""
-
-
-def kuka_cases() -> list[Case]:
-    """The KUKA LWR4+ splits: run 1 -> run 2, runs 1+2 -> run 3, run 1 -> run 3 (joint torque)."""
-    urdf = str(KUKA / "kuka_lwr4.urdf")
-    robot = rd.load(urdf)
-
-    def run(k: int) -> rd.Recording:
-        z = np.load(KUKA / f"measurements_{k}.npz")
-        return rd.Recording(t=z["times"], q=z["positions"], qd=z["velocities"], tau=z["torques"],
-                            joint_names=robot.joint_names, source=f"kuka run {k}")
-
-    r = {k: run(k) for k in (1, 2, 3)}
-    return [Case("KUKA run 1 -> run 2", robot, urdf, [r[1]], [r[2]], "tau",
-                 "the same trajectory, another run; joint torque sensors"),
-            Case("KUKA runs 1+2 -> run 3", robot, urdf, [r[1], r[2]], [r[3]], "tau",
-                 "another trajectory"),
-            Case("KUKA run 1 -> run 3", robot, urdf, [r[1]], [r[3]], "tau", "another trajectory")]
-
-
-def kinova_cases() -> list[Case]:
-    """The Kinova Gen3 splits: 70/30 pooled, across runs, whole runs -> jointwise (current)."""
-    robot = rd.load("kinova_gen3")
-    urdf = str(KINOVA / "gen3.urdf")
-    runs = {name: read(p) for name, p in zip(WHOLE_ARM, WHOLE_ARM_FILES, strict=True)}
-    halves = {name: split(rec) for name, rec in runs.items()}
-    jointwise = [read(p) for p in JOINTWISE_FILES]
-    return [
-        Case("Kinova 70/30 pooled", robot, urdf, [h[0] for h in halves.values()],
-             [h[1] for h in halves.values()], "current",
-             "first 70 % of the three whole-arm runs -> the last 30 %; motor current"),
-        Case("Kinova across runs", robot, urdf,
-             [runs["RunTrajectory1"], runs["RecordTrajectory_quadratic"]], [runs["Trajectory1"]],
-             "current", "RunTrajectory1 + RecordTrajectory_quadratic -> Trajectory1"),
-        Case("Kinova whole runs -> jointwise", robot, urdf, list(runs.values()), jointwise, "current",
-             "the three whole runs -> the seven jointwise runs, all joints (the held ones too)"),
-    ]
-
-
-def _rounded(rec: rd.Recording, decimals: int) -> rd.Recording:
-    """The recording as a log printed to ``decimals`` decimals (stamps, q, current, tau)."""
-    def r(a):
-        return None if a is None else np.round(np.asarray(a), decimals)
-
-    t = np.round(rec.t, decimals)
-    keep = np.concatenate([[True], np.diff(t) > 0])
-    pick = (lambda a: None if a is None else a[keep])  # noqa: E731
-    return rd.Recording(t=t[keep], q=pick(r(rec.q)), tau=pick(r(rec.tau)), current=pick(r(rec.current)),
-                        joint_names=rec.joint_names, source=rec.source + f" ({decimals} decimals)")
-
-
-def _gapped(rec: rd.Recording, rng: np.random.Generator, gaps: int, length: int) -> rd.Recording:
-    """The recording with ``gaps`` runs of ``length`` samples dropped (a logger's lost packets)."""
-    keep = np.ones(rec.n_samples, bool)
-    for start in rng.integers(length, rec.n_samples - 2 * length, gaps):
-        keep[start:start + length] = False
-    pick = (lambda a: None if a is None else np.asarray(a)[keep])  # noqa: E731
-    return rd.Recording(t=rec.t[keep], q=pick(rec.q), tau=pick(rec.tau), current=pick(rec.current),
-                        joint_names=rec.joint_names, source=rec.source + " (gaps)")
-
-
-#: Torque-sensor noise of the virtual 7-DOF arm, N m: its held-out noise floor is then 0.023 raw,
-#: the issue's torque-sensing arm's 0.0242 (0.3 N m before 2026-12-06: floor 0.085).
-TORQUE_NOISE_7DOF = 0.08
-#: The Stribeck hump of the plant's friction in the third virtual row: static friction this much
-#: above the Coulomb level (a fraction of it), fading over this velocity (rad/s).
-HUMP_EXCESS, HUMP_VELOCITY = 0.5, 0.05
-
-
-def _with_hump(lab: Any, coulomb: np.ndarray) -> rd.Recording:
-    """The lab's recording with the current a Stribeck hump of the plant's friction takes,
-    ``(Fs - Fc) sign(v) exp(-(v / vs)^2)`` at the exact velocity, through the actual drive gains
-    (a plant with that friction and a controller that feeds it forward: the motion unchanged)."""
-    v = lab.truth.qd
-    extra = HUMP_EXCESS * coulomb * np.sign(v) * np.exp(-((v / HUMP_VELOCITY) ** 2))
-    return replace(lab.recording, current=lab.recording.current + extra / lab.truth.drive_gain)
-
-
-#: The perturbed plants of two virtual rows: each moving link's mass x U(1 - s, 1 + s), its
-#: inertia x U(1 - 1.5 s, 1 + 1.5 s), its centre of mass + N(0, (0.1 s m)^2) per axis, and each
-#: joint's viscous and Coulomb friction x U(1 - s, 1 + s), with s this spread: a description off
-#: the arm as a URDF is off a real one, so that the prior the default pulls towards is wrong.
-PLANT_SPREAD = 0.2
-
-
-def _perturbed(robot: rd.Robot, seed: int) -> rd.Robot:
-    """``robot`` with its parameters drawn around the description's (:data:`PLANT_SPREAD`)."""
-    import sympy as sp
-
-    rng = np.random.default_rng(seed)
-    s = PLANT_SPREAD
-    links = [robot.links[0]]
-    for link in robot.links[1:]:
-        links.append(replace(link, mass=sp.Float(float(link.mass) * rng.uniform(1 - s, 1 + s)),
-                             com=sp.Matrix([float(c) + rng.normal(0, 0.1 * s) for c in link.com]),
-                             inertia=link.inertia * rng.uniform(1 - 1.5 * s, 1 + 1.5 * s)))
-    joints = []
-    for j in robot.joints:
-        f, k = j.friction, rng.uniform(1 - s, 1 + s, 3)
-        joints.append(replace(j, friction=replace(f, viscous=f.viscous * k[0],
-                                                  coulomb_positive=f.coulomb_positive * k[1],
-                                                  coulomb_negative=f.coulomb_negative * k[2])))
-    return replace(robot, links=tuple(links), joints=tuple(joints), name=robot.name + "_plant",
-                   description_hash="")
-
-
-def _perturbed_note(seed: int) -> str:
-    s = PLANT_SPREAD
-    return (f"the plant's parameters drawn around the description's (seed {seed}): masses and "
-            f"friction x U({1 - s:g}, {1 + s:g}), inertias x U({1 - 1.5 * s:g}, {1 + 1.5 * s:g}), "
-            f"centres of mass + N(0, ({100 * 0.1 * s:g} cm)^2) per axis; the description, and so "
-            "the prior, as given")
-
-
-def _virtual_6dof() -> list[Case]:
-    """A 6-DOF arm like the current-driven cobot: ~94 Hz (10/12 ms stamps), 4 decimals, currents;
-    three rows from the same three programs: as measured, with the current of a Stribeck hump in
-    the plant's friction that the description does not have, and run by a plant whose parameters
-    are off the description's (:func:`_perturbed`)."""
-    from robodyn.studies.testprog import jointwise
-    from robodyn.studies.virtual_lab import Sensors, virtual_lab
-
-    puma = rd.load("puma560")
-    model = rd.compile_model(puma)
-    subs = puma.defaults()
-    coulomb = np.array([0.5 * float((j.friction.coulomb_positive + j.friction.coulomb_negative)
-                                    .xreplace(subs)) for j in puma.joints])
-    duration = 40.0
-    sens = Sensors(sample_period=0.0106, jitter=0.001, counts_per_rev=4096.0, current_noise=0.03,
-                   current_offset=0.02, torque_constant_error=0.03, torque_noise=None,
-                   tracker_period=0.0)
-    programs = [rd.excitation(model, harmonics=4, base_frequency=1.0 / duration, starts=1,
-                              seed=seed, max_iterations=10, dt=0.0106) for seed in (1, 2)]
-    programs.append(jointwise(model, speeds=(0.5,), stroke=0.8))
-    labs = [virtual_lab(model, p, sensors=sens, seed=seed) for seed, p in enumerate(programs, 1)]
-    plain = [_rounded(lab.recording, 4) for lab in labs]
-    humped = [_rounded(_with_hump(lab, coulomb), 4) for lab in labs]
-    plant = rd.compile_model(_perturbed(puma, 1))
-    off = [_rounded(virtual_lab(plant, p, sensors=sens, seed=seed).recording, 4)
-           for seed, p in enumerate(programs, 1)]
-    # fit on the first excitation run; check on the other one and the jointwise run
-    return [Case("virtual 6-DOF, 94 Hz, 4 decimals, current -> other run + jointwise", puma, None,
-                 plain[:1], plain[1:], "current", "PUMA 560 as the plant, like the issue's "
-                 "current-driven cobot: 10/12 ms stamps, values printed to 4 decimals"),
-            Case("virtual 6-DOF as above, the plant's friction with a Stribeck hump", puma, None,
-                 humped[:1], humped[1:], "current",
-                 f"the same runs, the plant's Coulomb friction Fc with a Stribeck hump (static "
-                 f"friction {1 + HUMP_EXCESS:g} Fc, Stribeck velocity {HUMP_VELOCITY:g} rad/s) "
-                 "that the description does not have, the drive supplying it (added to the "
-                 "current at the exact velocity through the actual drive gains)"),
-            Case("virtual 6-DOF as above, the plant's parameters off the description's", puma,
-                 None, off[:1], off[1:], "current", "the same programs and sensors, "
-                 + _perturbed_note(1))]
-
-
-def virtual_cases(quick: bool) -> list[Case]:
-    """The two virtual arms of issue 20: the 6-DOF one three times (:func:`_virtual_6dof`), the
-    7-DOF one twice (its plant the description, and one off it); ``quick``: only the 7-DOF one as
-    described, on a shorter period."""
-    from robodyn.studies.virtual_lab import Sensors, virtual_lab
-
-    cases = [] if quick else _virtual_6dof()
-    # a 7-DOF torque-sensing arm: 1 kHz with gaps, periodic excitation, held-out part of the period
-    gen3 = rd.load("kinova_gen3")
-    model7 = rd.compile_model(gen3)
-    period = 10.0 if quick else 20.0
-    # torque noise 0.08 N m: the noise floor (0.023 raw) of the issue's arm (0.0242)
-    sens7 = Sensors(sample_period=1e-3, jitter=2e-5, counts_per_rev=2**18,
-                    torque_noise=TORQUE_NOISE_7DOF, tracker_period=0.0)
-    ex = rd.excitation(model7, harmonics=4, base_frequency=1.0 / period, starts=1, seed=4,
-                       max_iterations=10, dt=1e-3)
-    plants = [model7] if quick else [model7, rd.compile_model(_perturbed(gen3, 1))]
-    for plant in plants:
-        rec = _gapped(virtual_lab(plant, ex, sensors=sens7, seed=4).recording,
-                      np.random.default_rng(4), gaps=20, length=15)
-        k = int(0.75 * rec.n_samples)
-        fit, check = [rec.slice(rec.t[0], rec.t[k - 1])], [rec.slice(rec.t[k], rec.t[-1])]
-        if plant is model7:
-            cases.append(Case("virtual 7-DOF, 1 kHz with gaps, torque, 75/25 of the period", gen3,
-                              None, fit, check, "tau", f"Gen3 as the plant, like the issue's "
-                              f"torque-sensing arm: a {period:g} s period, 20 gaps of 15 samples, "
-                              f"torque noise {TORQUE_NOISE_7DOF:g} N m (the arm's noise floor)"))
-        else:
-            cases.append(Case("virtual 7-DOF as above, the plant's parameters off the "
-                              "description's", gen3, None, fit, check, "tau",
-                              "the same period, gaps and sensors, " + _perturbed_note(1)))
-    return cases
 
 
 def _score(case: Case, predict: Callable[[rd.Recording], np.ndarray]) -> tuple[float, float, float]:
