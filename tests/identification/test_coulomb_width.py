@@ -14,7 +14,14 @@ import pytest
 
 import robodyn as rd
 from robodyn.cli.identify import _width
-from robodyn.identification.coulomb_width import WIDTH_PER_NOISE, auto_coulomb_width, velocity_noise
+from robodyn.identification.coulomb_width import (
+    HOLD_SECONDS,
+    HOLD_SPEED,
+    WIDTH_PER_NOISE,
+    auto_coulomb_width,
+    holds,
+    velocity_noise,
+)
 from robodyn.identification.pipeline import nominal_standard
 from robodyn.identification.preprocess import Preprocess
 from robodyn.robot.errors import IdentificationError
@@ -86,6 +93,48 @@ def test_a_narrow_width_is_the_step_away_from_rest(planar_run):
     moving = np.all(np.abs(qd) > 1e-6, axis=1)
     np.testing.assert_allclose(smooth.predict(rec)[moving], np.asarray(rec.tau)[moving], rtol=0,
                                atol=1e-8 * np.abs(rec.tau).max())
+
+
+def test_holds_are_sustained_slow_stretches_on_any_stamps():
+    rng = np.random.default_rng(5)
+    t = np.cumsum(rng.uniform(0.008, 0.012, 600))  # ~6 s of irregular stamps
+    qd = np.column_stack([np.cos(2 * np.pi * 0.5 * t),  # brisk: reversals pass in milliseconds
+                          np.where((t > 2.0) & (t < 3.0), 1e-4 * np.sin(40 * t), 0.5),  # 1 s hold
+                          np.where((t > 4.0) & (t < 4.1), 0.0, 0.5)])  # 0.1 s: too short
+    held = holds(t, qd)
+    assert not held[:, 0].any() and not held[:, 2].any()
+    np.testing.assert_array_equal(held[:, 1], (t > 2.0) & (t < 3.0))
+    assert HOLD_SECONDS > 0.1 and HOLD_SPEED > 1e-4
+
+
+def test_a_held_joint_is_predicted_with_the_mean_of_the_two_levels(planar_run):
+    """Joint 1 creeps (+-2e-4 rad/s) for 2 s while joint 2 moves on; a plant with the exact step
+    flips its friction with each creep, which no sign predicts: the prediction takes the mean of
+    the two levels there, and keeps the step (a narrow width) everywhere else."""
+    robot, model, rec = planar_run
+    t = np.asarray(rec.t)
+    q, qd, qdd = (np.array(a) for a in (rec.q, rec.qd, rec.qdd))
+    hold = (t >= 10.0) & (t < 12.0)
+    w = 2 * np.pi * 3.0
+    th = t[hold] - 10.0
+    q[hold, 0] = q[hold, 0][0] + 2e-4 / w * (1.0 - np.cos(w * th))
+    qd[hold, 0], qdd[hold, 0] = 2e-4 * np.sin(w * th), 2e-4 * w * np.cos(w * th)
+    p = nominal_standard(robot).copy()
+    for j, (pos, neg) in enumerate(LEVELS):
+        p[PER_JOINT * j + FV:PER_JOINT * j + FV + 4] = (0.3, pos, neg, 0.0)
+    tau = model.regressor(q, qd, qdd) @ p
+    crept = rd.Recording(t=t, q=q, qd=qd, qdd=qdd, tau=tau, joint_names=robot.joint_names,
+                         source="creep")
+    ident = _identify(robot, model, crept, coulomb_width=1e-9)
+    expected = tau.copy()
+    pos, neg = LEVELS[0]
+    inside = hold & (qd[:, 0] != 0)
+    # the step Fcp H(qd) - Fcn H(-qd) becomes (Fcp - Fcn) / 2 in the hold
+    expected[inside, 0] += 0.5 * (pos - neg) - (pos * (qd[inside, 0] > 0) - neg * (qd[inside, 0] < 0))
+    assert np.max(np.abs(expected - tau)) > 1.0  # the hold is visible
+    moving = np.abs(qd) > 1e-6
+    np.testing.assert_allclose(ident.predict(crept)[moving], expected[moving], rtol=0,
+                               atol=1e-8 * np.abs(tau).max())
 
 
 def test_the_widths_are_reported(planar_run):

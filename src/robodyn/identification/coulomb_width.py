@@ -13,6 +13,12 @@ This lowers the expected squared error of the Coulomb torque wherever ``|qd|`` i
 a single run may come out either way (``benchmarks/bench_identification_coulomb.py``, simulated
 runs).
 
+**A joint held by its controller** (:func:`holds`: its estimated speed below
+:data:`HOLD_SPEED` for at least :data:`HOLD_SECONDS`) creeps at speeds no noise estimate sees,
+and its friction does not follow their sign: there the expected step is the mean of the two
+levels (``s = 0`` in :func:`robodyn.identification.preprocess.coulomb_smoothing`), whatever the
+width. A reversal in brisk motion passes below that speed for milliseconds and keeps the width.
+
 ``s`` per joint (:func:`velocity_noise`): the positions' (or the measured velocities') white
 noise, measured by their fourth divided differences at their own stamps (which any cubic in time
 leaves at zero, so that the motion does not count as noise, on irregular stamps too), carried
@@ -33,10 +39,15 @@ import numpy as np
 from robodyn.identification.preprocess import MOVING_RAD
 from robodyn.measure.filtering import differentiate, lowpass
 
-__all__ = ["WIDTH_PER_NOISE", "auto_coulomb_width", "velocity_noise"]
+__all__ = ["HOLD_SECONDS", "HOLD_SPEED", "WIDTH_PER_NOISE", "auto_coulomb_width", "holds",
+           "velocity_noise"]
 
 #: ``w / s``: tanh(x / w) and erf(x / (sqrt(2) s)) have the same slope at 0 (module docstring).
 WIDTH_PER_NOISE = float(np.sqrt(np.pi / 2.0))
+#: A hold: a joint's estimated speed below this (rad/s, m/s; the textbook's dead band) ...
+HOLD_SPEED = 1e-3
+#: ... for at least this long, s (a reversal in brisk motion stays below it for milliseconds).
+HOLD_SECONDS = 0.25
 #: Fewest samples for a noise estimate of a recording.
 _MIN_SAMPLES = 64
 #: The five samples of a window of :func:`_white_std`.
@@ -109,3 +120,30 @@ def auto_coulomb_width(recordings: Sequence[Any], settings: Any) -> np.ndarray:
         var[moving] += rec.t.size * s[moving] ** 2
         count[moving] += rec.t.size
     return WIDTH_PER_NOISE * np.sqrt(np.divide(var, count, out=np.zeros_like(var), where=count > 0))
+
+
+def holds(t: np.ndarray, qd: np.ndarray, speed: float = HOLD_SPEED,
+          seconds: float = HOLD_SECONDS) -> np.ndarray:
+    """Where each joint is held (N, n): its estimated speed ``|qd|`` stays below ``speed``
+    (rad/s, m/s) for at least ``seconds`` without a break.
+
+    Parameters
+    ----------
+    t : numpy.ndarray, shape (N,)
+        Stamps, s, increasing (any spacing).
+    qd : numpy.ndarray, shape (N, n)
+        Processed velocities, rad/s (m/s).
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (N, n)
+    """
+    slow = np.abs(qd) < speed
+    out = np.zeros_like(slow)
+    for j in range(qd.shape[1]):
+        # runs of slow samples: starts where the mask rises, ends where it falls
+        edges = np.diff(np.concatenate([[0], slow[:, j].astype(np.int8), [0]]))
+        for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True):
+            if t[b - 1] - t[a] >= seconds:
+                out[a:b, j] = True
+    return out
