@@ -21,8 +21,12 @@ Data sets:
   ~94 Hz with 10/12 ms stamps and values printed to 4 decimals, motor currents, validated on
   other excitation and on jointwise runs with static holds (three times: the plain plant, a plant
   whose friction has a Stribeck hump the description lacks, and a plant whose parameters are off
-  the description's, :data:`PLANT_SPREAD`); and a 7-DOF torque-sensing arm at 1 kHz with gaps in
-  the stamps, a held-out part of the period (twice: the plain plant and one off the description).
+  the description's, ``quality_cases.PLANT_SPREAD``); a 7-DOF torque-sensing arm at 1 kHz with
+  gaps in the stamps, a held-out part of the period (twice: the plain plant and one off the
+  description); and another arm configured like the cobot: the KUKA LWR4+ URDF (no drive data,
+  so the gains are absorbed per joint) run by a plant off it with drives it lacks and friction
+  lower in the validation runs (``quality_cases._virtual_lwr4``). The data sets are built in
+  ``quality_cases.py``.
 
 Speed (``--only speed``): 10^5 samples x 7 joints (Gen3, 1 kHz, a simulated run with noise and
 a measured velocity) identified by the default ``rd.identify`` (physically consistent, velocity

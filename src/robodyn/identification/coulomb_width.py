@@ -15,9 +15,9 @@ runs).
 
 **A joint held by its controller** (:func:`holds`: its estimated speed below
 :data:`HOLD_SPEED` for at least :data:`HOLD_SECONDS`) creeps at speeds no noise estimate sees,
-and its friction does not follow their sign: there the expected step is the mean of the two
-levels (``s = 0`` in :func:`robodyn.identification.preprocess.coulomb_smoothing`), whatever the
-width. A reversal in brisk motion passes below that speed for milliseconds and keeps the width.
+and below that speed its sign says little about its friction: there the width is at least
+:data:`HOLD_SPEED` (:func:`held_widths`). A reversal in brisk motion passes below that speed for
+milliseconds and keeps the width from the noise.
 
 ``s`` per joint (:func:`velocity_noise`): the positions' (or the measured velocities') white
 noise, measured by their fourth divided differences at their own stamps (which any cubic in time
@@ -39,8 +39,8 @@ import numpy as np
 from robodyn.identification.preprocess import MOVING_RAD
 from robodyn.measure.filtering import differentiate, lowpass
 
-__all__ = ["HOLD_SECONDS", "HOLD_SPEED", "WIDTH_PER_NOISE", "auto_coulomb_width", "holds",
-           "velocity_noise"]
+__all__ = ["HOLD_SECONDS", "HOLD_SPEED", "WIDTH_PER_NOISE", "auto_coulomb_width", "held_widths",
+           "holds", "velocity_noise"]
 
 #: ``w / s``: tanh(x / w) and erf(x / (sqrt(2) s)) have the same slope at 0 (module docstring).
 WIDTH_PER_NOISE = float(np.sqrt(np.pi / 2.0))
@@ -147,3 +147,11 @@ def holds(t: np.ndarray, qd: np.ndarray, speed: float = HOLD_SPEED,
             if t[b - 1] - t[a] >= seconds:
                 out[a:b, j] = True
     return out
+
+
+def held_widths(t: np.ndarray, qd: np.ndarray, width: float | np.ndarray) -> np.ndarray:
+    """Per-sample widths (N, n), rad/s (m/s): ``width`` (scalar or (n,)) where the joint moves,
+    at least :data:`HOLD_SPEED` where it is held (:func:`holds`); a joint whose width is 0 keeps
+    the step everywhere."""
+    w = np.broadcast_to(np.asarray(width, float), qd.shape)
+    return np.where(holds(t, qd) & (w > 0), np.maximum(w, HOLD_SPEED), w)

@@ -226,26 +226,22 @@ def coulomb_dead_band(y: np.ndarray, qd: np.ndarray, band: float) -> np.ndarray:
     return y
 
 
-def coulomb_smoothing(y: np.ndarray, qd: np.ndarray, width: float | np.ndarray,
-                      held: np.ndarray | None = None) -> np.ndarray:
+def coulomb_smoothing(y: np.ndarray, qd: np.ndarray, width: float | np.ndarray) -> np.ndarray:
     """The regressor ``y`` (N, n, 15 n) with joint j's Coulomb steps smoothed over ``w_j``.
 
     Where a joint moves (its Coulomb columns ``H(qd)``, ``-H(-qd)`` not both zero: ``qd != 0``
     and outside the dead band) they become ``(1 + s) / 2`` and ``-(1 - s) / 2`` with
     ``s = tanh(qd / w)``: the probabilities that the velocity is positive or negative when its
     estimate is ``qd`` (:mod:`robodyn.identification.coulomb_width`), so that the Coulomb torque
-    passes through the mean of its two levels at ``qd = 0``; ``s = 0`` where ``held`` (N, n)
-    says the joint is held (:func:`robodyn.identification.coulomb_width.holds`); a joint at rest
-    keeps the offset alone. ``qd`` (N, n), rad/s; ``width`` rad/s, one for all joints or (n,),
-    0: the step (and no hold). ``y`` is changed in place and returned."""
-    widths = np.broadcast_to(np.asarray(width, float), (qd.shape[1],))
-    for j in np.flatnonzero(widths > 0):
+    passes through the mean of its two levels at ``qd = 0``; a joint at rest keeps the offset
+    alone. ``qd`` (N, n), rad/s; ``width`` rad/s: one for all joints, (n,), or (N, n) per
+    sample; 0: the step. ``y`` is changed in place and returned."""
+    widths = np.broadcast_to(np.asarray(width, float), qd.shape)
+    for j in np.flatnonzero(np.any(widths > 0, axis=0)):
         cols = joint_columns(j, "Fcp", "Fcn")
         moving = y[:, j, cols.start] - y[:, j, cols.start + 1]  # 1 where moving, else 0
-        s = np.tanh(qd[:, j] / widths[j])
-        if held is not None:
-            # held: no sign at all, the mean of the two levels
-            s[held[:, j]] = 0.0
+        w = widths[:, j]
+        s = np.where(w > 0, np.tanh(qd[:, j] / np.where(w > 0, w, 1.0)), np.sign(qd[:, j]))
         # H(qd) -> (1 + s) / 2, -H(-qd) -> -(1 - s) / 2: the expected step given the estimate
         y[:, j, cols.start] = moving * 0.5 * (1.0 + s)
         y[:, j, cols.start + 1] = -moving * 0.5 * (1.0 - s)
@@ -253,16 +249,14 @@ def coulomb_smoothing(y: np.ndarray, qd: np.ndarray, width: float | np.ndarray,
 
 
 def prediction_rows(model: Any, s: Samples, settings: Preprocess, out: np.ndarray | None = None,
-                    coulomb_width: float | np.ndarray = 0.0,
-                    held: np.ndarray | None = None) -> np.ndarray:
+                    coulomb_width: float | np.ndarray = 0.0) -> np.ndarray:
     """Regressor (N, n, 15 n) of processed samples for a prediction: the compiled regressor of
     ``model`` at ``(s.q, s.qd, s.qdd)`` with the Coulomb dead band (:func:`coulomb_dead_band`)
-    and the Coulomb steps smoothed over ``coulomb_width`` rad/s (scalar or (n,)), their sign
-    dropped where ``held`` (N, n) (:func:`coulomb_smoothing`);
+    and the Coulomb steps smoothed over ``coulomb_width`` rad/s (scalar, (n,) or (N, n),
+    :func:`coulomb_smoothing`);
     written into ``out`` (N, n, 15 n), C-contiguous, when given."""
     y = regressor_rows_of(model, s.q, s.qd, s.qdd, out=out)
-    return coulomb_smoothing(coulomb_dead_band(y, s.qd, settings.dead_band), s.qd, coulomb_width,
-                             held)
+    return coulomb_smoothing(coulomb_dead_band(y, s.qd, settings.dead_band), s.qd, coulomb_width)
 
 
 def regressor_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool = True) -> np.ndarray:

@@ -12,7 +12,7 @@ import sympy as sp
 from robodyn.identification.bandwidth import check_prediction_cutoff
 from robodyn.identification.base import BaseRelations
 from robodyn.identification.choices import Choices
-from robodyn.identification.coulomb_width import holds
+from robodyn.identification.coulomb_width import held_widths
 from robodyn.identification.friction import FrictionFit, without_friction
 from robodyn.identification.options import IdentifyOptions, positive_frequency
 from robodyn.identification.preprocess import Preprocess, Samples, prediction_rows, preprocess
@@ -267,12 +267,12 @@ class Identification:
         count, n = s.q.shape
         out = np.empty((count, n))
         buf = np.empty((min(count, EFFORT_CHUNK), n, self.standard.size))
-        held = holds(s.t, s.qd)  # on the whole run: a hold may span chunks
+        width = held_widths(s.t, s.qd, self.coulomb_width)  # the whole run: holds span chunks
         for a in range(0, count, EFFORT_CHUNK):
             b = min(a + EFFORT_CHUNK, count)
             part = Samples(s.t[a:b], s.q[a:b], s.qd[a:b], s.qdd[a:b], None, s.source)
             y = prediction_rows(self._model, part, self.preprocess, out=buf[:b - a],
-                                coulomb_width=self.coulomb_width, held=held[a:b])
+                                coulomb_width=width[a:b])
             out[a:b] = self._effort_of(part, y, None if temperature is None else temperature[a:b], pay)
         return out
 
