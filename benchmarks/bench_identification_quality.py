@@ -83,9 +83,9 @@ ROW_TARGETS = (("KUKA run 1 -> run 2", "raw", 0.0214), ("KUKA runs 1+2 -> run 3"
 SPEED_TARGET_S, SPEED_SAMPLES = 10.0, 100_000
 
 PEERS = {
-    "nominal": "the description's own parameters, no fit (Kinova: amperes through the "
-               "description's gains, 1 N m/A, as its URDF has no drive data: the row only says "
-               "that the description alone does not predict current)",
+    "nominal": "the description's own parameters, no fit (Kinova and the LWR4+ cobot row: "
+               "amperes through the description's gains, 1 N m/A, as their URDFs have no drive "
+               "data: the rows only say that the description alone does not predict current)",
     "textbook": "benchmarks/textbook.py, what an engineer writes in an afternoon, independent of "
                 "robodyn's code: Pinocchio's computeJointTorqueRegressor plus per joint rotor "
                 "inertia, viscous, Coulomb (sign(qd), 0 below 1e-3 rad/s) and offset columns; "

@@ -141,10 +141,11 @@ def render_identification_quality(data: dict[str, Any]) -> str:
     e = data["benchmarks"]["identification_quality"]
     lines = rc.wrap(rc.run(data, e, (
         "Held-out prediction error of the default `rd.identify` against a textbook "
-        "least-squares script, on every real data set here and two virtual arms configured like "
+        "least-squares script, on every real data set here, two virtual arms configured like "
         "issue 20's held-out arms (each also with a plant whose parameters are off the "
         "description's, and the 6-DOF one with a plant whose friction the description cannot "
-        f"express), {len(e['rows'])} rows")) + (
+        "express) and a third arm (the KUKA LWR4+ description, no drive data) configured like the "
+        f"cobot, {len(e['rows'])} rows")) + (
         f" Figures: {e['error']}; each cell raw / filtered (one figure where they agree to three "
         "digits); one run (the figures do not depend on load). Targets are issue 20's, judged on "
         "the figures below."))
@@ -164,7 +165,8 @@ def render_identification_quality(data: dict[str, Any]) -> str:
         "The issue's targets for its two held-out arms (0.11 and 0.013 filtered) cannot be judged "
         "here: their recordings are not in the repository; the virtual rows are configured like "
         "them, with the description as the plant, or a plant with friction the description lacks, "
-        "or a plant whose parameters are drawn around the description's. "
+        "or a plant whose parameters (and, on the LWR4+, drives) are drawn around the "
+        "description's. "
         "Why some rows lose, and the frequency bands "
         "of the Kinova current: docs/identification.md.")
     lines += [""] + rc.wrap(_speed(e))
