@@ -149,7 +149,7 @@ def test_the_widths_are_reported(planar_run):
     smooth = _identify(robot, model, rec, coulomb_width=0.25)
     assert "smoothed over <b>0.25 rad/s</b>" in _choices_html(smooth)
     assert _smoothing_note(np.array([0.0031, 0.0024])) == \
-        ", Coulomb step smoothed over 0.0031, 0.0024 rad/s"
+        ", Coulomb step smoothed over 0.0031, 0.0024 rad/s (at least 0.001 where held)"
     assert _smoothing_note(np.zeros(2)) == ""
     assert "smoothed" not in _choices_html(_identify(robot, model, rec, coulomb_width=0.0))
 

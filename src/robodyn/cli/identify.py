@@ -202,8 +202,10 @@ def _smoothing_note(width: float | np.ndarray) -> str:
     """The predictions' Coulomb smoothing as the note says it ("" without one)."""
     if not np.any(width):
         return ""
+    from robodyn.identification.coulomb_width import HOLD_SPEED
+
     text = ", ".join(f"{w:.2g}" for w in np.atleast_1d(width))
-    return f", Coulomb step smoothed over {text} rad/s"
+    return f", Coulomb step smoothed over {text} rad/s (at least {HOLD_SPEED:g} where held)"
 
 
 def _compiled(robot: rd.Robot) -> rd.Model:
