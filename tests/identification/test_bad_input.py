@@ -126,9 +126,9 @@ def test_options_object_checks_once_and_runs_like_the_keywords(arm):
     by_options = rd.identify(robot, rec, options=opts, model=model)
     np.testing.assert_array_equal(by_options.standard, by_keywords.standard)
     assert by_options.options is opts and by_keywords.options.method == "ols"
-    assert by_keywords.options.cutoff is None and by_keywords.options.spikes == "keep"
+    assert by_keywords.options.cutoff is None and by_keywords.options.spikes == "auto"
     for bad, message in [({"method": "lasso"}, r"method: expected one of \('ols', 'wls', 'consistent'\)"),
-                         ({"spikes": "clip"}, r"spikes: expected one of \('keep', 'drop'\)"),
+                         ({"spikes": "clip"}, r"spikes: expected one of \('auto', 'keep', 'drop'\)"),
                          ({"weights": "state-noise"}, r"state_noise: weights='state-noise' needs"),
                          ({"thermal": 1}, r"thermal: expected False, True or 'auto', got 1"),
                          ({"ripple": "yes"}, r"ripple: expected False, True or 'auto', got 'yes'")]:

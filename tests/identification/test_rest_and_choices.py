@@ -13,7 +13,7 @@ import pytest
 import robodyn as rd
 from robodyn.identification.consistent import EPS, _project_link, pseudo_inertia
 from robodyn.identification.pipeline import nominal_standard
-from robodyn.robot.errors import IdentificationError
+from robodyn.robot.errors import IdentificationError, RecordingWarning
 from robodyn.robot.validation import inertia_problems
 from robodyn.robot.yaml_writer import dump_yaml
 from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT
@@ -392,7 +392,8 @@ def test_a_few_corrupt_rows_are_dropped_as_spikes(puma):
     # issue 20 item 3: real logs carry a few corrupt rows within plausible bounds (an encoder
     # glitch, a torque spike, a row of zeros). Kept, five of 6000 rows double the held-out error
     # on exact motion; spikes="drop" finds and drops them (and nothing else here), and the fit is
-    # the clean one again.
+    # the clean one again; so does the default, spikes="auto", which drops gross glitches only
+    # (these are: a third of a radian, twenty times the torque, a row of zeros), with a warning.
     robot, model = puma
     t = np.arange(0.0, 30.0, 0.005)
     fit, _ = _log(model, t, 1)
@@ -416,12 +417,15 @@ def test_a_few_corrupt_rows_are_dropped_as_spikes(puma):
     q[rows[4]] = 0.0  # a row of zeros
     assert clean < 0.06  # the clean fit (0.5 N m noise, no prior) predicts the exact motion to 5 %
     assert held_out(q, tau, "keep") > 1.5 * clean  # the glitches steer the fit
-    from robodyn.identification.spikes import spike_rows
+    from robodyn.identification.spikes import GROSS_THRESHOLD, spike_rows
 
     found = spike_rows(t, q, tau)
     assert set(np.flatnonzero(found)) == set(rows)  # the five rows, and only they
     assert not spike_rows(t, fit.q, noisy_tau).any()  # clean data: nothing
     assert held_out(q, tau) < 1.02 * clean
+    assert set(np.flatnonzero(spike_rows(t, q, tau, threshold=GROSS_THRESHOLD))) == set(rows)
+    with pytest.warns(RecordingWarning, match=r"5 row\(s\) dropped as one-sample glitches"):
+        assert held_out(q, tau, "auto") < 1.02 * clean
 
 
 def test_least_squares_writes_a_physical_completion_when_one_exists(puma, tmp_path):

@@ -31,7 +31,7 @@ FRICTION_MODELS: tuple[str, ...] = ("none", "linear", "stribeck", "load", "polyn
 METHODS: tuple[str, ...] = ("ols", "wls", "consistent")
 VELOCITIES: tuple[str, ...] = ("auto", "position", "measured")
 SENSORS: tuple[str, ...] = ("motor", "link")
-SPIKES: tuple[str, ...] = ("keep", "drop")
+SPIKES: tuple[str, ...] = ("auto", "keep", "drop")
 
 
 def tqdm(*args: object, **kwargs: object) -> object:
@@ -483,10 +483,12 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
                         "sign is uncertain (joints held still, slow reversals); the fit keeps the "
                         "step; 0: none; auto: per joint, from the noise of the identification "
                         "data's processed velocity (default: %(default)s)")
-    p.add_argument("--spikes", choices=SPIKES, default="keep",
+    p.add_argument("--spikes", choices=SPIKES, default="auto",
                    help="one-sample glitches (a position or target sample far off the line "
-                        "through its neighbours) in the identification recordings: keep them, or "
-                        "drop those rows before the fit (default: %(default)s)")
+                        "through its neighbours) in the identification recordings: keep them, "
+                        "drop those rows before the fit (beyond 12 robust standard deviations), "
+                        "or auto: drop gross glitches only (beyond 100), with a warning "
+                        "(default: %(default)s)")
     p.add_argument("--ripple", type=_auto_on_off, default="auto", metavar="{auto,on,off}",
                    help="a torque once per revolution of each revolute joint (a sin q + b cos q), "
                         "fitted on what the model leaves: on, off, or auto: kept when it predicts "

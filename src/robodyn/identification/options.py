@@ -24,7 +24,7 @@ METHODS = ("ols", "wls", "consistent")
 WEIGHTS = ("residual", "state-noise")
 VELOCITIES = ("auto", "position", "measured")
 SENSORS = ("motor", "link")
-SPIKES = ("keep", "drop")
+SPIKES = ("auto", "keep", "drop")
 
 
 @dataclass(frozen=True, eq=False)
@@ -85,13 +85,14 @@ class IdentifyOptions:
         drive: the reflected rotor inertia ``Ia`` is identified), or "link" (a joint torque
         sensor after the gear, which does not see the rotor: the ``Ia`` columns are dropped and
         ``Ia = 0`` in the prior and the result; ``target="tau"`` only).
-    spikes : {"keep", "drop"}
+    spikes : {"auto", "keep", "drop"}
         One-sample glitches of the identification recordings (a sample of ``q`` or of the target
         far off the line through its neighbours, :mod:`robodyn.identification.spikes`): kept, or
-        their rows dropped before anything else (estimated velocities then re-estimated). Off
-        by default: on the real logs here the test also flags 0.5-3 % of ordinary samples, and
-        dropping them changed the quality table's held-out errors by -0.4 % to +5.5 %
-        (benchmarks/bench_identification_quality.py cases, one run).
+        their rows dropped before anything else (estimated velocities then re-estimated).
+        "drop": beyond 12 robust standard deviations, which on the real logs here also flags
+        0.5-3 % of ordinary samples (the quality table's held-out errors moved by -0.4 % to
+        +5.5 %); "auto" (the default): gross glitches only, beyond 100 (none to nine rows per
+        real run here; every real row of the quality table within 0.1 %), with a warning.
     ripple : bool or "auto"
         A torque once per revolution of each revolute joint, ``a_j sin q_j + b_j cos q_j``,
         fitted on what the identified model leaves of the target
@@ -129,7 +130,7 @@ class IdentifyOptions:
     state_noise: Any = None
     thermal: bool | str = False
     sensor: str = "motor"
-    spikes: str = "keep"
+    spikes: str = "auto"
     ripple: bool | str = "auto"
     resonance: bool | str = "auto"
     prediction_cutoff: float | str = "fit"

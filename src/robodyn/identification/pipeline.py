@@ -50,7 +50,7 @@ from robodyn.identification.preprocess import (
 )
 from robodyn.identification.prior import joint_prior
 from robodyn.identification.result import BaseParameters, Identification
-from robodyn.identification.spikes import drop_spikes
+from robodyn.identification.spikes import without_spikes
 from robodyn.identification.state_noise import state_noise_std, torque_variance
 from robodyn.identification.thermal import ThermalData, ThermalFit, thermal_data
 from robodyn.identification.to_robot import robot_with_parameters
@@ -107,7 +107,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
              bounds: dict[str, tuple[float, float]] | None = None, model: Model | None = None,
              payloads: Sequence[Payload | None] | None = None, weights: str = "residual",
              state_noise: Any = None, thermal: bool | str = False, sensor: str = "motor",
-             spikes: str = "keep", ripple: bool | str = "auto", resonance: bool | str = "auto",
+             spikes: str = "auto", ripple: bool | str = "auto", resonance: bool | str = "auto",
              prediction_cutoff: float | str = "fit",
              options: IdentifyOptions | None = None) -> Identification:
     """Identify the base inertial, drive and friction parameters of a robot from recordings.
@@ -160,8 +160,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         IdentificationError)
     recs, target, pays = checked_inputs(robot, recordings, target, opts.sensor, payloads)
     check_prediction_cutoff(recs, opts.prediction_cutoff)
-    if opts.spikes == "drop":  # one-sample glitches removed from the fit's recordings
-        recs = [drop_spikes(r, target)[0] for r in recs]
+    recs = without_spikes(recs, target, opts.spikes)  # one-sample glitches of the fit's recordings
     model = model if model is not None else compile_model(robot)
     measured = all(r.qd is not None and "qd" not in getattr(r, "estimated", frozenset()) for r in recs)
     temps = all(getattr(r, "temperature", None) is not None for r in recs)
