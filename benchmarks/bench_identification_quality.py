@@ -116,7 +116,9 @@ METHODS: Sequence[tuple[str, dict, str]] = (
      "rd.identify(robot, fit, target=...): the physically consistent program with the Tikhonov "
      "weight, velocity source, cut-off, friction law (linear or Stribeck), position ripple and "
      "drive modes (one second-order mode per joint) chosen by held-out time blocks of the fit "
-     "data, and the predictions' Coulomb step smoothed over the fit data's velocity noise"),
+     "data, and the predictions' Coulomb step smoothed over the fit data's velocity noise (over "
+     "at least 1e-3 rad/s where a joint is held); gross one-sample glitches of the fit data "
+     "dropped (spikes='auto')"),
     ("no Coulomb smoothing", {"coulomb_width": 0.0},
      "the default with the Coulomb step kept in predictions (coulomb_width=0): the default of "
      "the previous version"),
