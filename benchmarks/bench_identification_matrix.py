@@ -22,7 +22,6 @@ from __future__ import annotations
 import argparse
 import sys
 import warnings
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -63,18 +62,8 @@ def configuration(text: str) -> tuple[str, float, str, int, str]:
 
 def _plant(desc: rd.Robot, arm: str, target: str, seed: int) -> rd.Robot:
     """The description perturbed (seed), with drives it lacks for currents (LWR4+, Gen3)."""
-    import sympy as sp
-
     plant = qc._perturbed(desc, seed)
-    if target != "current" or arm == "puma":
-        return plant
-    rng = np.random.default_rng(100 + seed)
-    joints = []
-    for j in plant.joints:
-        g, kt, jm = (sp.Float(rng.uniform(lo, hi)) for lo, hi in qc.LWR4_DRIVES)
-        joints.append(replace(j, drive=replace(j.drive, gear_ratio=g, torque_constant=kt,
-                                               rotor_inertia=jm)))
-    return replace(plant, joints=tuple(joints))
+    return plant if target != "current" or arm == "puma" else qc.with_drives(plant, 100 + seed)
 
 
 def case(arm: str, rate: float, target: str, seed: int, validation: str) -> quality.Case:

@@ -209,26 +209,32 @@ def _scaled_friction(robot: rd.Robot, k: float) -> rd.Robot:
         coulomb_negative=fj.coulomb_negative * k)) for j, fj in zip(robot.joints, f, strict=True)))
 
 
+def with_drives(robot: rd.Robot, seed: int) -> rd.Robot:
+    """``robot`` with drives drawn per joint within :data:`LWR4_DRIVES` (gear ratio, torque
+    constant, rotor inertia), as a plant has and a URDF lacks."""
+    import sympy as sp
+
+    rng = np.random.default_rng(seed)
+    joints = []
+    for j in robot.joints:
+        g, kt, jm = (sp.Float(rng.uniform(lo, hi)) for lo, hi in LWR4_DRIVES)
+        joints.append(replace(j, drive=replace(j.drive, gear_ratio=g, torque_constant=kt,
+                                               rotor_inertia=jm)))
+    return replace(robot, joints=tuple(joints))
+
+
 def _virtual_lwr4() -> Case:
     """Another arm configured like the current-driven cobot: the KUKA LWR4+ description (its
     URDF: no drive data, so the gains are absorbed per joint as on a real cobot's URDF) and a plant
     off it (:func:`_perturbed`, seed 1) with drives the description does not have
     (:data:`LWR4_DRIVES`, seed 101) and friction lower by :data:`LWR4_FRICTION_DRIFT` in the
     validation runs; the 6-DOF rows' sensors, programs and split."""
-    import sympy as sp
-
     from robodyn.studies.testprog import jointwise
     from robodyn.studies.virtual_lab import virtual_lab
 
     urdf = str(KUKA / "kuka_lwr4.urdf")
     desc = rd.load(urdf)
-    rng = np.random.default_rng(101)
-    joints = []
-    for j in _perturbed(desc, 1).joints:
-        g, kt, jm = (sp.Float(rng.uniform(lo, hi)) for lo, hi in LWR4_DRIVES)
-        joints.append(replace(j, drive=replace(j.drive, gear_ratio=g, torque_constant=kt,
-                                               rotor_inertia=jm)))
-    plant = replace(_perturbed(desc, 1), joints=tuple(joints))
+    plant = with_drives(_perturbed(desc, 1), 101)
     plants = [rd.compile_model(plant)] + 2 * [rd.compile_model(_scaled_friction(plant, LWR4_FRICTION_DRIFT))]
     model = rd.compile_model(desc)
     programs = [rd.excitation(model, harmonics=4, base_frequency=1.0 / 40.0, starts=1, seed=seed,

@@ -138,14 +138,18 @@ def holds(t: np.ndarray, qd: np.ndarray, speed: float = HOLD_SPEED,
     -------
     numpy.ndarray of bool, shape (N, n)
     """
-    slow = np.abs(qd) < speed
-    out = np.zeros_like(slow)
+    slow = (np.abs(qd) < speed).astype(np.int8)
+    out = np.zeros(qd.shape, dtype=bool)
     for j in range(qd.shape[1]):
-        # runs of slow samples: starts where the mask rises, ends where it falls
-        edges = np.diff(np.concatenate([[0], slow[:, j].astype(np.int8), [0]]))
-        for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True):
-            if t[b - 1] - t[a] >= seconds:
-                out[a:b, j] = True
+        # runs of slow samples: starts where the mask rises, ends (exclusive) where it falls
+        edges = np.diff(np.concatenate([[0], slow[:, j], [0]]))
+        starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+        long = t[ends - 1] - t[starts] >= seconds
+        # +1 at each long run's start, -1 past its end: the running sum marks the run
+        mark = np.zeros(t.size + 1, dtype=np.int64)
+        np.add.at(mark, starts[long], 1)
+        np.add.at(mark, ends[long], -1)
+        out[:, j] = np.cumsum(mark[:-1]) > 0
     return out
 
 
@@ -154,4 +158,6 @@ def held_widths(t: np.ndarray, qd: np.ndarray, width: float | np.ndarray) -> np.
     at least :data:`HOLD_SPEED` where it is held (:func:`holds`); a joint whose width is 0 keeps
     the step everywhere."""
     w = np.broadcast_to(np.asarray(width, float), qd.shape)
+    if not np.any(w > 0):
+        return w  # the step everywhere: no hold to look for
     return np.where(holds(t, qd) & (w > 0), np.maximum(w, HOLD_SPEED), w)

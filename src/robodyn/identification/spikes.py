@@ -117,4 +117,3 @@ def without_spikes(recordings: list[Any], target: str, mode: str) -> list[Any]:
                           RecordingWarning, stacklevel=3)
         out.append(kept)
     return out
-

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from robodyn.identification.coulomb_width import HOLD_SECONDS, HOLD_SPEED
 from robodyn.report.html import Markup, figure, html_table, page, render, render_macro
 from robodyn.validation.validation import Validation
 
@@ -160,7 +161,8 @@ def _choices_html(ident: Any) -> str:
     width = np.atleast_1d(getattr(ident, "coulomb_width", 0.0))
     widths = ", ".join(f"{w:.2g}" for w in width) if np.any(width) else ""
     return render("choices.html.j2", ch=ch, cutoff=_cutoff(ident), table=Markup(table),
-                  widths=widths, scores=lambda pairs: ", ".join(f"{k} {v:.4f}" for k, v in pairs))
+                  widths=widths, hold_speed=f"{HOLD_SPEED:g}", hold_seconds=f"{HOLD_SECONDS:g}",
+                  scores=lambda pairs: ", ".join(f"{k} {v:.4f}" for k, v in pairs))
 
 
 def _cutoff(ident: Any) -> str:
