@@ -1,5 +1,6 @@
-"""README sections of the dynamics suites: ``derivatives`` (``bench_derivatives.py``) and
-``identify`` (``bench_identify.py``), rendered from their entries in the results file.
+"""README sections of the dynamics suites: ``derivatives`` (``bench_derivatives.py``),
+``identify`` (``bench_identify.py``) and ``schedule`` (``bench_schedule.py``), rendered from their
+entries in the results file.
 
 Registered in ``render_readme.py`` through :data:`RENDERERS`; each renderer takes the whole results
 file (machine record and benchmarks) and returns Markdown lines ending in a newline. Standard
@@ -173,5 +174,25 @@ def render_identify(data: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def render_schedule(data: dict[str, Any]) -> str:
+    """Markdown of the ``schedule`` entry: ID and FD per statement order and transposition."""
+    e = data["benchmarks"]["schedule"]
+    layouts = ", ".join("robodyn's model flags" + (f" + `{' '.join(x)}`" if x else "")
+                        for x in e["layouts"])
+    lines = rc.wrap(rc.run(data, e, (
+        f"Statement order and input transposition of the generated kernels, {e['states']:,} random "
+        f"states, one thread, raw batch calls, ns per state, the best of {e['repeats']} calls "
+        "per build, the builds taking turns")) + (
+        f" Each source is compiled three ways that differ only in code layout ({layouts}); the "
+        "table gives each build's time and their median. Every build's results equal the first "
+        f"one's to {max(r['max_rel_difference'] for r in e['rows']):.1e} (relative)."))
+    rows = [[r["robot"], r["kernel"], r["variant"],
+             " / ".join(f"{x:.1f}" for x in r["ns_per_state_by_layout"]),
+             f"{r['median_of_layouts']:.1f}"] for r in e["rows"]]
+    lines += [""] + rc.table(["robot", "kernel", "statements, transposition", "by layout",
+                              "median"], rows, text_last=False)
+    return "\n".join(lines) + "\n"
+
+
 RENDERERS: dict[str, Callable[[dict[str, Any]], str]] = {
-    "derivatives": render_derivatives, "identify": render_identify}
+    "derivatives": render_derivatives, "identify": render_identify, "schedule": render_schedule}

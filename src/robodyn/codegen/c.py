@@ -11,12 +11,15 @@ Euler, under a sampled state-feedback law, in one call) and ``PREFIXsimulate_ens
 trajectories at once, a block of them per vector loop).
 
 Every kernel is evaluated a block of :data:`BLOCK` states at a time. The states of a block are
-transposed into structure-of-arrays buffers (entry i of state k at ``[BLOCK * i + k]``), then
+transposed into structure-of-arrays buffers (entry i of state k at ``[BLOCK * i + k]``; by
+vector shuffles where there is AVX, :mod:`robodyn.codegen.c_transpose`), then
 ``PREFIXk_block`` runs the whole straight-line body in one loop over the block's states: loads
 and stores are consecutive across states, the body has no calls (the sines and cosines were
 evaluated before, see below; sqrt and division are vector instructions) and no branches (the
 conditionals are selects), so the compiler vectorises the body itself, 4 or 8 states per
-instruction. The outputs are transposed back.
+instruction. The body's statements are printed in an order that keeps few values live
+(:mod:`robodyn.codegen.schedule`; cores of at most :data:`SCHEDULE_LIMIT` statements). The
+outputs are transposed back.
 
 The sines and cosines of the joint angles come from ``PREFIXsincos_block``: one branch-free loop
 of polynomial code per angle (Cody-Waite reduction by pi/2 in three parts and fdlibm's minimax
@@ -44,8 +47,9 @@ take pieces of whole blocks. All of it is plain C99 with ordinary IEEE arithmeti
 flags (vectorisation needs only -O3 and a SIMD target); the one pragma is OpenMP's, inside
 ``#ifdef _OPENMP``; the compiler-specific attributes (GCC's ``noinline`` on large cores and its
 scheduling ``optimize`` on the sine/cosine loop) sit under ``#if defined(__GNUC__)`` and change no
-result. The one use of intrinsics moves no value through arithmetic: large outputs
-with constant entries (the regressor) are staged and, for batches too large for the cache,
+result. The two uses of intrinsics move no value through arithmetic: the inputs' transposition
+under ``#if defined(__AVX__)`` (:mod:`robodyn.codegen.c_transpose`), and large outputs
+with constant entries (the regressor), which are staged and, for batches too large for the cache,
 copied out with streaming stores under ``#if defined(__SSE2__)`` (:mod:`robodyn.codegen.c_outputs`).
 """
 
@@ -62,8 +66,10 @@ from robodyn.codegen.c_simulation import (
     simulate_signature,
     simulation_source,
 )
+from robodyn.codegen.c_transpose import gather_source
 from robodyn.codegen.cpu import BLOCK  # states per block: 16 with AVX-512, else 8, or ROBODYN_BLOCK
 from robodyn.codegen.kernels import Argument, Kernel, KernelSet
+from robodyn.codegen.schedule import live_values, low_pressure_order
 
 #: Cores with more assignments than this are not inlined into their batch loop (compile time).
 INLINE_LIMIT = 400
@@ -75,6 +81,20 @@ INLINE_LIMIT = 400
 #: state in a block differently in the last bit (1 ulp in 2 of 540 PUMA regressor entries), and
 #: the batch kernels keep one state's bits whatever the batch (tests/numeric/test_model.py).
 DIRECT_MIN: int | None = None
+
+#: Order of the statements in a core: "pressure" (:func:`robodyn.codegen.schedule.low_pressure_order`,
+#: few values live at once) or "source" (loads, then the assignments as CSE left them, then the
+#: stores; kept for ``benchmarks/bench_schedule.py``, which compares the two).
+SCHEDULE = "pressure"
+
+#: Cores of more statements than this keep the given order: measured on the AVX2 EPYC, the
+#: Gen3's forward-dynamics derivatives (thousands of statements) ran 5 % slower reordered and its
+#: largest kernels took GCC about 30 % longer to compile.
+SCHEDULE_LIMIT = 600
+
+#: Statements the schedule puts, where it can, between a division or square root and its first
+#: user (their latency is several times an addition's or a multiplication's).
+SLOW_LATENCY = 10
 
 #: States per thread's piece of a threaded batch (whole blocks, so the same blocks as one thread).
 THREAD_CHUNK = 64 * BLOCK
@@ -262,18 +282,20 @@ class CPrinter(Printer):
         lines = [f"/* {core.summary}, for m_ <= {BLOCK} states stored structure-of-arrays. */",
                  f"{inline}static void {self.prefix}{core.name}(int m_, {', '.join(args)}) {{",
                  "    for (int k_ = 0; k_ < m_; ++k_) {"]
-        ind = "        "
-        lines += [f"{ind}const double {sym.name} = {arg.name}[{BLOCK * k} + k_];"
+        # the loads first, in the inputs' order (loads sunk to their first use among the spills'
+        # stores made the PUMA 560's inverse dynamics 25 % slower in some code layouts)
+        lines += [f"        const double {sym.name} = {arg.name}[{BLOCK * k} + k_];"
                   for arg, k, sym in core.used_inputs()]
-        lines += [ind + self.assign(s, e) for s, e in core.body]
+        # then (symbol defined or None, statement, expression read): assignments and stores
+        statements: list[tuple[sp.Symbol | None, str, sp.Expr]] = [
+            (s, self.assign(s, e), e) for s, e in core.body]
         for arg in core.outputs:
-            if arg.name in direct:
-                size, where = direct[arg.name]
-                lines += [f"{ind}{arg.name}[{size} * k_ + {where[k]}] = {self.expr(sp.sympify(e))};"
-                          for k, e in enumerate(arg.entries)]
-            else:
-                lines += [f"{ind}{arg.name}[{BLOCK * k} + k_] = {self.expr(sp.sympify(e))};"
-                          for k, e in enumerate(arg.entries)]
+            size, where = direct.get(arg.name, (None, None))
+            for k, e in enumerate(arg.entries):
+                place = f"{size} * k_ + {where[k]}" if where is not None else f"{BLOCK * k} + k_"
+                statements.append((None, f"{arg.name}[{place}] = {self.expr(sp.sympify(e))};",
+                                   sp.sympify(e)))
+        lines += ["        " + statements[i][1] for i in _statement_order(statements)]
         return "\n".join([*lines, "    }", "}"]) + "\n"
 
     def blocked_batch(self, kernel: Kernel, core: Kernel, angles: list[tuple[sp.Symbol, str, int]],
@@ -291,8 +313,8 @@ class CPrinter(Printer):
         core_inputs = {a.name for a in core.inputs}
         gathered = [a for a in kernel.inputs
                     if a.name in core_inputs or any(name == a.name for _, name, _ in angles)]
-        gather = [f"            for (int i_ = 0; i_ < {a.size}; ++i_) {a.name}_b_[{BLOCK} * i_ + k_] = "
-                  f"{a.name}[{a.size} * j_ + i_];" for a in gathered]
+        gather = [f"        {self.prefix}gather(m_, {a.size}, {a.name} + {a.size} * k0_, {a.name}_b_);"
+                  for a in gathered]
         out = output_lines(self.prefix, self.expr, kernel, core, computed or {}, direct, BLOCK)
         sizes = {a.name: a.size for a in core.outputs}
         arrays = [f"{a.name}_b_[{sizes.get(a.name, a.size) * BLOCK}]"
@@ -305,10 +327,7 @@ class CPrinter(Printer):
                  for a in core.outputs]
         # (a kernel whose outputs are constants reads no input)
         transpose = ["        /* transpose the block's inputs: x_b_[BLOCK i + k] = x[size (k0 + k) + i] */",
-                     "        for (int k_ = 0; k_ < m_; ++k_) {",
-                     "            const long j_ = k0_ + k_;",
-                     *gather,
-                     "        }"] if gather else []
+                     *gather] if gather else []
         params = ", ".join(_parameters(kernel))
         stream = (f"count >= {-(-STREAM_MIN_BYTES // out.staged_bytes)}L" if out.staged_bytes
                   else "(void)count, 0")
@@ -426,6 +445,7 @@ class CPrinter(Printer):
         parts = [self.header(kset), "#include <math.h>\n"]
         if any(_angles(k) for k in kset.kernels):
             parts.append(sincos_source(self.prefix))
+        parts.append(gather_source(self.prefix, BLOCK))
         if any(len(k.body) > INLINE_LIMIT for k in kset.kernels):
             macro = f"{self.prefix.upper()}NOINLINE"
             parts.append(f"#if defined(__GNUC__)\n#define {macro} __attribute__((noinline))\n#else\n"
@@ -528,3 +548,22 @@ def c_files(kset: KernelSet, prefix: str = "robodyn_", with_simulation: bool = T
                         printer.declarations(kset, with_simulation).rstrip(), "#endif", ""])
     source = printer.source(kset, with_simulation)
     return [GeneratedFile(f"{stem}.h", header), GeneratedFile(f"{stem}.c", source)]
+
+
+def _statement_order(statements: list[tuple[sp.Symbol | None, str, sp.Expr]]) -> list[int]:
+    """The order in which a core's statements are printed (:data:`SCHEDULE`)."""
+    if SCHEDULE == "source" or len(statements) > SCHEDULE_LIMIT:
+        return list(range(len(statements)))
+    defined = {sym: i for i, (sym, _, _) in enumerate(statements) if sym is not None}
+    operands = [[defined[x] for x in e.free_symbols if x in defined] for _, _, e in statements]
+    latency = [SLOW_LATENCY if _slow(e) else 1 for _, _, e in statements]
+    order = low_pressure_order(operands, [sym is not None for sym, _, _ in statements], latency)
+    # the greedy order is kept where it has fewer values live at its peak than the given one
+    # (a mass matrix's many shared terms can make it open more values than it closes)
+    source = list(range(len(statements)))
+    return order if live_values(operands, order) < live_values(operands, source) else source
+
+
+def _slow(e: sp.Expr) -> bool:
+    """Whether ``e`` divides or takes a root (a division or square-root instruction)."""
+    return any(not (p.exp.is_Integer and p.exp > 0) for p in e.atoms(sp.Pow))

@@ -1,0 +1,69 @@
+"""C source of the transposition of a block's input rows into structure-of-arrays buffers.
+
+The batch kernels (:mod:`robodyn.codegen.c`) take states stored one after another (row k of an
+input at ``[size k + i]``) and evaluate a block of :data:`~robodyn.codegen.cpu.BLOCK` of them
+from buffers that hold entry i of every state together (``[BLOCK i + k]``). Copied one double at
+a time, the buffers are written by scalar stores that the core then reads by vector loads: a
+load that spans several smaller earlier stores cannot take its value from them while they are
+in flight, and waits until they reach the cache. With AVX, ``PREFIXgather`` moves a full block
+by 4 x 4 transpositions instead: four rows' unaligned 4-double loads, two unpacks and two
+lane permutations per pair of output vectors, and 4-double stores (columns 4 at a time, the last
+group overlapping the one before when ``size`` is not a multiple of 4, so any ``size >= 4``).
+Loads, shuffles and stores only: every value is copied bit for bit. The function is not
+inlined: measured on the AMD EPYC with AVX2 (2026-12-06, Kinova Gen3 inverse dynamics, 5 10^4
+states, six builds whose code layouts differ by alignment and OpenMP flags), inlined it ran
+73.6-83.4 ns per state, called 71.8-81.0 (median 82.9 and 72.6; PUMA 560: 36.1 and 37.2).
+"""
+
+from __future__ import annotations
+
+__all__ = ["VECTOR", "gather_source"]
+
+#: Whether the AVX path is generated (False: one double at a time everywhere; kept for
+#: ``benchmarks/bench_schedule.py``, which compares the two).
+VECTOR = True
+
+_GATHER = """\
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
+
+/* xb[BLOCK i + k] = x[size k + i] for k < m, i < size: a block's rows into structure-of-arrays
+ * buffers. A full block of at least 4 columns with AVX: 4 x 4 transpositions (the last group
+ * of columns overlaps the one before); otherwise one double at a time. Not inlined: a copy
+ * in every kernel's loop made the Gen3's inverse dynamics slower in some code layouts. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static void PREFIXgather(int m, int size, const double *restrict x, double *restrict xb) {
+#if defined(__AVX__)
+    if (m == BLOCK && BLOCK % 4 == 0 && size >= 4) {
+        for (int k = 0; k < BLOCK; k += 4) {
+            const double *restrict r = x + (long)size * k;
+            for (int i = 0; i < size; i += 4) {
+                const int c = i + 4 <= size ? i : size - 4;
+                const __m256d a = _mm256_loadu_pd(r + c), b = _mm256_loadu_pd(r + size + c);
+                const __m256d e = _mm256_loadu_pd(r + 2 * size + c);
+                const __m256d f = _mm256_loadu_pd(r + 3 * size + c);
+                /* (a0 b0 a2 b2), (a1 b1 a3 b3), (e0 f0 e2 f2), (e1 f1 e3 f3) */
+                const __m256d lo = _mm256_unpacklo_pd(a, b), hi = _mm256_unpackhi_pd(a, b);
+                const __m256d lo2 = _mm256_unpacklo_pd(e, f), hi2 = _mm256_unpackhi_pd(e, f);
+                _mm256_storeu_pd(xb + BLOCK * c + k, _mm256_permute2f128_pd(lo, lo2, 0x20));
+                _mm256_storeu_pd(xb + BLOCK * (c + 1) + k, _mm256_permute2f128_pd(hi, hi2, 0x20));
+                _mm256_storeu_pd(xb + BLOCK * (c + 2) + k, _mm256_permute2f128_pd(lo, lo2, 0x31));
+                _mm256_storeu_pd(xb + BLOCK * (c + 3) + k, _mm256_permute2f128_pd(hi, hi2, 0x31));
+            }
+        }
+        return;
+    }
+#endif
+    for (int k = 0; k < m; ++k)
+        for (int i = 0; i < size; ++i) xb[BLOCK * i + k] = x[(long)size * k + i];
+}
+"""
+
+
+def gather_source(prefix: str, block: int) -> str:
+    """C source of ``static void PREFIXgather(m, size, x, xb)`` for blocks of ``block`` states."""
+    text = _GATHER if VECTOR else _GATHER.replace("#if defined(__AVX__)\n    if", "#if 0\n    if")
+    return text.replace("PREFIX", prefix).replace("BLOCK", str(block))
