@@ -19,6 +19,8 @@ def test_default_follows_the_vector_width(monkeypatch) -> None:
     monkeypatch.setattr(cpu, "cpu_flags", lambda: frozenset({"sse2", "avx2", "avx512f"}))
     assert cpu.block_width() == 16
     monkeypatch.setattr(cpu, "cpu_flags", lambda: frozenset({"sse2", "avx2"}))
+    assert cpu.block_width() == 16
+    monkeypatch.setattr(cpu, "cpu_flags", lambda: frozenset({"sse2", "avx"}))  # AVX, no AVX2
     assert cpu.block_width() == 8
     monkeypatch.setattr(cpu, "cpu_flags", frozenset)  # no /proc/cpuinfo (macOS, ARM without it)
     assert cpu.block_width() == 8

@@ -67,7 +67,7 @@ from robodyn.codegen.c_simulation import (
     simulation_source,
 )
 from robodyn.codegen.c_transpose import gather_source
-from robodyn.codegen.cpu import BLOCK  # states per block: 16 with AVX-512, else 8, or ROBODYN_BLOCK
+from robodyn.codegen.cpu import BLOCK  # states per block: 16 with AVX2 or AVX-512, else 8, or ROBODYN_BLOCK
 from robodyn.codegen.kernels import Argument, Kernel, KernelSet
 from robodyn.codegen.schedule import live_values, low_pressure_order
 
@@ -89,12 +89,11 @@ SCHEDULE = "pressure"
 
 #: Cores of more statements than this keep the given order: measured on the AVX2 EPYC, the
 #: Gen3's forward-dynamics derivatives (thousands of statements) ran 5 % slower reordered and its
-#: largest kernels took GCC about 30 % longer to compile.
+#: largest kernels took GCC about 30 % longer to compile. Cores that divide or take roots (the
+#: forward dynamics' factorisation) keep it too: CSE's order interleaves the factorisation with
+#: the bias terms, which hides the latency of its divisions and roots (reordered, even with that
+#: latency modelled, the PUMA 560's forward dynamics at 16 states per block took 4 % longer).
 SCHEDULE_LIMIT = 600
-
-#: Statements the schedule puts, where it can, between a division or square root and its first
-#: user (their latency is several times an addition's or a multiplication's).
-SLOW_LATENCY = 10
 
 #: States per thread's piece of a threaded batch (whole blocks, so the same blocks as one thread).
 THREAD_CHUNK = 64 * BLOCK
@@ -552,15 +551,15 @@ def c_files(kset: KernelSet, prefix: str = "robodyn_", with_simulation: bool = T
 
 def _statement_order(statements: list[tuple[sp.Symbol | None, str, sp.Expr]]) -> list[int]:
     """The order in which a core's statements are printed (:data:`SCHEDULE`)."""
-    if SCHEDULE == "source" or len(statements) > SCHEDULE_LIMIT:
-        return list(range(len(statements)))
+    source = list(range(len(statements)))
+    if SCHEDULE == "source" or len(statements) > SCHEDULE_LIMIT \
+            or any(_slow(e) for _, _, e in statements):
+        return source
     defined = {sym: i for i, (sym, _, _) in enumerate(statements) if sym is not None}
     operands = [[defined[x] for x in e.free_symbols if x in defined] for _, _, e in statements]
-    latency = [SLOW_LATENCY if _slow(e) else 1 for _, _, e in statements]
-    order = low_pressure_order(operands, [sym is not None for sym, _, _ in statements], latency)
+    order = low_pressure_order(operands, [sym is not None for sym, _, _ in statements])
     # the greedy order is kept where it has fewer values live at its peak than the given one
     # (a mass matrix's many shared terms can make it open more values than it closes)
-    source = list(range(len(statements)))
     return order if live_values(operands, order) < live_values(operands, source) else source
 
 

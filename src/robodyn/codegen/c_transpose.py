@@ -10,9 +10,10 @@ by 4 x 4 transpositions instead: four rows' unaligned 4-double loads, two unpack
 lane permutations per pair of output vectors, and 4-double stores (columns 4 at a time, the last
 group overlapping the one before when ``size`` is not a multiple of 4, so any ``size >= 4``).
 Loads, shuffles and stores only: every value is copied bit for bit. The function is not
-inlined: measured on the AMD EPYC with AVX2 (2026-12-06, Kinova Gen3 inverse dynamics, 5 10^4
-states, six builds whose code layouts differ by alignment and OpenMP flags), inlined it ran
-73.6-83.4 ns per state, called 71.8-81.0 (median 82.9 and 72.6; PUMA 560: 36.1 and 37.2).
+inlined: measured on the AMD EPYC with AVX2 (2026-12-06, 8 states per block, Kinova Gen3 inverse
+dynamics, 5 10^4 states, six builds whose code layouts differ by alignment and OpenMP flags),
+inlined it ran 73.6-83.4 ns per state, called 71.8-81.0 (median 82.9 and 72.6; PUMA 560: 36.1
+and 37.2).
 """
 
 from __future__ import annotations

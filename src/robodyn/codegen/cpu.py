@@ -3,7 +3,8 @@
 The batch kernels evaluate :data:`robodyn.codegen.c.BLOCK` states at a time, structure-of-arrays,
 so that one loop over the block becomes vector instructions. The width that fills the vector
 registers depends on the processor: with AVX-512 (8 doubles per register) 16 states, two
-registers per quantity; with AVX2 or narrower (4 or 2 doubles) 8 states. Measured on an AVX-512
+registers per quantity; with AVX2 (4 doubles) 16 states too, four registers per quantity;
+narrower (2 doubles, or none known) 8 states. Measured on an AVX-512
 Xeon (2 cores, shared with other jobs; PUMA 560, 10^5 states, ns per state, min of 7), the code
 built for AVX-512 (``-march=native``) and for AVX2 (``-march=haswell``) at each width:
 
@@ -22,7 +23,13 @@ within that noise on AVX-512 and about 8 % in favour of 8 for AVX2's inverse dyn
 ``benchmarks/bench_block_width.py`` repeats the sweep on the machine it runs on (the README's
 ``results:block_width`` section); on an AMD EPYC with AVX-512 (2 shared cores), two runs put
 width 16 within 0-15 % of the fastest width (8 or 16) for both kernels, and every width from 4
-up 2-3x faster than scalar code: not a difference that would justify another rule. The
+up 2-3x faster than scalar code: not a difference that would justify another rule. AVX2 had 8
+until 2026-12-06, when the inputs' transposition by shuffles (:mod:`robodyn.codegen.c_transpose`)
+and the scheduled statement order (:mod:`robodyn.codegen.schedule`) made 16 the fastest on the
+AMD EPYC with AVX2 (``bench_block_width.py``, PUMA 560, ns per state, min of 12, native code:
+ID 38.5 / 38.1 / 34.4 / 36.9 and FD 69.8 / 69.3 / 66.7 / 69.8 at widths 4 / 8 / 16 / 32; the
+Gen3 through ``Model``: ID 77 -> 70, FD 183 -> 174, mass matrix 146 -> 121, FD derivatives
+1132 -> 1162). Before those changes 16 was already within 1 % of 8 there. The
 environment variable ``ROBODYN_BLOCK`` (1, 2, 4, 8, 16 or 32) overrides the choice: 1 gives
 scalar code (one state per loop), which the CI runs the kernel tests with too. The width is
 part of the generated source, so each width has its own entry in the compiled-model cache.
@@ -53,7 +60,7 @@ def cpu_flags() -> frozenset[str]:
 
 
 def block_width() -> int:
-    """States per block: ``ROBODYN_BLOCK`` when set, else 16 with AVX-512 and 8 otherwise.
+    """States per block: ``ROBODYN_BLOCK`` when set, else 16 with AVX-512 or AVX2 and 8 otherwise.
 
     Raises
     ------
@@ -71,8 +78,9 @@ def block_width() -> int:
 
 def default_block_width(flags: frozenset[str] | None = None) -> int:
     """The width for a processor with feature ``flags`` (default: this one's): 16 with AVX-512
-    (two 8-double registers per quantity), else 8."""
-    return 16 if "avx512f" in (cpu_flags() if flags is None else flags) else 8
+    or AVX2 (two 8-double or four 4-double registers per quantity), else 8."""
+    flags = cpu_flags() if flags is None else flags
+    return 16 if "avx512f" in flags or "avx2" in flags else 8
 
 
 def vector_flags(flags: frozenset[str] | None = None) -> tuple[str, ...]:

@@ -12,14 +12,24 @@ registers of AVX2 (32 with AVX-512) it is stored to the stack and loaded back.
 register-pressure mode): among the statements whose operands are all computed, it emits the one
 that frees the most values (operands it is the last user of) less the one it creates, ties
 going to the statement that uses the most recently computed value (to finish a chain while its
-values are still in registers), then to the earlier statement. Loads of inputs therefore move
-to their first use and stores of outputs to just after their value. Only the order changes:
+values are still in registers), then to the earlier statement. Stores of outputs therefore
+move to just after their value (and loads of inputs, given as statements, to their first use;
+robodyn's C printer keeps its loads first instead, see :mod:`robodyn.codegen.c`). Only the
+order changes:
 every statement, and so every rounding, is the same (the compiler may still fuse a product and
 a sum across statements differently, as it may for any order; the tests compare to 1e-14).
 
-Measured on the AMD EPYC with AVX2 (2026-12-06, PUMA 560 inverse dynamics, 10^5 states, the
-same C compiled both ways): the largest number of values live at once 93 -> 75 and
-38.0 -> 34.6 ns per state.
+An optional latency per statement keeps a slow statement's users a number of statements away
+where other work exists. robodyn's C printer (:func:`robodyn.codegen.c._statement_order`) does not
+use it: it leaves cores that divide or take roots in CSE's order, which measured faster for the
+forward dynamics with or without the latency modelled.
+
+Measured on the AMD EPYC with AVX2 (2026-12-06, ``benchmarks/bench_schedule.py``, 16 states per
+block, ns per state, median of three code layouts), inverse dynamics in CSE's order and
+scheduled: PUMA 560 36.9 -> 35.6 (34.0 -> 32.7 with the inputs transposed by shuffles), Kinova
+Gen3 82.4 -> 68.4 (79.4 -> 64.8). The largest number of values live at once in those cores (the
+loads of inputs, printed first, not counted):
+81 -> 63 and 132 -> 84.
 """
 
 from __future__ import annotations
