@@ -444,12 +444,13 @@ class CPrinter(Printer):
         parts = [self.header(kset), "#include <math.h>\n"]
         if any(_angles(k) for k in kset.kernels):
             parts.append(sincos_source(self.prefix))
-        parts.append(gather_source(self.prefix, BLOCK))
         if any(len(k.body) > INLINE_LIMIT for k in kset.kernels):
             macro = f"{self.prefix.upper()}NOINLINE"
             parts.append(f"#if defined(__GNUC__)\n#define {macro} __attribute__((noinline))\n#else\n"
                          f"#define {macro}\n#endif\n")
         kernels = [self.kernel_source(kernel) for kernel in kset.kernels]
+        if any(f"{self.prefix}gather(" in k for k in kernels):
+            parts.append(gather_source(self.prefix, BLOCK))
         if any(f"{self.prefix}copy_out(" in k for k in kernels):
             parts.append(copy_out_source(self.prefix))
         parts.extend(kernels)
