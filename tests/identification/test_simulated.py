@@ -97,11 +97,14 @@ def test_rigid_body_columns_and_base_count_match_pinocchio(tmp_path, seed):
     w = np.vstack(stacked)
     s = np.linalg.svd(w / np.maximum(np.linalg.norm(w, axis=0), 1e-300), compute_uv=False)
     pin_rank = int(np.sum(s > 1e-8 * s[0]))
-    from robodyn.identification.base import base_relations
+    from robodyn.identification.base import pivoted_columns
 
-    relations = base_relations(model)
-    inertial = [c for c in relations.independent if c % PER_JOINT < len(INERTIAL_NAMES)]
-    assert len(inertial) == pin_rank
+    # robodyn's rank rule on its own rigid-body columns. (Not the number of rigid-body columns
+    # among the base columns of the whole regressor: a column exactly collinear with a rotor
+    # inertia or friction column, such as the first joint's ZZ with its Ia, ties with it, and
+    # rounding, which differs between vector widths and statement orders, breaks the tie.)
+    rank = pivoted_columns(np.vstack([ours[i][:, cols] for i in range(40)]))[4]
+    assert rank == pin_rank
 
 
 @pytest.mark.slow

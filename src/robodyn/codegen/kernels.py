@@ -36,6 +36,7 @@ inertia and the hydrodynamic terms are differentiated like the rest.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, fields
@@ -172,6 +173,7 @@ DERIVATIVE_KERNEL_NAMES = ("inverse_dynamics_derivatives", "forward_dynamics_der
 REGRESSOR_DERIVATIVE_KERNEL_NAMES = ("regressor_derivatives",)
 
 
+@functools.lru_cache(maxsize=256)  # every model call asks (2 us a call otherwise)
 def kernel_signature(name: str, n: int) -> tuple[tuple[tuple[str, int], ...], tuple[int, ...]]:
     """``((input name, width), ...), output shape`` of kernel ``name`` for ``n`` joints."""
     q, qd, qdd, tau = ("q", n), ("qd", n), ("qdd", n), ("tau", n)

@@ -393,6 +393,12 @@ class Model:
         return _compile_derivatives(self, REGRESSOR_DERIVATIVE_KERNEL_NAMES, "regderiv")
 
     # --- plumbing ------------------------------------------------------------------------------
+    @cached_property
+    def _functions(self) -> frozenset[str]:
+        """Names of the compiled library's functions, listed once (a missing one looked up by
+        ``getattr`` costs cffi a failed symbol search, about 4 us, on every call)."""
+        return frozenset() if isinstance(self._impl, ModuleType) else frozenset(dir(self._impl.lib))
+
     def parameter_input(self, value: ParameterValues, batch: tuple[int, ...] = (),
                         where: str = "parameters") -> np.ndarray:
         """The kernels' runtime-parameter input for ``batch`` states, checked.
@@ -452,7 +458,8 @@ class Model:
         out = np.empty(out_shape) if target is None else target
         ptrs = [ffi.from_buffer("double[]", a) for a in args]
         out_ptr = ffi.from_buffer("double[]", out)
-        staged = getattr(lib, f"{_PREFIX}{name}_batch_stream", None) if batch_shape else None
+        stream_name = f"{_PREFIX}{name}_batch_stream"
+        staged = getattr(lib, stream_name) if batch_shape and stream_name in self._functions else None
         if staged is not None:
             # streaming stores into a large reused matrix; cached ones into fresh memory, whose
             # lines the operating system has just zeroed through the cache
