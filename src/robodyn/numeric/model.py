@@ -395,8 +395,7 @@ class Model:
     # --- plumbing ------------------------------------------------------------------------------
     @cached_property
     def _functions(self) -> frozenset[str]:
-        """Names of the compiled library's functions, listed once (a missing one looked up by
-        ``getattr`` costs cffi a failed symbol search, about 4 us, on every call)."""
+        """The library's function names, listed once (a failed ``getattr`` costs cffi 4 us)."""
         return frozenset() if isinstance(self._impl, ModuleType) else frozenset(dir(self._impl.lib))
 
     def parameter_input(self, value: ParameterValues, batch: tuple[int, ...] = (),
