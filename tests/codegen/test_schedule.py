@@ -1,8 +1,8 @@
 """The statement order of the generated cores and the transposition of a block's inputs.
 
 ``robodyn.codegen.schedule.low_pressure_order`` reorders straight-line code; it must keep every
-statement after its operands, lower the values live at once where the given order is wasteful,
-and keep a slow statement's users away from it where other work exists. ``PREFIXgather``
+statement after its operands and lower the values live at once where the given order is
+wasteful. ``PREFIXgather``
 (``robodyn.codegen.c_transpose``) must copy a block's rows into structure-of-arrays buffers bit
 for bit, for every row size and partial blocks, on the vector path and off it.
 """
@@ -28,8 +28,7 @@ def test_the_order_is_a_permutation_with_every_statement_after_its_operands(seed
     rng = np.random.default_rng(seed)
     operands = _random_program(rng, 300)
     produces = [bool(x) for x in rng.integers(0, 5, 300)]  # some statements are stores
-    latency = rng.choice([1, 10], 300, p=[0.9, 0.1]).tolist()
-    order = low_pressure_order(operands, produces, latency)
+    order = low_pressure_order(operands, produces)
     assert sorted(order) == list(range(300))
     where = {s: k for k, s in enumerate(order)}
     assert all(where[j] < where[i] for i, d in enumerate(operands) for j in d)
@@ -44,18 +43,6 @@ def test_loads_move_to_their_use_and_free_their_values():
     order = low_pressure_order(operands, produces)
     assert live_values(operands, given) == 20
     assert live_values(operands, order) == 1
-
-
-def test_a_slow_statement_is_separated_from_its_user_by_independent_work():
-    # s = sqrt(a) at 0, its user at 1; eight independent statements 2..9 (a pair of load and
-    # store each): with latency 5, at least 4 statements go between s and its user
-    operands = [[], [0]] + [[] if k % 2 == 0 else [k - 1] for k in range(2, 10)]
-    produces = [True, False] + [k % 2 == 0 for k in range(2, 10)]
-    order = low_pressure_order(operands, produces, [5] + [1] * 9)
-    assert order.index(1) - order.index(0) >= 5
-    # without a latency the user follows at once (it frees s and creates nothing)
-    plain = low_pressure_order(operands, produces)
-    assert plain.index(1) - plain.index(0) == 1
 
 
 def test_an_operand_after_its_reader_is_refused():

@@ -19,10 +19,9 @@ order changes:
 every statement, and so every rounding, is the same (the compiler may still fuse a product and
 a sum across statements differently, as it may for any order; the tests compare to 1e-14).
 
-An optional latency per statement keeps a slow statement's users a number of statements away
-where other work exists. robodyn's C printer (:func:`robodyn.codegen.c._statement_order`) does not
-use it: it leaves cores that divide or take roots in CSE's order, which measured faster for the
-forward dynamics with or without the latency modelled.
+robodyn's C printer (:func:`robodyn.codegen.c._statement_order`) leaves cores that divide or
+take roots in CSE's order, which measured faster for the forward dynamics, also against a
+variant of this scheduler that kept a division's users ten statements away from it.
 
 Measured on the AMD EPYC with AVX2 (2026-12-06, ``benchmarks/bench_schedule.py``, 16 states per
 block, ns per state, median of three code layouts), inverse dynamics in CSE's order and
@@ -40,8 +39,7 @@ from collections.abc import Sequence
 __all__ = ["live_values", "low_pressure_order"]
 
 
-def low_pressure_order(operands: Sequence[Sequence[int]], produces: Sequence[bool],
-                       latency: Sequence[int] | None = None) -> list[int]:
+def low_pressure_order(operands: Sequence[Sequence[int]], produces: Sequence[bool]) -> list[int]:
     """A dependency-respecting order of statements that keeps few values live.
 
     Parameters
@@ -51,10 +49,6 @@ def low_pressure_order(operands: Sequence[Sequence[int]], produces: Sequence[boo
         ``i`` in the given order: the given order is a valid one).
     produces : sequence of n bool
         Whether statement ``i`` defines a value (an assignment or a load; a store defines none).
-    latency : sequence of n int, optional
-        How many statements should separate statement ``i`` from its first user (default 1 for
-        each: none); a statement whose operands are not that far back yet is emitted only
-        when no other can be.
 
     Returns
     -------
@@ -63,7 +57,6 @@ def low_pressure_order(operands: Sequence[Sequence[int]], produces: Sequence[boo
     """
     n = len(operands)
     deps = [sorted(set(d)) for d in operands]
-    delay = [1] * n if latency is None else [max(1, int(x)) for x in latency]
     users: list[list[int]] = [[] for _ in range(n)]
     for i, d in enumerate(deps):
         for j in d:
@@ -74,20 +67,16 @@ def low_pressure_order(operands: Sequence[Sequence[int]], produces: Sequence[boo
     waiting = [len(d) for d in deps]  # operands not yet emitted
     position = [-1] * n  # where each emitted statement went
     recency = [-1] * n  # position of a ready statement's latest operand
-    earliest = [0] * n  # position from which a statement's operands' latencies have passed
 
     def key(i: int) -> tuple[int, int, int]:
         frees = sum(1 for j in deps[i] if remaining[j] == 1)
         # heapq pops the smallest: most freed less created, latest operand, earliest statement
         return (-(frees - int(produces[i] and bool(users[i]))), -recency[i], i)
 
-    heap = [key(i) for i in range(n) if waiting[i] == 0]  # ready and due
+    heap = [key(i) for i in range(n) if waiting[i] == 0]
     heapq.heapify(heap)
-    pending: list[tuple[int, int]] = []  # (earliest, statement): ready, latency not yet passed
     order: list[int] = []
-    while heap or pending:
-        while pending and (pending[0][0] <= len(order) or not heap):
-            heapq.heappush(heap, key(heapq.heappop(pending)[1]))
+    while heap:
         entry = heapq.heappop(heap)
         i = entry[2]
         if position[i] >= 0 or entry != key(i):
@@ -97,22 +86,16 @@ def low_pressure_order(operands: Sequence[Sequence[int]], produces: Sequence[boo
         for j in deps[i]:
             remaining[j] -= 1
             if remaining[j] == 1:
-                # the last user of j now frees it: its key improved (if it is in the heap)
+                # the last user of j now frees it: its key improved (if it is ready)
                 last = next(u for u in users[j] if position[u] < 0)
-                if waiting[last] == 0 and earliest[last] <= len(order):
+                if waiting[last] == 0:
                     heapq.heappush(heap, key(last))
         for u in users[i]:
             waiting[u] -= 1
-            earliest[u] = max(earliest[u], position[i] + delay[i])
             if waiting[u] == 0:
                 recency[u] = position[i]
-                if earliest[u] <= len(order):
-                    heapq.heappush(heap, key(u))
-                else:
-                    heapq.heappush(pending, (earliest[u], u))
-    if len(order) != n:
-        raise ValueError("the statements' operands form a cycle")
-    return order
+                heapq.heappush(heap, key(u))
+    return order  # every statement: its operands come before it, so all become ready
 
 
 def live_values(operands: Sequence[Sequence[int]], order: Sequence[int]) -> int:
