@@ -60,9 +60,12 @@ def test_pivoted_columns_is_the_one_base_column_rule():
     a = rng.standard_normal((50, 2))
     # columns: a0, 1e6 a1 (units must not decide), a0 - 1e6 a1 (dependent), a structural zero
     w = np.column_stack([a[:, 0], 1e6 * a[:, 1], a[:, 0] - 1e6 * a[:, 1], np.zeros(50)])
-    norms, used, _, piv, rank = pivoted_columns(w)
+    scales, used, _, piv, rank = pivoted_columns(w)
     assert rank == 2 and list(used) == [0, 1, 2]
-    np.testing.assert_allclose(norms, np.linalg.norm(w, axis=0))
+    # the column norms, the earlier columns' shortened by at most 1e-6 (the tie preference)
+    norms = np.linalg.norm(w, axis=0)
+    assert np.all(scales <= norms) and np.all(scales >= norms * (1 - 1e-6))
+    assert scales[0] < scales[2] / norms[2] * norms[0]
     # excitation design takes its base columns through the same function
     assert excitation.pivoted_columns is pivoted_columns
 
@@ -104,3 +107,27 @@ def test_effort_in_chunks_equals_the_effort_of_the_whole_regressor(monkeypatch):
     whole = prediction_rows(model, s, ident.preprocess) @ ident.standard / ident.gains
     monkeypatch.setattr(result, "EFFORT_CHUNK", 700)
     np.testing.assert_allclose(ident.effort(s), whole, rtol=0, atol=1e-12 * np.abs(whole).max())
+
+
+def test_pivoted_columns_gives_exact_ties_to_the_earlier_column():
+    """Of two exactly collinear columns (the first joint's ZZ and Ia), the earlier one is the base
+    column whatever the last bits say: round-off, which differs between BLAS builds, vector
+    widths and statement orders, must not choose between them."""
+    from robodyn.identification.base import pivoted_columns
+
+    rng = np.random.default_rng(1)
+    for trial in range(40):
+        a, b = rng.standard_normal((2, 60))
+        scale = rng.uniform(0.1, 10.0)
+        # columns 1 and 3 exactly collinear up to a last-bit wobble either way
+        wobble = 1.0 + rng.choice([-1, 1]) * np.finfo(float).eps * rng.integers(1, 8, 60)
+        w = np.column_stack([b, scale * a, a + b, a * wobble])
+        _, used, _, piv, rank = pivoted_columns(w)
+        base = set(used[piv[:rank]].tolist())
+        assert rank == 2, trial
+        # {b, scale a} span everything: columns 2 (a + b) and 3 (a) depend on them
+        assert base == {0, 1}, (trial, base)
+        # the same columns in the other order: now column 1 is the later twin
+        w2 = np.column_stack([b, a * wobble, a + b, scale * a])
+        _, used2, _, piv2, rank2 = pivoted_columns(w2)
+        assert set(used2[piv2[:rank2]].tolist()) == {0, 1}, trial

@@ -31,6 +31,11 @@ __all__ = ["BaseRelations", "base_relations", "random_states"]
 RANK_RTOL = 1e-8
 #: Coefficients below this (relative to 1) are exact zeros.
 BETA_ZERO = 1e-10
+#: Relative preference for the earlier of two columns whose remaining norms tie (exactly
+#: collinear columns, such as the first joint's ``ZZ`` and its rotor inertia ``Ia``): above the
+#: error of LAPACK's downdated column norms (up to about 1e-8 relative, where it recomputes them),
+#: far below any real difference of independence (:func:`pivoted_columns`).
+TIE_PREFERENCE = 1e-6
 #: Fraction of the random joint velocities set exactly to zero (see :func:`random_states`).
 ZERO_VELOCITY_FRACTION = 0.2
 
@@ -135,6 +140,10 @@ def pivoted_columns(w: np.ndarray, rtol: float = RANK_RTOL
     excitation design alike): columns whose norm is below ``BETA_ZERO`` of the largest (at least
     1) are structural zeros and left out; the others are scaled to unit norm, so that the units of
     the parameters do not decide the rank, and a pivot ``|R_kk| <= rtol |R_00|`` is dependent.
+    Column ``k`` of ``p`` is scaled to norm ``1 + TIE_PREFERENCE (p - k) / p`` rather than exactly
+    1, so that of two exactly collinear columns the earlier one is always the base column: left
+    to round-off, the choice changes with the BLAS, the vector width and the generated code's
+    statement order.
 
     Parameters
     ----------
@@ -145,12 +154,12 @@ def pivoted_columns(w: np.ndarray, rtol: float = RANK_RTOL
 
     Returns
     -------
-    norms : numpy.ndarray, shape (p,)
-        Column norms of ``w``.
+    scales : numpy.ndarray, shape (p,)
+        The column scales ``D``: the column norms of ``w``, each divided by its tie preference.
     used : numpy.ndarray of int, shape (k,)
         The columns that are not structural zeros.
     r : numpy.ndarray, shape (min(m, k), k)
-        ``R`` of ``W[:, used] D^-1 P = Q R``.
+        ``R`` of ``W[:, used] D^-1 P = Q R`` (``D`` restricted to ``used``).
     piv : numpy.ndarray of int, shape (k,)
         The pivot order, into ``used``.
     rank : int
@@ -158,11 +167,14 @@ def pivoted_columns(w: np.ndarray, rtol: float = RANK_RTOL
     """
     norms = np.linalg.norm(w, axis=0)
     used = np.flatnonzero(norms > BETA_ZERO * max(1.0, float(norms.max()) if norms.size else 1.0))
-    # W P = Q R on unit-norm columns: the pivots order the columns by independence
-    _, r, piv = scipy.linalg.qr(w[:, used] / norms[used], mode="economic", pivoting=True)
+    # near-unit-norm columns, the earlier slightly longer: exact ties go to the earlier column
+    p = norms.size
+    scales = norms / (1.0 + TIE_PREFERENCE * (p - np.arange(p)) / max(p, 1))
+    # W D^-1 P = Q R: the pivots order the columns by independence
+    _, r, piv = scipy.linalg.qr(w[:, used] / scales[used], mode="economic", pivoting=True)
     d = np.abs(np.diag(r))
     rank = int(np.sum(d > rtol * d[0])) if d.size else 0
-    return norms, used, r, piv, rank
+    return scales, used, r, piv, rank
 
 
 def base_relations(model: Model, *, samples: int | None = None, seed: int = 0,
@@ -200,13 +212,13 @@ def base_relations(model: Model, *, samples: int | None = None, seed: int = 0,
     w = model.regressor(q, qd, qdd).reshape(count * n, -1)
     if unseen is not None:
         w[:, np.asarray(unseen, dtype=int)] = 0.0
-    norms, used, r, piv, rank = pivoted_columns(w)
+    scales, used, r, piv, rank = pivoted_columns(w)
     zero = np.setdiff1d(np.arange(w.shape[1]), used)
     ind_local = used[piv[:rank]]
     dep_local = used[piv[rank:]]
     # beta in original (unscaled) units: W_d = W_b beta
     beta_scaled = scipy.linalg.solve_triangular(r[:rank, :rank], r[:rank, rank:])
-    beta_used = beta_scaled * norms[dep_local][None, :] / norms[ind_local][:, None]
+    beta_used = beta_scaled * scales[dep_local][None, :] / scales[ind_local][:, None]
     order = np.argsort(ind_local)
     independent = ind_local[order]
     beta_used = beta_used[order]
