@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from robodyn.identification.preprocess import MOVING_RAD
+from robodyn.measure.angles import unwrap_turns
 from robodyn.measure.filtering import differentiate, lowpass
 
 __all__ = ["HOLD_SECONDS", "HOLD_SPEED", "WIDTH_PER_NOISE", "auto_coulomb_width", "held_widths",
@@ -89,7 +90,7 @@ def velocity_noise(rec: Any, settings: Any) -> np.ndarray:
         recording's own velocities are taken as they are).
     """
     t = np.asarray(rec.t, float)
-    q = np.asarray(rec.q, float)
+    q = unwrap_turns(rec.q)  # a wrapped angle's steps are no velocity noise
     n = q.shape[1]
     if settings.cutoff is None or t.size < _MIN_SAMPLES:
         return np.zeros(n)

@@ -28,6 +28,7 @@ from robodyn.identification.preprocess import (
     preprocess,
     resolve_preprocess,
 )
+from robodyn.measure.angles import unwrap_turns
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
 
@@ -38,7 +39,7 @@ JOINT_PARAMETERS = ("J", "Gs", "Gc", "Fv", "Fcp", "Fcn", "Fo")
 
 def moving_joint(rec: Any) -> int | None:
     """The one joint whose position spans at least 1 mrad while the others do not (else None)."""
-    span = np.ptp(np.asarray(rec.q, float), axis=0)
+    span = np.ptp(unwrap_turns(rec.q), axis=0)
     moving = np.flatnonzero(span >= MOVING_RAD)
     return int(moving[0]) if moving.size == 1 else None
 
@@ -127,7 +128,7 @@ def identify_joint(robot: Robot, recording: Any, joint: int | str | None = None,
 
     check_recording(robot, recording, 0, target)
     src = str(getattr(recording, "source", "") or "recording")
-    span = np.ptp(np.asarray(recording.q, float), axis=0)
+    span = np.ptp(unwrap_turns(recording.q), axis=0)
     if joint is None:
         j = moving_joint(recording)
         if j is None:

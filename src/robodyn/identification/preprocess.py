@@ -25,6 +25,12 @@ a base parameter of its own, :mod:`robodyn.identification.base`); the fit's rows
 unfiltered model ``Y p`` that ``predict`` returns: the Coulomb sign is handled the same way in
 both.
 
+A logged angle that jumps by nearly a whole turn between two samples (a continuous joint
+reported within ``[-pi, pi)`` or ``[0, 2 pi)``) is unwrapped first: no arm
+turns half a revolution between two samples, and filtered and differentiated such a step would
+be a burst of velocity; the regressor's sines and cosines do not change
+(:func:`robodyn.measure.angles.unwrap_turns`).
+
 ``cutoff=None`` turns all filtering off: the recording's own ``qd`` and ``qdd`` (measured or
 estimated when the recording was built) and its raw target are used (simulated data).
 
@@ -45,6 +51,7 @@ from typing import Any, Literal
 import numpy as np
 
 from robodyn.identification.stacking import regressor_rows_of
+from robodyn.measure.angles import unwrap_turns
 from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass, lowpass_columns
 from robodyn.robot.errors import IdentificationError
 from robodyn.symbolic.regressor import joint_columns
@@ -130,7 +137,7 @@ def auto_cutoff(recordings: Sequence[Any]) -> float:
     """The cut-off of ``cutoff="auto"`` for these recordings, Hz (the module docstring's rule)."""
     bands = []
     for r in recordings:
-        q = np.asarray(r.q, float)
+        q = unwrap_turns(r.q)
         moving = np.ptp(q, axis=0) > MOVING_RAD
         if np.any(moving) and q.shape[0] >= 16:
             bands.append(bandwidth_cutoff(np.asarray(r.t, float), q[:, moving]))
@@ -191,7 +198,7 @@ def preprocess(rec: Any, settings: Preprocess, target: str | None) -> Samples:
     Samples
     """
     t = np.asarray(rec.t, dtype=float)
-    q = np.asarray(rec.q, dtype=float)
+    q = unwrap_turns(rec.q)
     raw_y = target_signal(rec, target) if target is not None else None
     y = None if raw_y is None else np.asarray(raw_y, dtype=float)
     if settings.cutoff is None:

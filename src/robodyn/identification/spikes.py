@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from robodyn.measure.angles import unwrap_turns
 from robodyn.robot.errors import RecordingWarning
 
 __all__ = ["GROSS_THRESHOLD", "QUANTA", "SHAPE", "THRESHOLD", "drop_spikes", "spike_rows",
@@ -90,7 +91,7 @@ def drop_spikes(rec: Any, target: str, threshold: float = THRESHOLD) -> tuple[An
         return rec, 0  # not a Recording: left as given
     for _ in range(PASSES):
         y = getattr(rec, target, None)
-        rows = spike_rows(rec.t, rec.q, *([] if y is None else [y]), threshold=threshold)
+        rows = spike_rows(rec.t, unwrap_turns(rec.q), *([] if y is None else [y]), threshold=threshold)
         if not rows.any():
             break
         with warnings.catch_warnings():  # the dropped rows are the only 'gaps' this adds

@@ -19,6 +19,7 @@ from types import MappingProxyType
 import numpy as np
 from scipy.interpolate import make_interp_spline
 
+from robodyn.measure.angles import unwrap_turns
 from robodyn.measure.filtering import differentiate, lowpass
 from robodyn.robot.errors import RecordingError, RecordingWarning
 
@@ -236,7 +237,8 @@ class Recording:
                                      f"{self.n_samples} samples (at least 8 are needed)")
             with np.errstate(over="ignore", invalid="ignore"):
                 try:
-                    _, qd, qdd = differentiate(self.t, self.q)
+                    # of the positions with wrap-around steps undone (a continuous joint)
+                    _, qd, qdd = differentiate(self.t, unwrap_turns(self.q))
                 except RecordingError as exc:  # the filter's own message, with the file
                     raise RecordingError(f"{self.source or 'Recording'}: {exc}") from None
             if not (np.all(np.isfinite(qd)) and np.all(np.isfinite(qdd))):

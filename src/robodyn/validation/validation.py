@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from robodyn.measure.angles import unwrap_turns
 from robodyn.measure.filtering import differentiate
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import ValidationError
@@ -316,8 +317,8 @@ def _model_states(t: np.ndarray, arrays: dict[str, np.ndarray], ident: Any,
         # qd = lowpass(qd_measured), qdd = d/dt of it
         qd, qdd, _ = differentiate(t, qd, cut)
         return q, qd, qdd
-    # q = lowpass(q), qd and qdd its derivatives
-    return differentiate(t, q, cut)
+    # q = lowpass(q), qd and qdd its derivatives (wrap-around steps undone first)
+    return differentiate(t, unwrap_turns(q), cut)
 
 
 def _current_gains(robot: Robot, model: Model, tgt: str, gains: Any) -> np.ndarray | None:
