@@ -139,6 +139,28 @@ def test_streamed_regressor_keeps_the_bits():
         np.testing.assert_array_equal(model.regressor(q[k], qd[k], qdd[k]), fresh[k])
 
 
+def test_streamed_derivatives_keep_the_bits():
+    """The six-joint forward-dynamics derivatives (108 entries per state, staged since
+    2026-12-06): a reused out= array large enough for streaming stores, on 1 and 3 threads, gives
+    the bits of a fresh array and of each state alone, constant entries included (NaN start)."""
+    robot = load_quiet("puma560")
+    model = rd.compile_model(robot)
+    n = robot.dof
+    count = -(-STREAM_MIN_BYTES // (8 * 3 * n * n)) + 2 * BLOCK + 5
+    rng = np.random.default_rng(22)
+    q, qd, tau = rng.uniform(-2, 2, (3, count, n))
+    fresh = np.concatenate(model.forward_dynamics_derivatives(q, qd, tau), axis=-1)
+    assert np.all(fresh[:, :, 0] == 0.0)  # the first joint's angle moves nothing: constants
+    for threads in (1, 3):
+        out = np.full((count, n, 3 * n), np.nan)
+        assert out.nbytes >= STREAM_MIN_BYTES
+        model.forward_dynamics_derivatives(q, qd, tau, threads=threads, out=out)
+        np.testing.assert_array_equal(out, fresh)
+    for k in (0, BLOCK + 1, count - 1):
+        one = np.concatenate(model.forward_dynamics_derivatives(q[k], qd[k], tau[k]), axis=-1)
+        np.testing.assert_array_equal(one, fresh[k])
+
+
 def test_forward_dynamics_inverts_inverse_dynamics(compiled):
     robot, eom, c_model, np_model = compiled
     n = robot.dof

@@ -28,9 +28,12 @@ import sympy as sp
 
 from robodyn.codegen.kernels import Kernel
 
-#: Outputs of this many entries per state (the regressor), some constant and some computed, are
-#: staged for large batches (:func:`staged_output`).
-STAGE_MIN, STAGE_MAX = 128, 2048
+#: Outputs of this many entries per state (the regressor; the derivatives, 72 and 108 entries for
+#: six joints), some constant and some computed, are staged for large batches
+#: (:func:`staged_output`). The lower bound was 128 before 2026-12-06: staged, the PUMA 560's
+#: forward-dynamics derivatives into a reused 100,000-state array took 462 against 499 ns per
+#: state (same process pair, alternating; the streaming stores skip reading the destination).
+STAGE_MIN, STAGE_MAX = 64, 2048
 
 #: A batch whose staged outputs reach this many bytes is written with streaming (non-temporal)
 #: stores: it would not stay in cache anyway, and the stores then skip reading each line first.
