@@ -142,7 +142,9 @@ def test_streamed_regressor_keeps_the_bits():
 def test_streamed_derivatives_keep_the_bits():
     """The six-joint forward-dynamics derivatives (108 entries per state, staged since
     2026-12-06): a reused out= array large enough for streaming stores, on 1 and 3 threads, gives
-    the bits of a fresh array and of each state alone, constant entries included (NaN start)."""
+    the bits of a fresh array (the same block code, only the stores differ), constant entries
+    included (NaN start); each state alone agrees to rounding (its scalar loop may fuse a multiply
+    and an add that the block does not)."""
     robot = load_quiet("puma560")
     model = rd.compile_model(robot)
     n = robot.dof
@@ -158,7 +160,7 @@ def test_streamed_derivatives_keep_the_bits():
         np.testing.assert_array_equal(out, fresh)
     for k in (0, BLOCK + 1, count - 1):
         one = np.concatenate(model.forward_dynamics_derivatives(q[k], qd[k], tau[k]), axis=-1)
-        np.testing.assert_array_equal(one, fresh[k])
+        np.testing.assert_allclose(one, fresh[k], rtol=1e-12, atol=1e-12 * np.abs(fresh[k]).max())
 
 
 def test_forward_dynamics_inverts_inverse_dynamics(compiled):
