@@ -41,4 +41,4 @@ def unwrap_turns(q: np.ndarray) -> np.ndarray:
         return q
     # q_k - 2 pi (turns wrapped up to k)
     shift = np.cumsum(np.where(wrap, 2.0 * np.pi * turns, 0.0), axis=0)
-    return np.vstack([q[:1], q[1:] - shift])
+    return np.concatenate([q[:1], q[1:] - shift], axis=0)
