@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
 import robodyn as rd
+from robodyn.robot.errors import RecordingWarning
 from tests.identification.helpers import fourier, load_quiet
 
 
@@ -33,6 +36,10 @@ def test_unwrapped_undoes_whole_turns_only():
     # a jump of 2 rad across a lost stretch of the log: motion, not a wrap
     gap = np.concatenate([np.zeros(50), np.full(50, 2.0)])[:, None]
     assert np.array_equal(unwrapped(gap), gap)
+    from robodyn.measure.angles import wrap_steps
+
+    assert list(wrap_steps(q)) == [int(np.sum(np.abs(np.diff(logged)) > np.pi)), 0]
+    assert list(wrap_steps(gap)) == [0]
     assert unwrapped(q[:1]) is not None and np.array_equal(unwrapped(q[:, 1:]), q[:, 1:])
 
 
@@ -52,8 +59,14 @@ def test_wrapped_angle_log_identifies_as_the_continuous_one(arm):
     assert np.sum(np.abs(np.diff(logged[:, 3])) > np.pi) >= 2
     cont = rd.Recording(t=t, q=q, tau=tau, joint_names=robot.joint_names, source="continuous")
     wrap = rd.Recording(t=t, q=logged, tau=tau, joint_names=robot.joint_names, source="wrapped")
-    a = rd.identify(robot, cont, model=model, resonance=False, ripple=False)
-    b = rd.identify(robot, wrap, model=model, resonance=False, ripple=False)
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        a = rd.identify(robot, cont, model=model, resonance=False, ripple=False)
+    assert not [w for w in seen if "modulo a turn" in str(w.message)]
+    steps = int(np.sum(np.abs(np.diff(logged[:, 3])) > np.pi))
+    with pytest.warns(RecordingWarning, match=rf"wrapped: q: angle logged modulo a turn on "
+                                              rf"{robot.joint_names[3]} \({steps}\)"):
+        b = rd.identify(robot, wrap, model=model, resonance=False, ripple=False)
     np.testing.assert_allclose(b.predict(wrap), a.predict(cont), rtol=1e-9, atol=1e-9)
     assert float(np.linalg.norm(a.predict(cont) - tau) / np.linalg.norm(tau)) < 0.05
 

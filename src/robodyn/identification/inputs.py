@@ -6,13 +6,15 @@ Every problem is an :class:`~robodyn.robot.errors.IdentificationError` naming th
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
 from robodyn.identification.payload import Payload
-from robodyn.robot.errors import IdentificationError
+from robodyn.measure.angles import wrap_steps
+from robodyn.robot.errors import IdentificationError, RecordingWarning
 from robodyn.robot.model import Robot
 
 __all__ = ["TARGETS", "check_payloads", "check_recording", "checked_inputs"]
@@ -113,7 +115,19 @@ def checked_inputs(robot: Robot, recordings: Any, target: str | None, sensor: st
                                   f"target='tau', got target={target!r}")
     for i, rec in enumerate(recs):
         check_recording(robot, rec, i, target)
+        _note_wraps(robot, rec, i)
     return recs, target, check_payloads(payloads, len(recs))
+
+
+def _note_wraps(robot: Robot, rec: Any, index: int) -> None:
+    """A warning naming the joints of ``rec`` whose angle is logged modulo a turn (the wrap
+    steps are undone before filtering, :mod:`robodyn.measure.angles`; the fit is unaffected)."""
+    counts = wrap_steps(rec.q)
+    if counts.any():
+        joints = ", ".join(f"{robot.joint_names[j]} ({int(c)})" for j, c in enumerate(counts) if c)
+        warnings.warn(f"{_src(rec, index)}: q: angle logged modulo a turn on {joints} (steps of a "
+                      "whole turn undone before filtering and differentiating; the recording is "
+                      "unchanged)", RecordingWarning, stacklevel=4)
 
 
 def check_payloads(payloads: Any, count: int) -> list[Payload | None]:

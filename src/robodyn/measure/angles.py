@@ -11,12 +11,29 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["WRAP_TOLERANCE", "unwrap_turns"]
+__all__ = ["WRAP_TOLERANCE", "unwrap_turns", "wrap_steps"]
 
 
 #: A step of a logged position is a wrap when it exceeds pi and lies within this of a whole
 #: number of turns (rad): what is left is the motion between the two samples.
 WRAP_TOLERANCE = 0.5
+
+
+def _wraps(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The whole turns of each step (N - 1, ...) and where a step is a wrap (same shape)."""
+    d = np.diff(q, axis=0)
+    turns = np.round(d / (2.0 * np.pi))
+    return turns, (np.abs(d) > np.pi) & (np.abs(d - 2.0 * np.pi * turns) < WRAP_TOLERANCE)
+
+
+def wrap_steps(q: np.ndarray) -> np.ndarray:
+    """How many wrap-around steps :func:`unwrap_turns` undoes in each column of ``q`` (N, n).
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (n,)
+    """
+    return np.sum(_wraps(np.asarray(q, dtype=float))[1], axis=0)
 
 
 def unwrap_turns(q: np.ndarray) -> np.ndarray:
@@ -34,9 +51,7 @@ def unwrap_turns(q: np.ndarray) -> np.ndarray:
         ``|dq - 2 pi k| < WRAP_TOLERANCE``, ``k = round(dq / 2 pi)``.
     """
     q = np.asarray(q, dtype=float)
-    d = np.diff(q, axis=0)
-    turns = np.round(d / (2.0 * np.pi))
-    wrap = (np.abs(d) > np.pi) & (np.abs(d - 2.0 * np.pi * turns) < WRAP_TOLERANCE)
+    turns, wrap = _wraps(q)
     if not np.any(wrap):
         return q
     # q_k - 2 pi (turns wrapped up to k)
