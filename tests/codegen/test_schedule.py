@@ -4,7 +4,8 @@
 statement after its operands and lower the values live at once where the given order is
 wasteful. ``PREFIXgather``
 (``robodyn.codegen.c_transpose``) must copy a block's rows into structure-of-arrays buffers bit
-for bit, for every row size and partial blocks, on the vector path and off it.
+for bit, for every row size and partial blocks, on the vector path and off it; ``PREFIXscatter``
+must put a block's computed entries back at their positions in the rows, leaving the others.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import numpy as np
 import pytest
 
 from robodyn.codegen.build import compile_library
-from robodyn.codegen.c_transpose import gather_source
+from robodyn.codegen.c_transpose import gather_source, scatter_source
 from robodyn.codegen.schedule import live_values, low_pressure_order
 
 
@@ -73,3 +74,35 @@ def test_gather_copies_a_block_into_structure_of_arrays_bit_for_bit(block):
             expected = x.T
             assert got[:, :m].tobytes() == np.ascontiguousarray(expected).tobytes()
             assert np.all(got[:, m:] == 7.0)  # lanes past the block's states untouched
+
+
+_SCATTER_WRAPPER = """
+void t_scatter_call(int m, int size, int count, const int *index, const double *b, double *row) {
+    t_scatter(m, size, count, index, b, row);
+}
+"""
+
+
+@pytest.mark.tool("gcc|cc")
+@pytest.mark.parametrize("block", [1, 4, 8, 16])
+def test_scatter_puts_computed_entries_at_their_positions_bit_for_bit(block):
+    lib = compile_library("#include <math.h>\n" + scatter_source("t_", block) + _SCATTER_WRAPPER,
+                          "void t_scatter_call(int m, int size, int count, const int *index, "
+                          "const double *b, double *row);")
+    rng = np.random.default_rng(100 + block)
+    size = 23
+    # runs of 1 to 6 consecutive positions with gaps: the vector path's 4-runs and the rest
+    layouts = [np.arange(size), np.array([0, 1, 2, 3, 5, 6, 7, 8, 9, 11, 12, 13, 20, 21, 22]),
+               np.array([1, 3, 4, 5, 6, 7, 8, 15]), np.sort(rng.choice(size, 11, replace=False))]
+    for index in layouts:
+        for m in sorted({m for m in (1, 3, block - 1, block) if 1 <= m <= block}):
+            b = rng.standard_normal((len(index), block))
+            b[0, 0] = -0.0
+            rows = np.full((m, size), 7.0)
+            lib.lib.t_scatter_call(m, size, len(index),
+                                   lib.ffi.from_buffer("int[]", index.astype(np.int32)),
+                                   lib.ffi.from_buffer("double[]", b),
+                                   lib.ffi.from_buffer("double[]", rows))
+            expected = np.full((m, size), 7.0)
+            expected[:, index] = b[:, :m].T
+            assert rows.tobytes() == expected.tobytes()

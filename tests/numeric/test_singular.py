@@ -126,6 +126,22 @@ def test_forward_dynamics_and_simulate_where_the_mass_matrix_is_singular(tmp_pat
     np.testing.assert_allclose(model.mass_matrix(bent) @ qdd, -model.gravity(bent), atol=1e-12)
 
 
+@pytest.mark.parametrize("backend", ["c", "numpy"])
+def test_forward_dynamics_derivatives_refuse_a_singular_state_anywhere_in_the_batch(tmp_path,
+                                                                                   backend):
+    # since 2026-12-06 only the diagonal of the d qdd/d tau block (M^-1) is checked for
+    # finiteness, not all 3 n^2 entries: a singular M must still be caught in any row
+    path = tmp_path / "point_mass_rr.yaml"
+    path.write_text(POINT_MASS)
+    model = rd.compile_model(rd.load(path), backend=backend)
+    q = np.array([[0.3, 1.0], [0.3, 0.5], [0.3, 0.0], [0.3, -1.0]])  # row 2 stretched: singular
+    zeros = np.zeros_like(q)
+    with pytest.raises(SingularMassMatrixError, match=r"singular at q = \[0\.3 0\. *\]"):
+        model.forward_dynamics_derivatives(q, zeros, zeros)
+    dq, dqd, dtau = model.forward_dynamics_derivatives(q[[0, 1, 3]], zeros[:3], zeros[:3])
+    np.testing.assert_allclose(dtau, np.linalg.inv(model.mass_matrix(q[[0, 1, 3]])), rtol=1e-12)
+
+
 @pytest.mark.parametrize("lang", ["c", "python"])
 def test_codegen_refuses_a_robot_without_forward_dynamics(massless, capsys, tmp_path, lang):
     from robodyn.cli import main

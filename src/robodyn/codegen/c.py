@@ -66,7 +66,7 @@ from robodyn.codegen.c_simulation import (
     simulate_signature,
     simulation_source,
 )
-from robodyn.codegen.c_transpose import gather_source
+from robodyn.codegen.c_transpose import gather_source, scatter_source
 from robodyn.codegen.cpu import BLOCK  # states per block: 16 with AVX2 or AVX-512, else 8, or ROBODYN_BLOCK
 from robodyn.codegen.kernels import Argument, Kernel, KernelSet
 from robodyn.codegen.schedule import live_values, low_pressure_order
@@ -451,6 +451,8 @@ class CPrinter(Printer):
         kernels = [self.kernel_source(kernel) for kernel in kset.kernels]
         if any(f"{self.prefix}gather(" in k for k in kernels):
             parts.append(gather_source(self.prefix, BLOCK))
+        if any(f"{self.prefix}scatter(" in k for k in kernels):
+            parts.append(scatter_source(self.prefix, BLOCK))
         if any(f"{self.prefix}copy_out(" in k for k in kernels):
             parts.append(copy_out_source(self.prefix))
         parts.extend(kernels)

@@ -111,19 +111,14 @@ def staged_output(prefix: str, name: str, size: int, count: int, block: int,
              f"        for (int k_ = 0; k_ < {block}; ++k_)",
              f"            for (int i_ = 0; i_ < {size}; ++i_) {stage}[{size} * k_ + i_] = {template}[i_];"]
     per_block = ["        if (stream_) {",
-                 f"            for (int i_ = 0; i_ < {count}; ++i_) {{",
-                 f"                const int p_ = {index}[i_];",
-                 f"                for (int k_ = 0; k_ < m_; ++k_) {stage}[{size} * k_ + p_] = "
-                 f"{name}_b_[{block} * i_ + k_];",
-                 "            }",
+                 f"            {prefix}scatter(m_, {size}, {count}, {index}, {name}_b_, {stage});",
                  f"            {prefix}copy_out({name} + {size} * k0_, {stage}, {size}L * m_);",
                  "        } else {",
-                 "            for (int k_ = 0; k_ < m_; ++k_) {",
-                 f"                double *restrict row_ = {name} + {size} * (k0_ + k_);",
-                 f"                for (int i_ = 0; i_ < {size}; ++i_) row_[i_] = {template}[i_];",
-                 f"                for (int i_ = 0; i_ < {count}; ++i_) row_[{index}[i_]] = "
-                 f"{name}_b_[{block} * i_ + k_];",
-                 "            }",
+                 "            for (int k_ = 0; k_ < m_; ++k_)",
+                 f"                for (int i_ = 0; i_ < {size}; ++i_) "
+                 f"{name}[{size} * (k0_ + k_) + i_] = {template}[i_];",
+                 f"            {prefix}scatter(m_, {size}, {count}, {index}, {name}_b_, "
+                 f"{name} + {size} * k0_);",
                  "        }"]
     return declare, start, per_block
 

@@ -20,8 +20,10 @@ terms, ``g`` the buoyancy, and the inverse and forward dynamics also drag, skin 
     jacobian(q)                  -> J (6, n)      [v; omega] of the tool origin, base frame
     regressor(q, qd, qdd)        -> Y (n, 15 n)   Y @ params == tau
 
-Derivative kernels (:data:`DERIVATIVE_KERNEL_NAMES`, built on request), by forward-mode
-differentiation of the recorded programs (:mod:`robodyn.symbolic.forward_mode`)::
+Derivative kernels (:data:`DERIVATIVE_KERNEL_NAMES`, built on request), by differentiation of the
+recorded programs: adjoints for the dynamics' derivatives (n outputs, 2 n directions,
+:mod:`robodyn.symbolic.reverse_mode`), forward mode for the regressor's (15 n^2 outputs,
+:mod:`robodyn.symbolic.forward_mode`)::
 
     inverse_dynamics_derivatives(q, qd, qdd) -> dtau (n, 2 n)      [d tau/dq, d tau/dqd]
     forward_dynamics_derivatives(q, qd, tau) -> dqdd (n, 3 n)      [d qdd/dq, d qdd/dqd, d qdd/dtau]
@@ -47,7 +49,7 @@ import sympy as sp
 from robodyn.codegen import optimize as opt
 from robodyn.robot.errors import InputError
 from robodyn.robot.model import Robot
-from robodyn.symbolic import crba, forward_mode
+from robodyn.symbolic import crba, forward_mode, reverse_mode
 from robodyn.symbolic import newton_euler as ne
 from robodyn.symbolic.hydro.terms import HydroTerms, hydro_terms
 from robodyn.symbolic.kinematics import end_effector_jacobian, forward_kinematics, joint_symbols
@@ -452,9 +454,10 @@ def _cholesky_solve(lower: dict[tuple[int, int], sp.Expr], inv_diag: Sequence[sp
 def _tau_derivatives(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol],
                      qdd: Sequence[sp.Symbol], rec: Recorder,
                      hyd: HydroTerms | None = None) -> list[sp.Expr]:
-    """``[d tau/dq, d tau/dqd]`` (n, 2 n) row-major, by forward mode over the tau program."""
+    """``[d tau/dq, d tau/dqd]`` (n, 2 n) row-major, by adjoints over the tau program (n outputs,
+    2 n directions: reverse mode is the cheaper, :mod:`robodyn.symbolic.reverse_mode`)."""
     tau = _tau_full(robot, q, qd, qdd, rec, hyd)
-    d = forward_mode.jacobian(list(rec.assignments), tau, [*q, *qd], rec)
+    d = reverse_mode.jacobian(list(rec.assignments), tau, [*q, *qd], rec)
     return list(d)
 
 
@@ -486,7 +489,7 @@ def _qdd_derivatives(robot: Robot, q: Sequence[sp.Symbol], qd: Sequence[sp.Symbo
     rec.prefix = ""
     # qdd is held fixed: d tau/dx at constant qdd
     held = [s for s in qdd if isinstance(s, sp.Symbol)]
-    d = forward_mode.jacobian(list(rec.assignments), full, [*q, *qd], rec, constants=held)
+    d = reverse_mode.jacobian(list(rec.assignments), full, [*q, *qd], rec, constants=held)
     columns = []
     for k in range(2 * n):
         # M dqdd/dx_k = -dtau/dx_k
