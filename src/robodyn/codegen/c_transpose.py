@@ -20,7 +20,8 @@ regressor): the computed entries, listed by their positions in the row, go from 
 rows that already hold the constants. Where four computed entries sit side by side in the row,
 a full block moves them by the same 4 x 4 transpositions; the others one double at a time.
 Measured on the AMD EPYC with AVX2 (2026-12-06, PUMA 560 forward-dynamics derivatives, 102 of
-108 entries computed, 10^5 states into a reused array): 440 -> NNN ns per state.
+108 entries computed, 10^5 states into a reused array through ``Model``, min of 10 calls, two
+processes one after the other): 440 -> 427 ns per state, the same bits.
 """
 
 from __future__ import annotations
