@@ -354,9 +354,7 @@ class Model:
         d = self._derivative_model._call("forward_dynamics_derivatives", q, qd, tau, threads=threads,
                                          parameters=parameters, out=out)
         n = self.dof
-        # a singular M leaves 1 / L_jj non-finite, and with it entry (j, j) of M^-1 (which holds
-        # (1 / L_jj)^2): checking that diagonal, not all 3 n^2 entries, spares re-reading the
-        # whole output from memory (measured 10 % of the call on 10^5 PUMA 560 states)
+        # singular M: 1/L_jj and so (M^-1)_jj are non-finite; the diagonal spares reading it all
         self._nonsingular(np.diagonal(d[..., 2 * n:], axis1=-2, axis2=-1), q, parameters)
         return d[..., :n], d[..., n:2 * n], d[..., 2 * n:]
 
