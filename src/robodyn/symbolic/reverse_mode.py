@@ -33,27 +33,11 @@ def jacobian(assignments: Sequence[Assignment], outputs: Sequence[sp.Expr],
              constants: Collection[sp.Symbol] = ()) -> sp.ImmutableMatrix:
     """``d outputs / d variables`` of a straight-line program, as a program, by adjoints.
 
-    Parameters
-    ----------
-    assignments : sequence of (Symbol, Expr)
-        The program, in evaluation order.
-    outputs : sequence of Expr, length m
-        Expressions of the program's symbols and inputs.
-    variables : sequence of Symbol, length k
-        Input symbols to differentiate with respect to.
-    rec : Recorder
-        Receives the new assignments (local partials ``p_<s>_<a>`` and adjoints
-        ``a<r>_<s>``), after ``assignments`` in evaluation order.
-    constants : collection of Symbol
-        Program symbols held fixed (their derivative is taken as zero even when their
-        assignment depends on ``variables``).
-
-    Returns
-    -------
-    sympy.ImmutableMatrix, (m, k)
-        Entry ``(i, v)`` is ``d outputs[i] / d variables[v]``, the same matrix as
-        :func:`robodyn.symbolic.forward_mode.jacobian` gives, in terms of the program's symbols,
-        the recorded partials and adjoints, and the inputs.
+    The arguments and the result are those of :func:`robodyn.symbolic.forward_mode.jacobian`
+    (``assignments`` in evaluation order; ``outputs`` (m) of the program's symbols and inputs;
+    ``variables`` (k) the inputs; ``constants`` program symbols held fixed), and so is the
+    (m, k) matrix returned. ``rec`` receives the local partials ``p_<s>_<a>`` and the adjoints
+    ``a<r>_<s>`` of output ``r`` (1-based), after ``assignments``.
     """
     fixed = set(constants)
     # the symbols whose value changes with the variables (not through the constants)
