@@ -295,10 +295,10 @@ class Model:
         """Partial derivatives of the full inverse dynamics ``tau(q, qd, qdd)``.
 
         Adjoints of the recorded Newton-Euler program (:mod:`robodyn.symbolic.reverse_mode`),
-        compiled on the first call (cached). Friction is included: viscous friction adds ``Fv`` to ``d tau/dqd``; Coulomb friction is a step in
-        ``qd`` whose derivative is taken as 0 (exact away from ``qd = 0``, where it has none).
-        Rotor inertia and, under water, the hydrodynamic terms are differentiated too.
-        ``d tau/dqdd`` is the mass matrix (:meth:`mass_matrix`).
+        compiled on the first call (cached). Viscous friction adds ``Fv`` to ``d tau/dqd``;
+        Coulomb friction is a step in ``qd`` with derivative 0 (exact away from ``qd = 0``, where
+        it has none). Rotor inertia and, under water, the hydrodynamic terms are differentiated
+        too. ``d tau/dqdd`` is the mass matrix (:meth:`mass_matrix`).
 
         Parameters
         ----------
