@@ -3,7 +3,9 @@
 The quality table (``bench_identification_quality.py``) holds a dozen fixed rows; this script
 looks for configurations where the default ``rd.identify`` loses to the textbook script
 (``benchmarks/textbook.py``), as issue 20 asks: "build for the general case". Each configuration
-is one arm (``lwr4``: the KUKA LWR4+ URDF; ``gen3``; ``puma``), one logging rate, one target
+is one arm (``lwr4``: the KUKA LWR4+ URDF; ``gen3``; ``puma``; ``aa300``: the built-in AA300, a
+revolute-prismatic-revolute cylindrical robot; ``alpha5``: the built-in Reach Alpha 5, a small
+four-joint arm, in air), one logging rate, one target
 (``current``: motor currents, drives the description lacks on the LWR4+ and the Gen3, values
 printed to 4 decimals; ``tau``: joint torque sensors, 0.08 N m noise, 20 gaps of 15 samples),
 one plant draw (``quality_cases._perturbed`` with that seed) and one validation (``jointwise``:
@@ -39,7 +41,7 @@ DEFAULT_CONFIGURATIONS = ("lwr4:1000:tau:1:jointwise", "lwr4:1000:tau:2:jointwis
                           "lwr4:50:current:1:jointwise", "gen3:94:current:1:jointwise",
                           "gen3:50:tau:1:other", "puma:250:current:1:jointwise")
 ARMS = {"lwr4": (qc.KUKA / "kuka_lwr4.urdf", None), "gen3": (qc.KINOVA / "gen3.urdf", "kinova_gen3"),
-        "puma": (None, "puma560")}
+        "puma": (None, "puma560"), "aa300": (None, "aa300"), "alpha5": (None, "reach_alpha5")}
 VALIDATIONS = ("jointwise", "other", "period")
 
 

@@ -9,6 +9,7 @@ import pytest
 import robodyn as rd
 from robodyn.identification.bandwidth import prediction_candidates
 from robodyn.identification.estimate import LAMBDA_GRID, cv_weight
+from robodyn.identification.preprocess import Samples
 from robodyn.robot.errors import IdentificationError
 from tests.identification.helpers import load_quiet
 
@@ -103,7 +104,7 @@ def test_bad_predict_cutoff_is_refused(fast_run, value, message):
         ident.predict(short, cutoff=value)
 
 
-@pytest.mark.parametrize("value, message", [("wide", "expected a frequency in Hz, 'auto' or 'fit'"),
+@pytest.mark.parametrize("value, message", [("wide", "expected a frequency in Hz, 'motion', 'auto' or 'fit'"),
                                             (-3.0, "expected a positive frequency"),
                                             (True, "expected a positive frequency in Hz"),
                                             (1e6, "must lie in")])
@@ -111,3 +112,61 @@ def test_bad_prediction_cutoff_is_refused(fast_run, value, message):
     robot, model, rec, _ = fast_run
     with pytest.raises(IdentificationError, match=f"prediction_cutoff: {message}"):
         rd.identify(robot, rec.slice(0.0, 2.0), target="tau", model=model, prediction_cutoff=value)
+
+
+def _run(robot, model, freqs, seed, source):
+    """PUMA 560 at 500 Hz moving at ``freqs`` ((Hz, rad) pairs), positions from a 4096-count
+    encoder, torque with 0.05 N m noise; and the exact states (t, q, qd, qdd) as Samples."""
+    t = np.arange(0.0, 20.0, 0.002)
+    rng = np.random.default_rng(seed)
+    q = np.zeros((t.size, 6)) + rng.uniform(-1, 1, 6)
+    qd, qdd = np.zeros_like(q), np.zeros_like(q)
+    for f, size in freqs:
+        w = 2 * np.pi * f
+        a = size * rng.choice([-1.0, 1.0], 6)
+        q += a * np.sin(w * t)[:, None]
+        qd += a * w * np.cos(w * t)[:, None]
+        qdd += -a * w * w * np.sin(w * t)[:, None]
+    tau = model.inverse_dynamics(q, qd, qdd)
+    step = 2 * np.pi / 4096
+    rec = rd.Recording(t=t, q=np.round(q / step) * step, tau=tau + 0.05 * rng.standard_normal(tau.shape),
+                       joint_names=robot.joint_names, source=source)
+    return rec, Samples(t, q, qd, qdd, None, "exact")
+
+
+def test_a_recording_faster_than_the_fit_data_is_predicted_in_its_own_band():
+    # the default prediction_cutoff="motion": a fit on slow motion (the cut-off rule's 2 Hz)
+    # predicts a faster run at that run's own rule, not below its motion
+    robot = load_quiet("puma560")
+    model = rd.compile_model(robot)
+    slow, _ = _run(robot, model, ((0.1, 0.5), (0.3, 0.3)), 4, "slow run")
+    fast, exact = _run(robot, model, ((0.1, 0.5), (0.3, 0.3), (2.5, 0.04), (3.5, 0.02)), 5, "fast run")
+    kw = {"target": "tau", "model": model, "ripple": False, "resonance": False, "friction": "linear"}
+    ident = rd.identify(robot, slow, **kw)
+    fit_only = rd.identify(robot, slow, prediction_cutoff="fit", **kw)
+    cut = ident.preprocess.cutoff
+    assert ident.options.prediction_cutoff == "motion" and ident.prediction is None
+    assert ident.recording_cutoff(slow) == cut == fit_only.recording_cutoff(fast)
+    own = ident.recording_cutoff(fast)
+    assert own > 1.5 * cut
+    np.testing.assert_array_equal(ident.predict(fast), ident.predict(fast, cutoff=own))
+    np.testing.assert_array_equal(ident.predict(slow), fit_only.predict(slow))
+    np.testing.assert_array_equal(ident.standard, fit_only.standard)
+    # the same parameters at the exact states: what a prediction of the fast run can reach;
+    # its own band comes closer to it than the fit's
+    best = ident.effort(exact)
+    err = [float(np.linalg.norm(i.predict(fast) - best) / np.linalg.norm(best))
+           for i in (ident, fit_only)]
+    assert err[0] < 0.5 * err[1]
+    # a fit cut-off given as a number is kept as given
+    fixed = rd.identify(robot, slow, cutoff=cut, **kw)
+    assert fixed.recording_cutoff(fast) == cut
+    # the CLI's note on its written predictions names the widened recording (and then offers
+    # no `robodyn validate` command at one cut-off as reproducing them)
+    from pathlib import Path
+
+    from robodyn.cli.identify import _prediction_note
+
+    note = _prediction_note(ident, Path("x.yaml"), [slow, fast])
+    assert f"{own:.3g} Hz for fast run" in note and "slow run" not in note
+    assert "reproduces" not in note

@@ -185,7 +185,7 @@ def test_identify_prints_and_reports_the_prediction_cutoff_choice(files, tmp_pat
     assert rc == 0 and "prediction cut-off" in out and "raw target of the identification" in out
     page = (tmp_path / "report.html").read_text(encoding="utf-8")
     assert "Prediction cut-off <b>" in page
-    for bad, message in (("wide", "expected fit, auto or a frequency in Hz, got 'wide'"),
+    for bad, message in (("wide", "expected motion, fit, auto or a frequency in Hz, got 'wide'"),
                          ("-2", "expected a positive frequency in Hz, got '-2'")):
         with pytest.raises(SystemExit) as exc:
             main(["identify", "puma560", "--data", str(train), "--prediction-cutoff", bad,

@@ -159,7 +159,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                                                                       strict=True))
         print(f"drive gains from the payload run(s), N m/A: {gain_text}")
     paths["metrics"] = _write_metrics([v for _, v in vals], out / "validation.csv")
-    note = _prediction_note(ident, paths["yaml"])
+    note = _prediction_note(ident, paths["yaml"], [r for _, r in jobs])
     for k, path in enumerate(_write_predictions(vals, out, note)):
         paths[f"predictions{k + 1}"] = path
     if not args.no_report:
@@ -180,18 +180,23 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     return _check_loadable(paths["yaml"])
 
 
-def _prediction_note(ident: Any, yaml_path: Path) -> str:
-    """How the written predictions were made, and the ``robodyn validate`` command that
-    reproduces them from the written description where the description alone does."""
+def _prediction_note(ident: Any, yaml_path: Path, recs: Sequence[Any]) -> str:
+    """How the written predictions of ``recs`` were made, and the ``robodyn validate`` command
+    that reproduces them from the written description where the description alone does."""
     pre = ident.prediction_settings
+    # recordings that move faster than the identification data: their own band
+    wider = [f"{c:.3g} Hz for {r.source}" for r in recs
+             if (c := ident.recording_cutoff(r)) != pre.cutoff]
     note = ("predicted by the identified model at states processed as the identification's: "
             + ("measured velocity" if pre.velocity == "measured" else "velocity from positions")
             + ("" if pre.cutoff is None else f", zero-phase low-pass at {pre.cutoff:.3g} Hz")
+            + (f" ({', '.join(wider)}: faster motion than the identification data's)"
+               if wider else "")
             + (f", Coulomb dead band {pre.dead_band:g} rad/s" if pre.dead_band else "")
             + _smoothing_note(ident.coulomb_width))
     fits = (ident.friction_fit, ident.thermal_fit, ident.ripple_fit, ident.resonance_fit,
             ident.prediction)
-    if pre.velocity == "position" and pre.cutoff is not None and not pre.dead_band \
+    if pre.velocity == "position" and pre.cutoff is not None and not pre.dead_band and not wider \
             and not np.any(ident.coulomb_width) and all(f is None for f in fits):
         note += (f"; robodyn validate {yaml_path} --target {ident.target} --cutoff "
                  f"{pre.cutoff:.17g} reproduces these figures from the written description")
@@ -455,13 +460,14 @@ def _width(text: str) -> float | str:
 
 
 def _prediction_cutoff(text: str) -> float | str:
-    """``--prediction-cutoff``: "fit", "auto" or a frequency in Hz."""
-    if text in ("fit", "auto"):
+    """``--prediction-cutoff``: "motion", "fit", "auto" or a frequency in Hz."""
+    if text in ("motion", "fit", "auto"):
         return text
     try:
         value = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected fit, auto or a frequency in Hz, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"expected motion, fit, auto or a frequency in Hz, "
+                                         f"got {text!r}") from None
     if not (np.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"expected a positive frequency in Hz, got {text!r}")
     return value
@@ -498,10 +504,12 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
                         "current loop) added to the prediction, its frequency, damping and share "
                         "fitted on what the model leaves: on, off, or auto: kept on a joint when "
                         "it predicts held-out time blocks better (default: %(default)s)")
-    p.add_argument("--prediction-cutoff", type=_prediction_cutoff, default="fit",
-                   metavar="{fit,auto,HZ}",
+    p.add_argument("--prediction-cutoff", type=_prediction_cutoff, default="motion",
+                   metavar="{motion,fit,auto,HZ}",
                    help="low-pass cut-off of the states the model is evaluated at in predictions: "
-                        "the fit's, a frequency in Hz, or auto: a wider one when it predicts the "
+                        "motion: the fit's, widened for a recording that moves faster than the "
+                        "identification data (the --cutoff auto rule on that recording); fit: the "
+                        "fit's; a frequency in Hz; or auto: a wider one when it predicts the "
                         "raw target of the identification data better (lower error against the "
                         "raw target, higher against a low-passed one) (default: %(default)s)")
     p.add_argument("--cutoff", type=_auto_or(float, none=True), default="auto", metavar="HZ",

@@ -151,12 +151,13 @@ def with_prediction_cutoff(ident: Any, recordings: Sequence[Any], payloads: Sequ
         The identification recordings, raw.
     payloads : sequence of Payload or None, optional
     target : {"tau", "current"}
-    option : float, "auto" or "fit"
-        A cut-off in Hz, chosen from the data ("auto"), or the fit's ("fit"). Without a fit
+    option : float, "motion", "auto" or "fit"
+        A cut-off in Hz, chosen from the data ("auto"), or the fit's ("fit"; "motion": the fit's,
+        widened per predicted recording by :meth:`Identification.predict`). Without a fit
         cut-off (``cutoff=None``: the recordings' own derivatives) there is nothing to choose.
     """
     fit_cut = ident.preprocess.cutoff
-    if option == "fit" or fit_cut is None:
+    if option in ("fit", "motion") or fit_cut is None:
         return ident
     pays = list(payloads) if payloads is not None else [None] * len(recordings)
     if option == "auto":

@@ -103,12 +103,15 @@ class IdentifyOptions:
         (:mod:`robodyn.identification.resonance`): frequency, damping and share chosen by
         held-out time blocks of the model's residual; "auto": a joint's mode kept only when it
         beats none by one standard error; True: every joint's best mode; False: none.
-    prediction_cutoff : float, "auto" or "fit"
+    prediction_cutoff : float, "motion", "auto" or "fit"
         Cut-off (Hz) of the states :meth:`Identification.predict` evaluates the model at
-        (:mod:`robodyn.identification.bandwidth`): "fit" (the default) is the fit's cut-off;
-        "auto" tries it and wider ones on the identification recordings against their raw
-        target and keeps a wider one only when it is better by more than one standard error
-        (lower error against the raw target, higher against a low-passed one: see the module).
+        (:mod:`robodyn.identification.bandwidth`): "motion" (the default) is the fit's cut-off,
+        widened for a predicted recording whose own positions move faster than the
+        identification data (the ``cutoff="auto"`` rule applied to that recording alone; only
+        after a fit with ``cutoff="auto"``); "fit" is the fit's cut-off; "auto" tries it and
+        wider ones on the identification recordings against their raw target and keeps a wider
+        one only when it is better by more than one standard error (lower error against the raw
+        target, higher against a low-passed one: see the module).
 
     Raises
     ------
@@ -133,7 +136,7 @@ class IdentifyOptions:
     spikes: str = "auto"
     ripple: bool | str = "auto"
     resonance: bool | str = "auto"
-    prediction_cutoff: float | str = "fit"
+    prediction_cutoff: float | str = "motion"
 
     def __post_init__(self) -> None:
         _choice("method", self.method, METHODS)
@@ -163,9 +166,9 @@ class IdentifyOptions:
                 raise IdentificationError(f"{name}: expected False, True or 'auto', got {value!r}")
         pc = self.prediction_cutoff
         if isinstance(pc, str):
-            if pc not in ("auto", "fit"):
-                raise IdentificationError(f"prediction_cutoff: expected a frequency in Hz, 'auto' or "
-                                          f"'fit', got {pc!r}")
+            if pc not in ("motion", "auto", "fit"):
+                raise IdentificationError(f"prediction_cutoff: expected a frequency in Hz, 'motion', "
+                                          f"'auto' or 'fit', got {pc!r}")
         else:
             positive_frequency(pc, "prediction_cutoff")
 

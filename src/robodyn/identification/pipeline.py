@@ -108,7 +108,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
              payloads: Sequence[Payload | None] | None = None, weights: str = "residual",
              state_noise: Any = None, thermal: bool | str = False, sensor: str = "motor",
              spikes: str = "auto", ripple: bool | str = "auto", resonance: bool | str = "auto",
-             prediction_cutoff: float | str = "fit",
+             prediction_cutoff: float | str = "motion",
              options: IdentifyOptions | None = None) -> Identification:
     """Identify the base inertial, drive and friction parameters of a robot from recordings.
 

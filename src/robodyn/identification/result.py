@@ -15,7 +15,13 @@ from robodyn.identification.choices import Choices
 from robodyn.identification.coulomb_width import held_widths
 from robodyn.identification.friction import FrictionFit, without_friction
 from robodyn.identification.options import IdentifyOptions, positive_frequency
-from robodyn.identification.preprocess import Preprocess, Samples, prediction_rows, preprocess
+from robodyn.identification.preprocess import (
+    Preprocess,
+    Samples,
+    auto_cutoff,
+    prediction_rows,
+    preprocess,
+)
 from robodyn.identification.resonance import ResonanceFit
 from robodyn.identification.ripple import RippleFit
 from robodyn.identification.thermal import ThermalFit, temperatures
@@ -201,7 +207,10 @@ class Identification:
         (same filter order, same derivative estimates, the same Coulomb dead band; the Coulomb
         step smoothed over :attr:`coulomb_width` when it is not 0), without
         decimation, at the prediction cut-off (:attr:`prediction_settings`: the fit's, or a
-        wider one chosen from the data by :mod:`robodyn.identification.bandwidth`); the
+        wider one chosen from the data by :mod:`robodyn.identification.bandwidth`; with the
+        default ``prediction_cutoff="motion"`` after ``cutoff="auto"``, widened to this
+        recording's own motion bandwidth where it moves faster than the identification data:
+        the same positions' rule that chose the fit's cut-off, :func:`recording_cutoff`); the
         prediction is the model's effort ``Y(q, qd, qdd) p`` at the processed states
         (:meth:`effort`). A joint with a drive mode (:attr:`resonance_fit`) is predicted from
         states processed at the mode's band, plus what the mode adds.
@@ -231,7 +240,7 @@ class Identification:
         from robodyn.identification.inputs import check_recording
 
         check_recording(self.robot, recording, 0, None)
-        settings = self.prediction_settings
+        settings = replace(self.prediction_settings, cutoff=self.recording_cutoff(recording))
         if cutoff is not None:
             cut = positive_frequency(cutoff, "prediction_cutoff")
             check_prediction_cutoff([recording], cut)
@@ -243,6 +252,22 @@ class Identification:
             return plain
         wide = preprocess(recording, replace(self.preprocess, cutoff=self.resonance_fit.band), None)
         return self.resonance_fit.combine(wide.t, self.effort(wide, temp, payload), plain)
+
+    def recording_cutoff(self, recording: Any) -> float | None:
+        """The cut-off (Hz) at which :meth:`predict` processes ``recording`` by default.
+
+        :attr:`prediction_settings`' cut-off, or, with ``prediction_cutoff="motion"`` after a fit
+        with ``cutoff="auto"``, the ``cutoff="auto"`` rule of ``recording`` alone where that is
+        higher: a recording that moves faster than the identification data (a jointwise run's
+        short strokes) is not low-passed below its own motion. Never lower than the fit's (the
+        identification recordings, whose rule chose it, keep it unless logged faster than the
+        slowest of them).
+        """
+        cut = self.prediction_settings.cutoff
+        opts = self.options
+        if cut is None or opts is None or opts.prediction_cutoff != "motion" or opts.cutoff != "auto":
+            return cut
+        return max(cut, auto_cutoff([recording]))
 
     @property
     def prediction_settings(self) -> Preprocess:
