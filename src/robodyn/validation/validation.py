@@ -197,10 +197,11 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
         When given, the model's states are the positions low-passed at ``cutoff`` Hz (zero-phase
         Butterworth) with velocities and accelerations differentiated from them
         (:func:`robodyn.measure.filtering.differentiate`), as identification does; when None,
-        the recording's ``q``, ``qd``, ``qdd`` as they are, except with ``ident``: then its
-        ``preprocess.cutoff`` (and ``preprocess.velocity == "measured"``: the measured velocity
-        filtered and differentiated), so that the friction cloud and the simulation's start
-        states are those of the prediction.
+        the recording's ``q``, ``qd``, ``qdd`` as they are, except with ``ident``: then the
+        cut-off its prediction of this recording uses (``ident.recording_cutoff(rec)``; and
+        ``preprocess.velocity == "measured"``: the measured velocity filtered and
+        differentiated), so that the friction cloud and the simulation's start states are those
+        of the prediction.
     noise_cutoff : float
         Cut-off of the zero-phase Butterworth low-pass (order 4) that separates the target
         from its noise, Hz (limited to 0.4 x the sample rate); default: the reference filter of
@@ -227,6 +228,8 @@ def validate(robot: Robot, recording: Any, target: str | None = None, *, ident: 
     t, arrays = _checked_arrays(rec, where)
     y = np.array(measured_target(rec, tgt))
     has = ~np.all(np.isnan(y), axis=0)  # an all-NaN column: that joint has no such sensor
+    if cutoff is None and hasattr(ident, "recording_cutoff"):
+        cutoff = ident.recording_cutoff(rec)  # the band ident.predict uses for this recording
     q, qd, qdd = _model_states(t, arrays, ident, cutoff)
     if model is None:
         model = compile_model(robot, backend=backend)
