@@ -9,8 +9,9 @@ reversal, the acceleration peaks of a short stroke); evaluated on states low-pas
 cut-off, the prediction misses it. Too wide a band, and the encoder noise differentiated twice
 enters the prediction instead.
 
-``prediction_cutoff="auto"`` (an option of :func:`robodyn.identify`; its default ``"fit"`` keeps
-the fit's cut-off) tries the fit's cut-off
+``prediction_cutoff="auto"`` (an option of :func:`robodyn.identify`; ``"fit"`` keeps the fit's
+cut-off, and the default ``"motion"`` widens it only for a predicted recording that moves faster
+than the identification data, :meth:`Identification.recording_cutoff`) tries the fit's cut-off
 ``f_c`` and the wider :data:`FACTORS` ``x f_c`` (at most :data:`MAX_FRACTION` of the sampling
 rate of the slowest recording), predicts the identification recordings with each, and scores each
 against their *raw* target (no reference filter: only the raw target holds the band in
