@@ -40,6 +40,20 @@ def test_prediction_candidates_stop_below_a_fifth_of_the_rate():
     assert prediction_candidates(5.0, 25.0) == [5.0]
 
 
+def _sines(t, freqs, rng):
+    """Six joints from random offsets plus sines at ``freqs`` ((Hz, rad) pairs, random signs):
+    positions, velocities and accelerations (N, 6), exact."""
+    q = np.zeros((t.size, 6)) + rng.uniform(-1, 1, 6)
+    qd, qdd = np.zeros_like(q), np.zeros_like(q)
+    for f, size in freqs:
+        w = 2 * np.pi * f
+        a = size * rng.choice([-1.0, 1.0], 6)
+        q += a * np.sin(w * t)[:, None]
+        qd += a * w * np.cos(w * t)[:, None]
+        qdd += -a * w * w * np.sin(w * t)[:, None]
+    return q, qd, qdd
+
+
 @pytest.fixture(scope="module")
 def fast_run():
     """PUMA 560 moving with content at 3-6 Hz, logged at 500 Hz with exact positions and 0.05 N m
@@ -48,14 +62,7 @@ def fast_run():
     model = rd.compile_model(robot)
     t = np.arange(0.0, 20.0, 0.002)
     rng = np.random.default_rng(3)
-    q = np.zeros((t.size, 6)) + rng.uniform(-1, 1, 6)
-    qd, qdd = np.zeros_like(q), np.zeros_like(q)
-    for f, size in ((0.1, 0.5), (0.3, 0.3), (3.0, 0.02), (6.0, 0.01)):
-        w = 2 * np.pi * f
-        a = size * rng.choice([-1.0, 1.0], 6)
-        q += a * np.sin(w * t)[:, None]
-        qd += a * w * np.cos(w * t)[:, None]
-        qdd += -a * w * w * np.sin(w * t)[:, None]
+    q, qd, qdd = _sines(t, ((0.1, 0.5), (0.3, 0.3), (3.0, 0.02), (6.0, 0.01)), rng)
     tau = model.inverse_dynamics(q, qd, qdd)
     noisy = tau + 0.05 * rng.standard_normal(tau.shape)
     rec = rd.Recording(t=t, q=q, tau=noisy, joint_names=robot.joint_names, source="fast run")
@@ -119,14 +126,7 @@ def _run(robot, model, freqs, seed, source):
     encoder, torque with 0.05 N m noise; and the exact states (t, q, qd, qdd) as Samples."""
     t = np.arange(0.0, 20.0, 0.002)
     rng = np.random.default_rng(seed)
-    q = np.zeros((t.size, 6)) + rng.uniform(-1, 1, 6)
-    qd, qdd = np.zeros_like(q), np.zeros_like(q)
-    for f, size in freqs:
-        w = 2 * np.pi * f
-        a = size * rng.choice([-1.0, 1.0], 6)
-        q += a * np.sin(w * t)[:, None]
-        qd += a * w * np.cos(w * t)[:, None]
-        qdd += -a * w * w * np.sin(w * t)[:, None]
+    q, qd, qdd = _sines(t, freqs, rng)
     tau = model.inverse_dynamics(q, qd, qdd)
     step = 2 * np.pi / 4096
     rec = rd.Recording(t=t, q=np.round(q / step) * step, tau=tau + 0.05 * rng.standard_normal(tau.shape),
