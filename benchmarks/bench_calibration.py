@@ -18,8 +18,9 @@ For a "true" PUMA 560 with millimetre-level manufacturing errors measured by a t
      does before the solve (a probe process that runs the command's steps up to the solver,
      the solver's ``import scipy.optimize`` included, and exits as the command does, without
      the interpreter's teardown; issue 22's target: at most 0.5 s), against, in the same
-     rounds, ``python -c "import numpy"`` (the issue's pairing), the dependencies' bare imports
-     (NumPy, SymPy, ``scipy.optimize``), ``import scipy.optimize`` and ``import sympy`` alone
+     rounds, ``python -c "import numpy"`` (the issue's pairing), the bare imports of
+     the dependencies it needs by then (NumPy, ``scipy.optimize``: the robot's numbers come from
+     robodyn's cache, without SymPy), ``import scipy.optimize`` and ``import sympy`` alone
      once NumPy is loaded, ``robodyn --help`` and an empty interpreter. The command's own
      progress lines give its solve and its cross-validation of the non-geometric terms; what
      comes after the solve (files, report, exit) is the rest of its wall time, per round.
@@ -177,14 +178,11 @@ STARTUP_PROBE = """
 import os
 import sys
 import robodyn.cli
+from robodyn.cli.workflows import calibration_inputs
 args = robodyn.cli._parser().parse_args(["calibrate", "puma560", "--data", sys.argv[1], "-o", "o",
                                          "--nongeometric", "compliance", "--nongeometric",
                                          "harmonics"])
-import robodyn as rd
-from robodyn.calibration.data_checks import ANGLE_UNITS, LENGTH_UNITS, convert_units
-from robodyn.calibration.io import read_calibration_csv, read_joint_map, write_calibration
-robot = rd.load(args.robot, tool=args.tool)
-data = read_calibration_csv(args.data, robot, targets=args.targets, joint_map=None)
+calibration_inputs(args)
 import scipy.optimize
 print("sympy" in sys.modules, flush=True)
 os._exit(0)
@@ -252,8 +250,8 @@ def cli(robot: rd.Robot, q: np.ndarray, y: np.ndarray, rounds: int) -> dict[str,
         rows = {"command": (cmd, False), "command --no-report": ([*cmd, "--no-report"], False),
                 "before the solve": ([py, "-c", STARTUP_PROBE, str(path)], False),
                 "import numpy process": ([py, "-c", "import numpy"], False),
-                "numpy + sympy + scipy.optimize": (
-                    [py, "-c", "import numpy, sympy, scipy.optimize, os; os._exit(0)"], False),
+                "numpy + scipy.optimize": (
+                    [py, "-c", "import numpy, scipy.optimize, os; os._exit(0)"], False),
                 "import scipy.optimize after numpy": (
                     [py, "-c", IMPORT_PROBE.format(pre="numpy", timed="scipy.optimize")], True),
                 "import sympy after numpy": (
@@ -281,7 +279,7 @@ def _cli_entry(t: dict[str, list[float]], err: dict[str, list[str]], rounds: int
         t[k], t["before the solve"], t[f"{k}: solve"], t[f"{k}: terms"],
         t["import scipy.optimize after numpy"], strict=True)] for k in ("command", "command --no-report")}
     before, numpy = t["before the solve"], t["import numpy process"]
-    floor = t["numpy + sympy + scipy.optimize"]
+    floor = t["numpy + scipy.optimize"]
     entry = {"rounds": rounds, "poses": 1000, "targets": 3, "terms": list(TERMS),
              "command_line": "python -m robodyn.cli calibrate puma560 --data poses.csv "
                              "--nongeometric compliance --nongeometric harmonics -o DIR",

@@ -65,20 +65,23 @@ CLI_ROWS = (
      "console command's exit, which skips the interpreter's teardown once its files are written"),
     ("command --no-report", "whole command, `--no-report`", "the same without the HTML report"),
     ("before the solve", "before the solve", "a probe process: interpreter start, the CLI's "
-     "import and parser, the robot, the calibration modules, the CSV, then `import "
+     "import and parser, the robot's numbers (from robodyn's cache: no SymPy), the calibration "
+     "modules, the CSV (`robodyn.cli.workflows.calibration_inputs`), then `import "
      "scipy.optimize` (the solver's import, which the command makes inside the solve), and the "
      "command's exit"),
     ("command: solve", "the solve", "the command's own progress line (0.1 s steps): "
-     "`rd.calibrate`, with the optimizer's import and first calls"),
+     "`rd.calibrate`, with the optimizer's import and first calls, and SymPy's import with the "
+     "description's full load for the calibrated descriptions it builds after the fit"),
     ("command: terms", "the terms' cross-validation", "the command's own progress line: "
      "5-fold cross-validation over poses of geometry, + compliance, + harmonics"),
     ("import scipy.optimize after numpy", "`import scipy.optimize`", "in a fresh process once "
      "NumPy is loaded, timed inside it"),
-    ("import sympy after numpy", "`import sympy`", "the same for SymPy"),
+    ("import sympy after numpy", "`import sympy`", "the same for SymPy (which the command no "
+     "longer imports before the solve)"),
     ("import numpy process", '`python -c "import numpy"`', "the issue's pairing: "
      "interpreter start + NumPy, whole process"),
-    ("numpy + sympy + scipy.optimize", "the dependencies' bare imports", "NumPy, SymPy and "
-     "`scipy.optimize` in a fresh process, whole process, exit without teardown"),
+    ("numpy + scipy.optimize", "the dependencies' bare imports", "NumPy and `scipy.optimize` "
+     "(what the command needs by then) in a fresh process, whole process, exit without teardown"),
     ("robodyn --help", "`robodyn --help`", "whole process"),
     ("empty interpreter", '`python -c "pass"`', "the interpreter's start and exit alone"),
 )
@@ -114,7 +117,7 @@ def _calibration_cli(e: dict[str, Any]) -> list[str]:
         f"{rc.sig(s['import scipy.optimize after numpy']['min'])} s and {sympy}, against "
         f"`python -c \"import numpy\"` {rc.sig(s['import numpy process']['min'])} s in the "
         f"same rounds ({rc.x(c['before_vs_import_numpy'], 2)}). Above the dependencies' bare "
-        f"imports ({rc.sig(s['numpy + sympy + scipy.optimize']['min'])} s) robodyn's own share "
+        f"imports ({rc.sig(s['numpy + scipy.optimize']['min'])} s) robodyn's own share "
         f"is {c['before_minus_floor_s']['min']:.2f} s ({rc.x(c['before_vs_floor'], 2)} the "
         "floor). Minima judged against the targets.")
     return lines

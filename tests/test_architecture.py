@@ -19,7 +19,7 @@ SRC = Path(__file__).resolve().parent.parent / "src" / "robodyn"
 #: Layer of every top-level package or module of robodyn, from the bottom. A module may import
 #: only from its own layer or below (and the graph stays acyclic within a layer).
 LAYERS: dict[str, int] = {
-    "_version": 0, "spatial": 0, "text": 0, "keywords": 0,
+    "_version": 0, "spatial": 0, "text": 0, "keywords": 0, "cache": 0,
     "robot": 1, "errors": 1, "output_names": 1, "extras": 1,           # the description, immutable data
     "symbolic": 2,                                        # equations (hydro terms included)
     "codegen": 3, "export": 3,                            # code and file writers

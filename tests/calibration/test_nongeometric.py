@@ -96,6 +96,31 @@ def test_compliance_and_harmonics_recovered_from_noise_free_data(puma_truth):
     assert validate(cal, q_test, y_test).max < 1e-9
 
 
+@pytest.mark.filterwarnings("ignore:calibration of puma560. the variance factor")
+def test_cached_numbers_calibrate_as_the_robot_itself(puma_truth, tmp_path, monkeypatch):
+    """``robodyn calibrate`` passes the robot's numbers read from the cache (no SymPy before the
+    solve): the same fit, bit for bit, with compliance (masses, gravity) and harmonics (gear
+    ratios) read from them, and the same calibrated description after it."""
+    from robodyn.robot.numbers_cache import load_numbers
+
+    monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path))
+    r, true, terms = puma_truth
+    load_numbers("puma560")
+    numbers = load_numbers("puma560")
+    assert numbers.loader is not None and len(list(tmp_path.glob("rd_robot_*.json"))) == 1
+    q = poses("puma560", 150, 11)
+    y = measured(true, link_angles(r, q, terms), TARGETS)
+    kw = {"nongeometric": ("compliance", "harmonics")}
+    a, b = calibrate(r, q, y, "s-model", **kw), calibrate(numbers, q, y, "s-model", **kw)
+    np.testing.assert_array_equal(a.params, b.params)
+    assert b.parameters == a.parameters
+    assert b.robot.description_hash == a.robot.description_hash
+    assert b.before_robot.description_hash == a.before_robot.description_hash
+    found = {p.name: p.value for p in b.parameters}
+    assert found["q2.compliance"] == pytest.approx(terms["q2.compliance"], rel=1e-6)
+    assert found["q6.motor_sin1"] == pytest.approx(terms["q6.motor_sin1"], rel=1e-6, abs=1e-12)
+
+
 def test_geometric_model_cannot_absorb_the_terms(puma_truth):
     r, true, terms = puma_truth
     q = poses("puma560", 150, 11)

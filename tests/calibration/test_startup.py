@@ -40,6 +40,26 @@ def test_loading_a_builtin_robot_does_not_import_the_urdf_loader():
     assert "sympy" in loaded  # the description itself holds SymPy expressions: the probe works
 
 
+def test_calibrate_reaches_its_solver_without_sympy_on_a_cached_robot(tmp_path, monkeypatch):
+    """``robodyn calibrate``'s work before the solve (robodyn.cli.workflows.calibration_inputs),
+    in a fresh process, once the robot's numbers are cached: no SymPy, no symbolic or code
+    generation layer, no compiler interface. The first process (nothing cached) loads in full."""
+    monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path / "cache"))
+    data = tmp_path / "poses.csv"
+    data.write_text("q1,q2,q3,q4,q5,q6,x,y,z\n" + "\n".join(
+        ",".join(f"{0.1 * (i + k) % 1.3:.3f}" for k in range(6)) + f",{0.5 + 0.01 * i},0.2,0.3"
+        for i in range(30)) + "\n")
+    argv = ["calibrate", "puma560", "--data", str(data), "-o", str(tmp_path / "out"),
+            "--nongeometric", "compliance"]
+    code = ("import robodyn.cli\nfrom robodyn.cli.workflows import calibration_inputs\n"
+            f"inputs = calibration_inputs(robodyn.cli._parser().parse_args({argv!r}))\n"
+            "assert inputs.data.q.shape == (30, 6), inputs.data.q.shape")
+    assert "sympy" in _imported_after(code)  # nothing cached yet: the description is loaded
+    loaded = _imported_after(code)
+    assert {"sympy", "robodyn.symbolic", "robodyn.codegen", "cffi", "scipy.optimize"}.isdisjoint(loaded)
+    assert "robodyn.calibration" in loaded  # the probe sees what was imported
+
+
 def test_parser_literals_match_their_sources():
     from robodyn.calibration.models import MODELS
     from robodyn.calibration.nongeometric import DEFLECTIONS

@@ -7,13 +7,17 @@ messages naming the array and the reason, before anything is fitted.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from robodyn.calibration.models import build_model
 from robodyn.calibration.nominal import RobotGeometry
 from robodyn.robot.errors import InputError
-from robodyn.robot.model import Robot
+from robodyn.robot.numbers import RobotNumbers, robot_numbers
+
+if TYPE_CHECKING:
+    from robodyn.robot.model import Robot
 
 __all__ = ["ANGLE_UNITS", "LENGTH_UNITS", "check_data", "check_magnitude", "convert_units"]
 
@@ -30,7 +34,7 @@ def _array(name: str, value, shape_text: str) -> np.ndarray:
     return a
 
 
-def check_data(robot: Robot, q, points, orientations=None, sigma=5e-5,
+def check_data(robot: Robot | RobotNumbers, q, points, orientations=None, sigma=5e-5,
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray]:
     """Validate calibration data; returns q (N, n), points, orientations and sigma (shape of points).
 
@@ -83,7 +87,8 @@ LENGTH_UNITS = {"m": 1.0, "mm": 1e-3}
 ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180}
 
 
-def convert_units(robot: Robot, q, points, sigma, sigma_rot, length_unit: str, angle_unit: str):
+def convert_units(robot: Robot | RobotNumbers, q, points, sigma, sigma_rot, length_unit: str,
+                  angle_unit: str):
     """Copies of q, points, sigma and sigma_rot in m and rad (revolute joints' readings only).
 
     Raises
@@ -100,7 +105,7 @@ def convert_units(robot: Robot, q, points, sigma, sigma_rot, length_unit: str, a
     lf, af = LENGTH_UNITS[length_unit], ANGLE_UNITS[angle_unit]
     q = _array("q", q, f"(N, {robot.dof})")
     if q.ndim == 2 and q.shape[1] == robot.dof:
-        scale = np.array([af if j.type == "revolute" else 1.0 for j in robot.joints])
+        scale = np.array([af if t == "revolute" else 1.0 for t in robot_numbers(robot).joint_types])
         q = q * scale  # a new array: the caller's is not modified
     return q, _array("points", points, "(N, 3)") * lf, _array("sigma", sigma, "") * lf, sigma_rot * af
 

@@ -2,17 +2,22 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from robodyn.calibration.models import build_model
 from robodyn.calibration.nominal import robot_geometry
 from robodyn.numeric.joint_corrections import link_positions
-from robodyn.robot.model import Robot
+from robodyn.robot.numbers import RobotNumbers
+
+if TYPE_CHECKING:
+    from robodyn.robot.model import Robot
 
 __all__ = ["robot_frames", "robot_positions"]
 
 
-def robot_positions(robot: Robot, q: np.ndarray) -> np.ndarray:
+def robot_positions(robot: Robot | RobotNumbers, q: np.ndarray) -> np.ndarray:
     """Tool positions of ``robot`` in its world frame for readings (N, n), shape (N, 3), m.
 
     Evaluated through the Hayati chain, which stays well conditioned at nearly parallel axes.
@@ -20,7 +25,7 @@ def robot_positions(robot: Robot, q: np.ndarray) -> np.ndarray:
     return robot_frames(robot, q)[:, :3, 3]
 
 
-def robot_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
+def robot_frames(robot: Robot | RobotNumbers, q: np.ndarray) -> np.ndarray:
     """Tool frames of ``robot`` in its world frame for readings (N, n), shape (N, 4, 4).
 
     The description's joint-reading corrections (``robot.corrections``) are applied first.

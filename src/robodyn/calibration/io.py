@@ -31,6 +31,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -38,7 +39,10 @@ from robodyn.calibration.joint_map import JointMap, identity_map, read_joint_map
 from robodyn.calibration.result import Calibration, ErrorStats
 from robodyn.output_names import output_path
 from robodyn.robot.errors import DataFileError
-from robodyn.robot.model import Robot
+from robodyn.robot.numbers import RobotNumbers
+
+if TYPE_CHECKING:
+    from robodyn.robot.model import Robot
 
 __all__ = ["MAX_ABS_VALUE", "CalibrationData", "JointMap", "read_calibration_csv", "read_joint_map",
            "read_table", "write_calibration"]
@@ -197,14 +201,14 @@ def _target_count(path: Path) -> int:
     return k
 
 
-def read_calibration_csv(path: str | Path, robot: Robot, *, targets: int | None = None,
+def read_calibration_csv(path: str | Path, robot: Robot | RobotNumbers, *, targets: int | None = None,
                          joint_map: JointMap | None = None) -> CalibrationData:
     """Read measured poses for ``robot`` from a calibration CSV (module docstring).
 
     Parameters
     ----------
     path : str or Path
-    robot : Robot
+    robot : Robot or RobotNumbers
     targets : int, optional
         Expected number of targets per pose (checked against the columns); default: as found.
     joint_map : JointMap, optional
@@ -255,7 +259,8 @@ def read_calibration_csv(path: str | Path, robot: Robot, *, targets: int | None 
     return CalibrationData(q, points, orientations, sigma, str(path))
 
 
-def write_calibration_csv(path: str | Path, robot: Robot, q: np.ndarray, points: np.ndarray) -> None:
+def write_calibration_csv(path: str | Path, robot: Robot | RobotNumbers, q: np.ndarray,
+                          points: np.ndarray) -> None:
     """Write poses in the calibration CSV format (for tests and simulated data)."""
     with Path(path).open("w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)

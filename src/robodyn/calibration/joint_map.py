@@ -29,12 +29,15 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robodyn.robot.errors import DataFileError
-from robodyn.robot.model import Robot
+from robodyn.robot.numbers import RobotNumbers
+
+if TYPE_CHECKING:
+    from robodyn.robot.model import Robot
 
 __all__ = ["JointMap", "identity_map", "read_joint_map"]
 
@@ -73,19 +76,19 @@ class JointMap:
         return c @ self.weights.T + self.offset  # q = W c + b
 
 
-def identity_map(robot: Robot) -> JointMap:
+def identity_map(robot: Robot | RobotNumbers) -> JointMap:
     """Each model joint read from the column of its own name."""
     return JointMap(tuple(robot.joint_names), np.eye(robot.dof), np.zeros(robot.dof))
 
 
-def read_joint_map(spec: Any, robot: Robot) -> JointMap:
+def read_joint_map(spec: Any, robot: Robot | RobotNumbers) -> JointMap:
     """Read a joint mapping (a recording spec or the short form; module notes) for ``robot``.
 
     Parameters
     ----------
     spec : mapping, str or Path
         A mapping, a YAML file, or the name of a built-in recording spec.
-    robot : Robot
+    robot : Robot or RobotNumbers
 
     Returns
     -------
@@ -125,7 +128,7 @@ def read_joint_map(spec: Any, robot: Robot) -> JointMap:
     return _short_form(spec, source, robot)
 
 
-def _from_spec(spec: Any, source: str, robot: Robot) -> JointMap:
+def _from_spec(spec: Any, source: str, robot: Robot | RobotNumbers) -> JointMap:
     """The recording spec's position conversion and couplings as ``q = W c + b`` in rad (m)."""
     from robodyn.measure.spec import POSITION_UNITS, load_spec
 
@@ -152,7 +155,7 @@ def _from_spec(spec: Any, source: str, robot: Robot) -> JointMap:
     return JointMap(tuple(ch.columns), weights[order], offset[order], si=True, source=source)
 
 
-def _short_form(spec: Any, source: str, robot: Robot) -> JointMap:
+def _short_form(spec: Any, source: str, robot: Robot | RobotNumbers) -> JointMap:
     """``{joint: column or {column, sign, offset, coupling}}`` as ``q = W c + b`` (file units)."""
     if not isinstance(spec, Mapping):
         raise DataFileError(f"{source}: a joint mapping is a recording spec (position, couplings) "

@@ -23,13 +23,18 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import sympy as sp
 
 from robodyn.calibration.kinematics import hom, rot, trans
 from robodyn.robot.errors import InputError
-from robodyn.robot.model import Robot
+from robodyn.robot.numbers import RobotNumbers, robot_numbers
+
+if TYPE_CHECKING:
+    import sympy as sp
+
+    from robodyn.robot.model import Robot
 
 __all__ = [
     "LinkParams",
@@ -50,6 +55,8 @@ EXACT_PARALLEL = 1e-9
 
 def numeric(matrix: sp.MatrixBase, subs: dict) -> np.ndarray:
     """A SymPy matrix with parameters at ``subs`` as a float array."""
+    import sympy as sp  # only where a description's expressions are evaluated
+
     m = sp.Matrix(matrix).xreplace(subs)
     return np.array(m.evalf(), dtype=float)
 
@@ -99,35 +106,31 @@ class RobotGeometry:
         return self.link_frames[-1] @ self.tool
 
 
-def robot_geometry(robot: Robot) -> RobotGeometry:
+def robot_geometry(robot: Robot | RobotNumbers) -> RobotGeometry:
     """Evaluate ``robot`` at ``q = 0`` with its parameters at their defaults."""
-    subs = robot.defaults()
-    base = numeric(robot.base, subs)
-    frame = base
-    joint_frames, axes, posts, links = [], [], [], []
-    for joint in robot.joints:
-        w = frame @ numeric(joint.pre, subs)
-        axis = numeric(joint.axis, subs).ravel()
+    num = robot_numbers(robot)
+    frame = num.base
+    joint_frames, axes, links = [], [], []
+    for name, pre, axis, post in zip(num.joint_names, num.pres, num.axes, num.posts, strict=True):
+        w = frame @ pre
         norm = np.linalg.norm(axis)
         if not norm > 0:
-            raise InputError(f"{robot.source}: joint {joint.name!r} has a zero axis")
-        post = numeric(joint.post, subs)
+            raise InputError(f"{num.source}: joint {name!r} has a zero axis")
         frame = w @ post
         joint_frames.append(w)
         axes.append(axis / norm)
-        posts.append(post)
         links.append(frame)
     jf = np.array(joint_frames)
     ax = np.array(axes)
     return RobotGeometry(
-        joint_names=robot.joint_names,
-        joint_types=tuple(j.type for j in robot.joints),
-        base=base,
+        joint_names=num.joint_names,
+        joint_types=num.joint_types,
+        base=np.array(num.base),
         joint_frames=jf,
         axes_local=ax,
-        posts=np.array(posts),
+        posts=np.array(num.posts),
         link_frames=np.array(links),
-        tool=numeric(robot.tool, subs),
+        tool=np.array(num.tool),
         points=jf[:, :3, 3].copy(),
         directions=np.einsum("nij,nj->ni", jf[:, :3, :3], ax),
     )

@@ -36,13 +36,17 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from robodyn.numeric.joint_corrections import holding_torque
 from robodyn.robot.corrections import CORRECTION_KINDS, HoldingTorque, JointCorrections
 from robodyn.robot.errors import InputError
-from robodyn.robot.model import Robot
+from robodyn.robot.numbers import RobotNumbers, full_robot, robot_numbers
+
+if TYPE_CHECKING:
+    from robodyn.robot.model import Robot
 
 __all__ = ["DEFLECTIONS", "NONGEOMETRIC", "NonGeometric", "build_nongeometric", "gravity_torque",
            "nominal_frames"]
@@ -240,24 +244,22 @@ class NonGeometric:
         }
 
 
-def robot_holding(robot: Robot) -> HoldingTorque:
+def robot_holding(robot: Robot | RobotNumbers) -> HoldingTorque:
     """The robot's own links as point masses on its nominal geometry (world frame, zero readings).
 
     The links' masses and centres of mass ride on the nominal geometry at ``q = 0``
     (:func:`robodyn.calibration.nominal.robot_geometry`); link ``j`` moves with joints ``1 .. j``.
     """
-    from robodyn.calibration.nominal import numeric, robot_geometry
+    from robodyn.calibration.nominal import robot_geometry
 
     geometry = robot_geometry(robot)
-    subs = robot.defaults()
-    gravity = np.array(robot.gravity.xreplace(subs), dtype=float).ravel()
-    masses = np.array([float(link.mass.xreplace(subs)) for link in robot.links])
-    coms = np.array([numeric(link.com, subs).ravel() for link in robot.links])
+    num = robot_numbers(robot)
+    gravity, masses, coms = num.gravity, num.masses, num.coms
     com0 = np.einsum("nij,nj->ni", geometry.link_frames[:, :3, :3], coms) + geometry.link_frames[:, :3, 3]
     dirs = geometry.directions / np.linalg.norm(geometry.directions, axis=1, keepdims=True)
     return HoldingTorque(_rows(geometry.points), _rows(dirs), tuple(geometry.joint_types),
                          tuple(float(m) for m in masses), _rows(masses[:, None] * com0),
-                         tuple(range(1, robot.dof + 1)), tuple(float(g) for g in gravity), "gravity model")
+                         tuple(range(1, num.dof + 1)), tuple(float(g) for g in gravity), "gravity model")
 
 
 def _rows(a: np.ndarray) -> tuple[tuple[float, float, float], ...]:
@@ -285,7 +287,7 @@ def gravity_torque(robot: Robot) -> Callable[[np.ndarray], np.ndarray]:
     return lambda q: holding_torque(holding, q)
 
 
-def _compiled_gravity(robot: Robot, extra: Callable[[np.ndarray], np.ndarray] | None,
+def _compiled_gravity(robot: Robot | RobotNumbers, extra: Callable[[np.ndarray], np.ndarray] | None,
                       h: float = 1e-6,
                       ) -> tuple[Callable[[np.ndarray], np.ndarray], Callable[[np.ndarray], np.ndarray]]:
     """``tau(x)`` (N, n) and ``G(x) = d tau / d x`` (N, n, n) from the compiled model.
@@ -302,7 +304,7 @@ def _compiled_gravity(robot: Robot, extra: Callable[[np.ndarray], np.ndarray] | 
         if "m" not in state:
             from robodyn.numeric.model import compile_model  # on first use only
 
-            state["m"] = compile_model(robot)
+            state["m"] = compile_model(full_robot(robot))
         return state["m"]
 
     def torque(x: np.ndarray) -> np.ndarray:
@@ -369,14 +371,14 @@ def nominal_frames(geometry) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndar
     return frames
 
 
-def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
+def build_nongeometric(robot: Robot | RobotNumbers, terms: Sequence[str], frames, *,
                        payload: tuple[float, Sequence[float]] | None = None,
                        identify_payload: bool = False, deflection: str = "linear") -> NonGeometric:
     """The non-geometric terms ``terms`` of ``robot``.
 
     Parameters
     ----------
-    robot : Robot
+    robot : Robot or RobotNumbers
         The nominal robot (masses, gravity, gear ratios).
     terms : sequence of str
         Subset of :data:`NONGEOMETRIC`.
@@ -404,44 +406,39 @@ def build_nongeometric(robot: Robot, terms: Sequence[str], frames, *,
         unknown ``deflection``, ``"exact"`` with ``identify_payload`` or without link masses.
     """
     terms = _checked_terms(terms, deflection, identify_payload)
-    subs = robot.defaults()
-    n = robot.dof
-    gear = np.full(n, np.nan)
-    for j, joint in enumerate(robot.joints):
-        g = float(joint.drive.gear_ratio.xreplace(subs))
-        if g != 1.0:
-            gear[j] = g
+    num = robot_numbers(robot)
+    gear = np.where(num.gear_ratios != 1.0, num.gear_ratios, np.nan)
     names, units, joints, kinds = [], [], [], []
     torque = exact_torque = torque_jacobian = holding = tool0 = None
     source = ""
-    gravity = np.array(robot.gravity.xreplace(subs), dtype=float).ravel()
+    gravity = num.gravity
     load = _payload_load(payload)
     if "compliance" in terms:
         holding, tool0, exact_torque, torque_jacobian = _compliance_holding(
             robot, frames, None if identify_payload else load, deflection)
         torque = lambda q, holding=holding: holding_torque(holding, q)  # noqa: E731
         source = holding.source
-        for j, joint in enumerate(robot.joints):
-            names.append(f"{joint.name}.compliance")
-            units.append("rad/(N m)" if joint.type == "revolute" else "m/N")
+        for j, (name, kind) in enumerate(zip(num.joint_names, num.joint_types, strict=True)):
+            names.append(f"{name}.compliance")
+            units.append("rad/(N m)" if kind == "revolute" else "m/N")
             joints.append(j)
             kinds.append("compliance")
     if "harmonics" in terms:
-        for j, joint in enumerate(robot.joints):
-            if joint.type != "revolute":
+        for j, (name, jtype) in enumerate(zip(num.joint_names, num.joint_types, strict=True)):
+            if jtype != "revolute":
                 continue
             pairs = [("ratio", "ratio"), ("cos", "cos1"), ("sin", "sin1")]
             if np.isfinite(gear[j]):
                 pairs += [("motor_cos", "motor_cos1"), ("motor_sin", "motor_sin1")]
             for kind, suffix in pairs:
-                names.append(f"{joint.name}.{suffix}")
+                names.append(f"{name}.{suffix}")
                 units.append("1" if kind == "ratio" else "rad")
                 joints.append(j)
                 kinds.append(kind)
     initial = [0.0] * len(names)
     payload_torque = None
     if identify_payload:
-        payload_torque = _payload_unit_torque(frames, [j.type for j in robot.joints], gravity)
+        payload_torque = _payload_unit_torque(frames, list(num.joint_types), gravity)
         source += " + identified payload"
         start = [0.0] * 4 if load is None else [load[0], *(load[0] * load[1])]
         kinds4 = ("payload_mass", "payload_moment", "payload_moment", "payload_moment")
@@ -487,15 +484,14 @@ def _payload_load(payload: tuple[float, Sequence[float]] | None) -> tuple[float,
     return mass, com
 
 
-def _compliance_holding(robot: Robot, frames, known: tuple[float, np.ndarray] | None, deflection: str,
+def _compliance_holding(robot: Robot | RobotNumbers, frames, known: tuple[float, np.ndarray] | None,
+                        deflection: str,
                         ) -> tuple[HoldingTorque, np.ndarray, Callable | None, Callable | None]:
     """The point masses whose holding torque loads the joints (the links' own, or a unit-mass
     basis without masses; plus a known payload), the nominal tool frame at zero readings
     (4, 4), and for ``"exact"`` the compiled torque and its Jacobian."""
-    n = robot.dof
-    subs = robot.defaults()
-    gravity = np.array(robot.gravity.xreplace(subs), dtype=float).ravel()
-    masses = [float(link.mass.xreplace(subs)) for link in robot.links]
+    num = robot_numbers(robot)
+    n, gravity, masses = num.dof, num.gravity, num.masses.tolist()
     origins0, axes0, tool0 = (a[0] for a in frames(np.zeros((1, n))))
     payload_point = [] if known is None else [tool0[:3, :3] @ known[1] + tool0[:3, 3]]
     exact_torque = torque_jacobian = None
@@ -517,7 +513,7 @@ def _compliance_holding(robot: Robot, frames, known: tuple[float, np.ndarray] | 
                          "basis of unknown scale; use deflection='linear'")
     # a 1 kg point mass on the axis of every joint after the first (riding on the link before
     # it) and at the tool
-    empty = HoldingTorque(_rows(origins0), _rows(axes0), tuple(j.type for j in robot.joints), (), (), (),
+    empty = HoldingTorque(_rows(origins0), _rows(axes0), num.joint_types, (), (), (),
                           tuple(float(g) for g in gravity))
     holding = _with_points(empty, [1.0] * n + ([known[0]] if known else []),
                            np.vstack([origins0[1:], tool0[None, :3, 3], *payload_point]),

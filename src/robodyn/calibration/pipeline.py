@@ -21,7 +21,7 @@ import math
 import warnings
 from collections.abc import Sequence
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -40,10 +40,12 @@ from robodyn.calibration.nominal import RobotGeometry, default_frame0, robot_geo
 from robodyn.calibration.options import CalibrateOptions
 from robodyn.calibration.result import Calibration, ErrorStats, Parameter
 from robodyn.calibration.solve import Fit, fit
-from robodyn.calibration.to_robot import calibrated_robot
 from robodyn.keywords import resolve
 from robodyn.robot.errors import InputError
-from robodyn.robot.model import Robot
+from robodyn.robot.numbers import RobotNumbers, robot_numbers
+
+if TYPE_CHECKING:
+    from robodyn.robot.model import Robot
 
 __all__ = ["calibrate", "identifiable_parameters", "nominal_placement", "random_configurations"]
 
@@ -83,21 +85,18 @@ def target_offsets(model: ErrorModel, params: np.ndarray, q: np.ndarray, points:
     return offsets, res
 
 
-def random_configurations(robot: Robot, count: int, rng: np.random.Generator | int = 0) -> np.ndarray:
+def random_configurations(robot: Robot | RobotNumbers, count: int, rng: np.random.Generator | int = 0,
+                          ) -> np.ndarray:
     """Uniformly random joint readings within the joint limits, shape (count, n).
 
     Joints without limits range over ``[-pi, pi]`` (revolute) or ``[-0.5, 0.5]`` m (prismatic).
     """
     rng = np.random.default_rng(rng)
-    subs = robot.defaults()
-    lo, hi = [], []
-    for j in robot.joints:
-        default = (-math.pi, math.pi) if j.type == "revolute" else (-0.5, 0.5)
-        lower = float(j.lower.xreplace(subs)) if j.lower is not None else default[0]
-        upper = float(j.upper.xreplace(subs)) if j.upper is not None else default[1]
-        lo.append(lower)
-        hi.append(upper)
-    return rng.uniform(lo, hi, size=(count, robot.dof))
+    num = robot_numbers(robot)
+    revolute = np.array([t == "revolute" for t in num.joint_types])
+    lo = np.where(np.isnan(num.lower), np.where(revolute, -math.pi, -0.5), num.lower)
+    hi = np.where(np.isnan(num.upper), np.where(revolute, math.pi, 0.5), num.upper)
+    return rng.uniform(lo, hi, size=(count, num.dof))
 
 
 def _rows(model: ErrorModel, params: np.ndarray, q: np.ndarray, weights: np.ndarray,
@@ -173,7 +172,8 @@ def _kabsch(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return hom(r, cb - r @ ca)
 
 
-def identifiable_parameters(robot: Robot, model: ErrorModel, params: np.ndarray, q: np.ndarray,
+def identifiable_parameters(robot: Robot | RobotNumbers, model: ErrorModel, params: np.ndarray,
+                            q: np.ndarray,
                             weights: np.ndarray | float = 1.0, rot_weight: float = 1.0,
                             ) -> tuple[list[int], list[Unidentifiable]]:
     """Identifiable parameters of ``model`` for the poses ``q``, and the reasons for the others.
@@ -210,7 +210,7 @@ def identifiable_parameters(robot: Robot, model: ErrorModel, params: np.ndarray,
 
 
 def calibrate(
-    robot: Robot,
+    robot: Robot | RobotNumbers,
     q,
     points,
     model: str = "s-model",
@@ -236,8 +236,9 @@ def calibrate(
 
     Parameters
     ----------
-    robot : Robot
-        The nominal robot.
+    robot : Robot or RobotNumbers
+        The nominal robot, or its numbers (:func:`robodyn.robot.numbers_cache.load_numbers`:
+        no SymPy before the solve; the calibrated robots are built in full after it).
     q : array_like, shape (N, n)
         Joint readings at the measured poses, rad (m for prismatic joints).
     points : array_like, shape (N, 3) or (N, K, 3)
@@ -306,7 +307,8 @@ def calibrate(
                                 placed_params, loss, initial, cp), options=opts)
 
 
-def _prepared_data(robot: Robot, q, points, orientations, sigma, sigma_rot: float, length_unit: str,
+def _prepared_data(robot: Robot | RobotNumbers, q, points, orientations, sigma, sigma_rot: float,
+                   length_unit: str,
                    angle_unit: str,
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray, float, RobotGeometry]:
     """The data of :func:`calibrate` in m and rad, checked, with the robot's nominal geometry.
@@ -362,7 +364,8 @@ def _before_calibration(geometry: RobotGeometry, q: np.ndarray, pts3: np.ndarray
     return world, target, placed, placed_params, before_res
 
 
-def _identify(robot: Robot, em: ErrorModel, model: str, q: np.ndarray, points: np.ndarray,
+def _identify(robot: Robot | RobotNumbers, em: ErrorModel, model: str, q: np.ndarray,
+              points: np.ndarray,
               sig: np.ndarray, orientations: np.ndarray | None, sigma_rot: float, k_count: int,
               loss: str, loss_scale: float, max_nfev: int | None, identify_payload: bool,
               ) -> tuple[Fit, list[Unidentifiable]]:
@@ -411,7 +414,8 @@ def _identify(robot: Robot, em: ErrorModel, model: str, q: np.ndarray, points: n
 EQUATIONS_PER_PARAMETER = 3.0
 
 
-def _check_pose_count(robot: Robot, em: ErrorModel, model: str, unid: Sequence[Unidentifiable],
+def _check_pose_count(robot: Robot | RobotNumbers, em: ErrorModel, model: str,
+                      unid: Sequence[Unidentifiable],
                       q: np.ndarray, k_count: int, oriented: bool) -> None:
     """Refuse fewer equations than structurally identifiable parameters (ValueError).
 
@@ -436,7 +440,7 @@ def _check_pose_count(robot: Robot, em: ErrorModel, model: str, unid: Sequence[U
             RuntimeWarning, stacklevel=4)
 
 
-def _calibration(robot: Robot, geometry: RobotGeometry, em: ErrorModel, res: Fit,
+def _calibration(robot: Robot | RobotNumbers, geometry: RobotGeometry, em: ErrorModel, res: Fit,
                  unid: Sequence[Unidentifiable], q: np.ndarray, sig: np.ndarray,
                  before_res: np.ndarray, placed: ErrorModel, placed_params: np.ndarray, loss: str,
                  initial: str, cp: CirclePointResult | None) -> Calibration:
@@ -457,6 +461,8 @@ def _calibration(robot: Robot, geometry: RobotGeometry, em: ErrorModel, res: Fit
         Parameter(em.names[k], float(res.params[k]), float(s), float(em.initial[k]), em.units[k])
         for k, s in zip(res.free, std, strict=True)
     )
+    from robodyn.calibration.to_robot import calibrated_robot  # SymPy: after the solve
+
     obs = observability(_rows(em, res.params, q, np.ones((len(sig), 3)), 1.0)[:, res.free], len(q))
     return Calibration(
         robot=calibrated_robot(robot, geometry, em, res.params),
@@ -480,12 +486,14 @@ def _calibration(robot: Robot, geometry: RobotGeometry, em: ErrorModel, res: Fit
         converged=res.success,
         message=res.message,
         circle_point=cp,
-        before_robot=calibrated_robot(robot, geometry, placed, placed_params, name=f"{robot.name}_placed"),
+        before_robot=calibrated_robot(robot, geometry, placed, placed_params,
+                                      name=f"{robot.name}_placed"),
         targets_axis=before_res.ndim == 3,
     )
 
 
-def _error_model(robot: Robot, geometry: RobotGeometry, model: str, initial: str, circle_data: Any,
+def _error_model(robot: Robot | RobotNumbers, geometry: RobotGeometry, model: str, initial: str,
+                 circle_data: Any,
                  target: np.ndarray, world: np.ndarray, oriented: bool, parallel_tol: float,
                  q: np.ndarray, pts3: np.ndarray, nongeometric: Sequence[str], payload: Any,
                  identify_payload: bool, deflection: str) -> tuple[ErrorModel, CirclePointResult | None]:

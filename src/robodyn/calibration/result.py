@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -10,7 +11,9 @@ from robodyn.calibration.identifiability import Observability, Unidentifiable
 from robodyn.calibration.joint_axes import CirclePointResult
 from robodyn.calibration.models import ErrorModel, model_frames
 from robodyn.calibration.options import CalibrateOptions
-from robodyn.robot.model import Robot
+
+if TYPE_CHECKING:
+    from robodyn.robot.model import Robot
 
 __all__ = ["Calibration", "ErrorStats", "Parameter"]
 

@@ -21,11 +21,14 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from robodyn.robot.model import Robot
+from robodyn.robot.numbers import RobotNumbers, robot_numbers
+
+if TYPE_CHECKING:
+    from robodyn.robot.model import Robot
 
 __all__ = ["TermsCheck", "description_alone", "terms_cross_validation"]
 
@@ -62,7 +65,7 @@ class TermsCheck:
         return "\n".join(lines)
 
 
-def terms_cross_validation(calibrate: Callable[..., Any], robot: Robot, q: np.ndarray,
+def terms_cross_validation(calibrate: Callable[..., Any], robot: Robot | RobotNumbers, q: np.ndarray,
                            points: np.ndarray, terms: Sequence[str], folds: int = 5,
                            seed: int = 0, **options: Any) -> TermsCheck:
     """K-fold cross-validation over poses of the nested term sets (module docstring).
@@ -71,7 +74,7 @@ def terms_cross_validation(calibrate: Callable[..., Any], robot: Robot, q: np.nd
     ----------
     calibrate : callable
         ``rd.calibrate`` (passed in: this module sits below it).
-    robot : Robot
+    robot : Robot or RobotNumbers
     q : numpy.ndarray, shape (N, n)
         Joint readings, in ``options``' ``angle_unit``.
     points : numpy.ndarray, shape (N, 3) or (N, K, 3)
@@ -129,13 +132,13 @@ def _trained(options: dict[str, Any], train: np.ndarray) -> dict[str, Any]:
     return out
 
 
-def _si_angles(robot: Robot, q: np.ndarray, options: dict[str, Any]) -> np.ndarray:
+def _si_angles(robot: Robot | RobotNumbers, q: np.ndarray, options: dict[str, Any]) -> np.ndarray:
     """Readings in rad for ``cal.predict`` (revolute joints converted from degrees)."""
     if options.get("angle_unit", "rad") != "deg":
         return q
     out = q.copy()
-    for j, joint in enumerate(robot.joints):
-        if joint.type == "revolute":
+    for j, kind in enumerate(robot_numbers(robot).joint_types):
+        if kind == "revolute":
             out[:, j] = np.radians(out[:, j])
     return out
 

@@ -33,6 +33,7 @@ from robodyn.calibration.kinematics import inv
 from robodyn.calibration.models import ErrorModel, model_frames
 from robodyn.calibration.nominal import RobotGeometry, numeric
 from robodyn.robot.model import Robot
+from robodyn.robot.numbers import RobotNumbers, full_robot
 
 __all__ = ["calibrated_robot", "sym"]
 
@@ -55,14 +56,15 @@ def sym(m: np.ndarray, snap: float = 1e-15) -> sp.ImmutableMatrix:
     return sp.ImmutableMatrix(out)
 
 
-def calibrated_robot(nominal: Robot, geometry: RobotGeometry, model: ErrorModel, params: np.ndarray,
-                     *, name: str | None = None) -> Robot:
+def calibrated_robot(nominal: Robot | RobotNumbers, geometry: RobotGeometry, model: ErrorModel,
+                     params: np.ndarray, *, name: str | None = None) -> Robot:
     """The robot described by ``model`` at ``params`` (see the module docstring).
 
     Parameters
     ----------
-    nominal : Robot
-        The robot the model was built from (names, links, drives, friction, limits).
+    nominal : Robot or RobotNumbers
+        The robot the model was built from (names, links, drives, friction, limits); numbers
+        from the cache are loaded in full (:func:`~robodyn.robot.numbers.full_robot`).
     geometry : RobotGeometry
         Its nominal geometry.
     model : ErrorModel
@@ -79,6 +81,7 @@ def calibrated_robot(nominal: Robot, geometry: RobotGeometry, model: ErrorModel,
     Robot
         Numeric kinematics; ``robot.base`` is the chain base frame in the instrument frame.
     """
+    nominal = full_robot(nominal)
     frame0, motion, target = model_frames(model, params)
     w = motion @ model.joint_to_robot  # robot joint frames, instrument coords
     base = frame0 @ model.base_to_robot

@@ -11,7 +11,7 @@ import csv
 import math
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -174,11 +174,30 @@ def _payload(values: np.ndarray | None) -> tuple[float, np.ndarray] | None:
     return float(values[0]), values[1:]
 
 
-def _cmd_calibrate(args: argparse.Namespace) -> int:
-    from robodyn.calibration.data_checks import ANGLE_UNITS, LENGTH_UNITS, convert_units
-    from robodyn.calibration.io import read_calibration_csv, read_joint_map, write_calibration
+class CalibrationInputs(NamedTuple):
+    """What ``robodyn calibrate`` reads before its solve (:func:`calibration_inputs`)."""
 
-    robot = rd.load(args.robot, tool=args.tool)
+    robot: Any  # RobotNumbers
+    stem: str
+    jmap: Any  # JointMap or None
+    data: Any  # CalibrationData
+    units: dict[str, str]
+    si: Callable[[Any], tuple[np.ndarray, np.ndarray]]  # a data set's q, points in rad and m
+    circle: list[tuple[np.ndarray, np.ndarray]] | None
+    sigma: Any  # float or array, the data's length unit
+    sigma_rot: float  # the data's angle unit
+
+
+def calibration_inputs(args: argparse.Namespace) -> CalibrationInputs:
+    """What ``robodyn calibrate`` reads before its solve: the robot's numbers (from the cache
+    where its description was loaded before: no SymPy), the output stem, the joint map, the
+    data, the circle-point files, and sigma and sigma_rot in the data's units.
+    ``benchmarks/bench_calibration.py`` times this function in a fresh process."""
+    from robodyn.calibration.data_checks import ANGLE_UNITS, LENGTH_UNITS, convert_units
+    from robodyn.calibration.io import read_calibration_csv, read_joint_map
+    from robodyn.robot.numbers_cache import load_numbers
+
+    robot = load_numbers(args.robot, tool=args.tool)
     stem = check_stem(args.stem) if args.stem is not None else \
         check_stem(f"{robot.name}_calibrated", what="robot name")
     jmap = read_joint_map(args.joint_map, robot) if args.joint_map else None
@@ -203,6 +222,13 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     sigma = data.sigma if data.sigma is not None else args.sigma * 1e-3 / LENGTH_UNITS[args.length_unit]
     # sigma_rot in the angle unit (the option is in mrad)
     sigma_rot = args.sigma_rot * 1e-3 / ANGLE_UNITS[args.angle_unit]
+    return CalibrationInputs(robot, stem, jmap, data, units, si, circle, sigma, sigma_rot)
+
+
+def _cmd_calibrate(args: argparse.Namespace) -> int:
+    from robodyn.calibration.io import write_calibration
+
+    robot, stem, jmap, data, units, si, circle, sigma, sigma_rot = calibration_inputs(args)
     with progress(f"calibrating {robot.name} from {len(data.q)} poses ({args.model} model)"):
         cal = rd.calibrate(robot, data.q, data.points, args.model, sigma=sigma, loss=args.loss,
                            initial="circle-point" if circle else "nominal", circle_data=circle,

@@ -33,6 +33,7 @@ from pathlib import Path
 
 import cffi
 
+from robodyn.cache import cache_dir
 from robodyn.codegen.cpu import BLOCK, vector_flags
 from robodyn.robot.errors import InputError
 
@@ -133,36 +134,6 @@ class CompiledLibrary:
     lib: object
 
 
-def cache_dir(*, create: bool = True) -> Path:
-    """The compiled-model cache directory.
-
-    Parameters
-    ----------
-    create : bool
-        Create it (mode 0700: other users can neither read nor plant libraries) when missing;
-        the default folder (not ``$ROBODYN_CACHE``) is also made 0700 when it is open to others.
-
-    Returns
-    -------
-    Path
-    """
-    root = os.environ.get("ROBODYN_CACHE")
-    if root:
-        path = Path(root)
-    else:
-        base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-        path = Path(base) / "robodyn"
-    if create and not path.is_dir():
-        path.mkdir(mode=0o700, parents=True, exist_ok=True)
-        os.chmod(path, 0o700)  # mkdir's mode is filtered by the umask
-    elif create and not root:
-        # the default folder is robodyn's own: one an older version left open is closed
-        st = path.stat()
-        if st.st_mode & 0o077 and st.st_uid == os.getuid():
-            os.chmod(path, 0o700)
-    return path
-
-
 @dataclass(frozen=True)
 class CacheInfo:
     """What the cache holds.
@@ -209,9 +180,11 @@ def cache_limit() -> int:
     return int(mb * 2**20)
 
 
-#: The names robodyn gives its cache files: ``rd_<24 hex>.so`` and its manifest, and generated
-#: sources ``rd_<tag>_<24 hex>.c/.cdef/.py/.singular``; nothing else is ever removed.
-_OWN_NAME = re.compile(r"rd_(?:[a-z]+_)?[0-9a-f]{24}(?:\.so(?:\.sha256)?|\.src|\.c|\.cdef|\.py|\.singular)")
+#: The names robodyn gives its cache files: ``rd_<24 hex>.so`` and its manifest, generated
+#: sources ``rd_<tag>_<24 hex>.c/.cdef/.py/.singular`` and the numbers of loaded descriptions
+#: ``rd_robot_<24 hex>.json`` (:mod:`robodyn.robot.numbers_cache`); nothing else is ever removed.
+_OWN_NAME = re.compile(
+    r"rd_(?:[a-z]+_)?[0-9a-f]{24}(?:\.so(?:\.sha256)?|\.src|\.c|\.cdef|\.py|\.singular|\.json)")
 #: A temporary compilation folder: ``tempfile``'s ``.build-`` plus 8 name characters.
 _OWN_BUILD = re.compile(r"\.build-[a-z0-9_]{8}")
 

@@ -8,11 +8,16 @@ deflected pose, Newton's method, :mod:`robodyn.numeric.deflection`).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from robodyn.numeric.deflection import exact_deflection
 from robodyn.robot.corrections import HoldingTorque, JointCorrections
-from robodyn.robot.model import Robot
+from robodyn.robot.numbers import RobotNumbers, robot_numbers
+
+if TYPE_CHECKING:
+    from robodyn.robot.model import Robot
 
 __all__ = ["holding_torque", "holding_torque_jacobian", "link_positions"]
 
@@ -98,7 +103,7 @@ def _transmission(table: np.ndarray, gear: np.ndarray, q: np.ndarray) -> tuple[n
     return du, diag
 
 
-def link_positions(robot: Robot, q: np.ndarray, *, derivative: bool = False,
+def link_positions(robot: Robot | RobotNumbers, q: np.ndarray, *, derivative: bool = False,
                    ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Link angles (N, n) for joint readings ``q`` (n,) or (N, n), rad (m).
 
@@ -108,7 +113,7 @@ def link_positions(robot: Robot, q: np.ndarray, *, derivative: bool = False,
 
     Parameters
     ----------
-    robot : Robot
+    robot : Robot or RobotNumbers
     q : numpy.ndarray, shape (n,) or (N, n)
     derivative : bool
         Also return ``d x / d q`` (N, n, n): the transmission terms exactly, the compliance's
@@ -127,8 +132,7 @@ def link_positions(robot: Robot, q: np.ndarray, *, derivative: bool = False,
     if corr is None:
         x, jac = q2.copy(), np.broadcast_to(np.eye(n), (len(q2), n, n)).copy()
     else:
-        subs = robot.defaults()
-        gear = np.array([float(j.drive.gear_ratio.xreplace(subs)) for j in robot.joints])
+        gear = np.array(robot_numbers(robot).gear_ratios)
         gear[gear == 1.0] = np.nan  # a direct drive has no separate motor harmonic
         table = corr.array
         du, diag = _transmission(table, gear, q2)

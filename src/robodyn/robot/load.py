@@ -12,9 +12,12 @@ from collections.abc import Mapping
 from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
+from typing import TYPE_CHECKING
 
 from robodyn.robot.errors import DescriptionError, DescriptionWarning, InputError
-from robodyn.robot.model import Robot
+
+if TYPE_CHECKING:
+    from robodyn.robot.model import Robot
 
 __all__ = ["ALIASES", "KNOWN_PROPERTIES", "builtin_names", "load"]
 
