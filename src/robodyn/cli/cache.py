@@ -39,7 +39,9 @@ def register(sub: argparse._SubParsersAction, fmt: type) -> None:
     p = sub.add_parser(
         "cache", help="show or empty the compiled-model cache", formatter_class=fmt,
         description="The compiled-model cache holds the generated sources and compiled "
-                    "libraries of rd.compile_model, keyed by content: $ROBODYN_CACHE, else "
+                    "libraries of rd.compile_model and the numbers of robot descriptions "
+                    "'robodyn calibrate' has loaded (rd_robot_*.json, so that it starts without "
+                    "SymPy), keyed by content: $ROBODYN_CACHE, else "
                     "$XDG_CACHE_HOME/robodyn, else ~/.cache/robodyn (mode 0700). Libraries are "
                     "checked against a size and SHA-256 manifest before loading and rebuilt "
                     "when they do not match. Beyond $ROBODYN_CACHE_MAX_MB megabytes (default "
