@@ -96,6 +96,22 @@ def test_no_report_skips_only_the_html(data, tmp_path, capsys):
     assert "wrote html" not in capsys.readouterr().out.split("puma560_calibrated.yaml")[-1]
 
 
+def test_a_cached_robot_calibrates_as_a_freshly_loaded_one(data, tmp_path, monkeypatch, capsys):
+    """The first run loads the description in full and caches its numbers, the second reads them
+    (no SymPy before its solve): the same calibrated description and report."""
+    monkeypatch.setenv("ROBODYN_CACHE", str(tmp_path / "cache"))
+    args = ["calibrate", "puma560", "--data", str(data / "si.csv"), "--model", "hayati", "--no-report"]
+    assert main([*args, "-o", str(tmp_path / "first")]) == 0
+    assert len(list((tmp_path / "cache").glob("rd_robot_*.json"))) == 1
+    assert main([*args, "-o", str(tmp_path / "second")]) == 0
+    first, second = (tmp_path / d for d in ("first", "second"))
+    assert sorted(p.name for p in first.iterdir()) == sorted(p.name for p in second.iterdir())
+    assert ((second / "puma560_calibrated.yaml").read_text()
+            == (first / "puma560_calibrated.yaml").read_text())
+    assert (json.loads((second / "puma560_calibrated_report.json").read_text())["parameters"]
+            == json.loads((first / "puma560_calibrated_report.json").read_text())["parameters"])
+
+
 def test_bad_mapping_and_target_count(data, tmp_path, capsys):
     r = robot("puma560")
     with pytest.raises(DataFileError, match="names joint 'q9', which puma560 does not have"):
