@@ -17,6 +17,7 @@ again; a cache folder that cannot be written only costs the speed-up.
 from __future__ import annotations
 
 import builtins
+import dataclasses
 import functools
 import hashlib
 import json
@@ -116,7 +117,7 @@ def load_numbers(source: str | Path, *, tool: str | None = None) -> RobotNumbers
     numbers = robot_numbers(robot)
     if entry is not None:
         _write(entry, numbers, given)
-    return RobotNumbers(**{**numbers.__dict__, "loader": lambda: robot})
+    return dataclasses.replace(numbers, loader=lambda: robot)  # this Robot, held
 
 
 def _loader(source: str | Path, tool: str | None) -> Callable[[], Robot]:
