@@ -11,15 +11,28 @@ with ``I_O`` the inertia about the link frame origin and ``h = m c``. The estima
 weighted squared error of the linear step (its row weights and its Tikhonov weight toward the
 description's base parameters) over the full standard vector ``p`` (15 n)::
 
-    min |A (K p) - b|^2 + lam |D (K p - theta0)|^2 + mu |S (p - p_nom)|^2
-    s.t. J_j(p) >= eps 1 (every link),  Ia_j, Fv_j, Fcp_j, Fcn_j >= 0,  optional bounds
+    f(p) = |A (K p) - b|^2 + lam |D (K p - theta0)|^2
+    stage 1:  f* = min f(p) (+ 1e-12 of the data scale times stage 2's distance)  s.t. C
+    stage 2:  min |S^-1 (p - p_nom)|^2  s.t. C,  f(p) <= f* (1 + nb / (m - nb)) + FLOOR_TOL |b|^2
+    C:  J_j(p) >= eps 1 (every link),  Ia_j, Fv_j, Fcp_j, Fcn_j >= 0,  optional bounds
 
-where ``K`` maps standard to base parameters, and the small ``mu`` term (1e-8 of the data term's
-scale, ``S`` the nominal magnitudes) picks, among the standard sets with the same base
-parameters, the one closest to the description. ``eps = EPS`` keeps a small margin inside the
-cone so that the result passes robodyn's strict inertia validation after rounding. The problem
-is a semidefinite program solved by cvxpy with Clarabel; an infeasible problem (e.g.
-contradictory ``bounds``) or a solver failure raises :class:`IdentificationError`.
+where ``K`` maps standard to base parameters, ``m`` the rows and ``nb`` the base parameters.
+Stage 2 picks, among the consistent standard sets that the data cannot tell from the best fit,
+the one closest to the description (``S`` the nominal magnitudes, floored at 1e-3): its
+allowance ``nb f* / (m - nb)`` is ``nb`` times the estimated variance of a row, the mean of
+chi^2 with ``nb`` degrees of freedom, the scale of the base parameters' joint confidence region
+(rows filtered and decimated are correlated, so the region it stands for is, if anything,
+narrower than that). Noise-free data give no allowance: the best fit itself. A
+tie-break added to stage 1's objective instead (as before 2026-12-06, with weight 1e-8 of the
+data's scale) acts as a prior toward the description on the identifiable parameters too: on a
+plant whose centres of mass lie centimetres off its description's (noise-free data, truth
+inside the cone) it moved the base parameters by 4e-4 of the largest (now 1.5e-7), and on a virtual 7-DOF
+torque arm it put every link on the cone's boundary and lost to plain least squares.
+``eps = EPS`` keeps a small margin inside the
+cone so that the result passes robodyn's strict inertia validation after rounding. Both stages
+are semidefinite programs solved by cvxpy with Clarabel; an infeasible problem (e.g.
+contradictory ``bounds``) or a failure of stage 1 raises :class:`IdentificationError`; a failure
+of stage 2 keeps stage 1's set (consistent and best-fitting, not the closest).
 """
 
 from __future__ import annotations
@@ -39,6 +52,12 @@ __all__ = ["EPS", "consistent_standard", "pseudo_inertia"]
 
 #: Margin inside the pseudo-inertia cone, kg m^2 (Sigma block) and kg (mass).
 EPS = 1e-7
+#: Weight of the distance to the description in stage 1, relative to the data's mean squared
+#: singular value (the program before 2026-12-06 used 1e-8 there, and no stage 2).
+UNIQUE = 1e-12
+#: Stage 2's allowance relative to the target's squared norm, for data fitted exactly (solver
+#: accuracy; the statistical allowance is then zero).
+FLOOR_TOL = 1e-14
 
 
 def pseudo_inertia(standard: np.ndarray, j: int) -> np.ndarray:
@@ -93,7 +112,6 @@ def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray,
     import cvxpy as cp  # a core dependency, imported when used (slow to import)
 
     n = robot.dof
-    names = relations.standard_names
     # the row weights relative to the largest: the program is the same (every term scales with
     # w^2), but noise-free data give weights of 1e15 and Clarabel's absolute tolerances fail
     w = fit.weights[joint] / max(float(np.max(fit.weights)), 1e-300)
@@ -109,12 +127,38 @@ def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray,
     theta0 = relations.to_base(nominal)
     p = cp.Variable(k.shape[1])
     theta = k @ p
-    data = float(np.sum(s**2)) / max(s.size, 1)
-    mag = np.maximum(np.abs(nominal), 1e-3)
-    objective = cp.sum_squares(r_mat @ theta - r_rhs)
+    fit_term = cp.sum_squares(r_mat @ theta - r_rhs)
     if fit.lam > 0:
-        objective += fit.lam * cp.sum_squares(cp.multiply(scale, theta - theta0))
-    objective += 1e-8 * data * cp.sum_squares(cp.multiply(1.0 / mag, p - nominal))
+        fit_term += fit.lam * cp.sum_squares(cp.multiply(scale, theta - theta0))
+    constraints = _constraints(cp, p, n, relations.standard_names, bounds)
+    mag = np.maximum(np.abs(nominal), 1e-3)
+    distance = cp.sum_squares(cp.multiply(1.0 / mag, p - nominal))
+    # stage 1: the estimate's fit over the cone (the distance at UNIQUE only makes the optimum
+    # unique: parameters that no column sees would leave an unbounded optimal face)
+    data = float(np.sum(s**2)) / max(s.size, 1)
+    _solve(cp, cp.Problem(cp.Minimize(fit_term + UNIQUE * data * distance), constraints), bounds)
+    first = np.asarray(p.value, dtype=float)
+    # stage 2: among the consistent sets that the data cannot tell from the best (within the
+    # base parameters' confidence region), the one closest to the description
+    best = _fit_value(first, k, r_mat, r_rhs, fit.lam, scale, theta0)
+    bound = best + _allowance(best, a.shape) + FLOOR_TOL * float(r_rhs @ r_rhs)
+    closest = cp.Problem(cp.Minimize(distance), [*constraints, fit_term <= bound])
+    try:
+        closest.solve(solver=cp.CLARABEL)
+    except cp.error.SolverError:
+        p.value = first  # the stage-1 set stands (consistent, best fit; not the closest)
+    if closest.status not in ("optimal", "optimal_inaccurate") or p.value is None:
+        p.value = first
+    out = np.asarray(p.value, dtype=float)
+    for j in range(n):
+        _project_link(out, j)
+        _check_link(out, j, robot)
+    return out
+
+
+def _constraints(cp, p, n: int, names: tuple[str, ...],
+                 bounds: Mapping[str, tuple[float, float]] | None) -> list:
+    """The cone (``J_j >= EPS 1``), ``Ia, Fv, Fcp, Fcn >= 0`` and the user's ``bounds``."""
     constraints = []
     for j in range(n):
         constraints.append(_pseudo_expr(cp, p, j) >> EPS * np.eye(4))
@@ -126,7 +170,11 @@ def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray,
                                       f"(names like {names[0]!r}, {names[9]!r})")
         i = names.index(name)
         constraints += [p[i] >= lo, p[i] <= hi]
-    problem = cp.Problem(cp.Minimize(objective), constraints)
+    return constraints
+
+
+def _solve(cp, problem, bounds: Mapping[str, tuple[float, float]] | None) -> None:
+    """Solve ``problem`` with Clarabel; IdentificationError unless it ends optimal."""
     try:
         problem.solve(solver=cp.CLARABEL)
     except cp.error.SolverError as exc:
@@ -137,14 +185,29 @@ def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray,
             "method='consistent': the semidefinite program is infeasible: no physically "
             "consistent parameters (pseudo-inertia >= 0, rotor inertia and friction >= 0)"
             + (f" satisfy the bounds {dict(bounds)}" if bounds else ""))
-    if problem.status not in ("optimal", "optimal_inaccurate") or p.value is None:
+    if problem.status not in ("optimal", "optimal_inaccurate") or problem.variables()[0].value is None:
         raise IdentificationError(f"method='consistent': the semidefinite program ended with "
                                   f"status {problem.status!r}")
-    out = np.asarray(p.value, dtype=float)
-    for j in range(n):
-        _project_link(out, j)
-        _check_link(out, j, robot)
-    return out
+
+
+def _allowance(best: float, shape: tuple[int, int]) -> float:
+    """Stage 2's allowance on stage 1's objective ``best`` for a problem of ``shape`` (m, b).
+
+    ``sigma^2 = best / (m - b)`` estimates the residual variance of a row (in the weighted units
+    of the objective); ``b sigma^2`` is the mean of chi^2 with ``b`` degrees of freedom, the scale
+    of the base parameters' joint confidence region around the best fit.
+    """
+    m, b = shape
+    # delta f = b sigma^2 = b best / (m - b)
+    return b * best / max(m - b, 1)
+
+
+def _fit_value(p: np.ndarray, k: np.ndarray, r_mat: np.ndarray, r_rhs: np.ndarray, lam: float,
+               scale: np.ndarray, theta0: np.ndarray) -> float:
+    """Stage 1's objective at the standard set ``p`` (15 n,)."""
+    theta = k @ p
+    # |R theta - r|^2 + lam |D (theta - theta0)|^2
+    return float(np.sum((r_mat @ theta - r_rhs) ** 2) + lam * np.sum((scale * (theta - theta0)) ** 2))
 
 
 def _project_link(p: np.ndarray, j: int) -> None:
