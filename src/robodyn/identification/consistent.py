@@ -132,17 +132,23 @@ def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray,
         fit_term += fit.lam * cp.sum_squares(cp.multiply(scale, theta - theta0))
     constraints = _constraints(cp, p, n, relations.standard_names, bounds)
     mag = np.maximum(np.abs(nominal), 1e-3)
-    distance = cp.sum_squares(cp.multiply(1.0 / mag, p - nominal))
+    offset = cp.multiply(1.0 / mag, p - nominal)  # S^-1 (p - p_nom)
     # stage 1: the estimate's fit over the cone (the distance at UNIQUE only makes the optimum
     # unique: parameters that no column sees would leave an unbounded optimal face)
     data = float(np.sum(s**2)) / max(s.size, 1)
-    _solve(cp, cp.Problem(cp.Minimize(fit_term + UNIQUE * data * distance), constraints), bounds)
+    stage1 = cp.Problem(cp.Minimize(fit_term + UNIQUE * data * cp.sum_squares(offset)), constraints)
+    _solve(cp, stage1, bounds)
     first = np.asarray(p.value, dtype=float)
     # stage 2: among the consistent sets that the data cannot tell from the best (within the
     # base parameters' confidence region), the one closest to the description
     best = _fit_value(first, k, r_mat, r_rhs, fit.lam, scale, theta0)
     bound = best + _allowance(best, a.shape) + FLOOR_TOL * float(r_rhs @ r_rhs)
-    closest = cp.Problem(cp.Minimize(distance), [*constraints, fit_term <= bound])
+    # |(R theta - r, sqrt(lam) D (theta - theta0))| <= sqrt(bound): the same set as f <= bound,
+    # better scaled for the solver than the squared form
+    residual = r_mat @ theta - r_rhs
+    if fit.lam > 0:
+        residual = cp.hstack([residual, np.sqrt(fit.lam) * cp.multiply(scale, theta - theta0)])
+    closest = cp.Problem(cp.Minimize(cp.norm(offset)), [*constraints, cp.norm(residual) <= np.sqrt(bound)])
     try:
         closest.solve(solver=cp.CLARABEL)
     except cp.error.SolverError:
@@ -152,6 +158,9 @@ def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray,
     out = np.asarray(p.value, dtype=float)
     for j in range(n):
         _project_link(out, j)
+        # Ia, Fv, Fcp, Fcn >= 0 hold to the solver's tolerance (-1e-12): exactly, after the clip
+        drive = slice(PER_JOINT * j + 10, PER_JOINT * j + 14)
+        out[drive] = np.maximum(out[drive], 0.0)
         _check_link(out, j, robot)
     return out
 
