@@ -13,6 +13,7 @@ description's base parameters) over the full standard vector ``p`` (15 n)::
 
     f(p) = |A (K p) - b|^2 + lam |D (K p - theta0)|^2
     stage 1:  f* = min f(p) (+ 1e-12 of the data scale times stage 2's distance)  s.t. C
+              (1e-10, then 1e-8, where Clarabel fails)
     stage 2:  min |S^-1 (p - p_nom)|^2  s.t. C,  f(p) <= f* (1 + nb / (m - nb)) + FLOOR_TOL |b|^2
     C:  J_j(p) >= eps 1 (every link),  Ia_j, Fv_j, Fcp_j, Fcn_j >= 0,  optional bounds
 
@@ -52,9 +53,11 @@ __all__ = ["EPS", "consistent_standard", "pseudo_inertia"]
 
 #: Margin inside the pseudo-inertia cone, kg m^2 (Sigma block) and kg (mass).
 EPS = 1e-7
-#: Weight of the distance to the description in stage 1, relative to the data's mean squared
-#: singular value (the program before 2026-12-06 used 1e-8 there, and no stage 2).
-UNIQUE = 1e-12
+#: Weights of the distance to the description in stage 1, relative to the data's mean squared
+#: singular value, tried in turn while Clarabel fails (its interior point can stall on a nearly
+#: flat face: one test's problem failed at 1e-12 with the kernels' block width 1 and solved with
+#: the default width); the program before 2026-12-06 used 1e-8, and no stage 2.
+UNIQUE = (1e-12, 1e-10, 1e-8)
 #: Stage 2's allowance relative to the target's squared norm, for data fitted exactly (solver
 #: accuracy; the statistical allowance is then zero).
 FLOOR_TOL = 1e-14
@@ -136,8 +139,14 @@ def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray,
     # stage 1: the estimate's fit over the cone (the distance at UNIQUE only makes the optimum
     # unique: parameters that no column sees would leave an unbounded optimal face)
     data = float(np.sum(s**2)) / max(s.size, 1)
-    stage1 = cp.Problem(cp.Minimize(fit_term + UNIQUE * data * cp.sum_squares(offset)), constraints)
-    _solve(cp, stage1, bounds)
+    for i, weight in enumerate(UNIQUE):
+        try:
+            _solve(cp, cp.Problem(cp.Minimize(fit_term + weight * data * cp.sum_squares(offset)),
+                                  constraints), bounds)
+            break
+        except _SolverFailed:
+            if i == len(UNIQUE) - 1:
+                raise
     first = np.asarray(p.value, dtype=float)
     # stage 2: among the consistent sets that the data cannot tell from the best (within the
     # base parameters' confidence region), the one closest to the description
@@ -182,20 +191,24 @@ def _constraints(cp, p, n: int, names: tuple[str, ...],
     return constraints
 
 
+class _SolverFailed(IdentificationError):
+    """Clarabel stopped without a solution (not an infeasible problem)."""
+
+
 def _solve(cp, problem, bounds: Mapping[str, tuple[float, float]] | None) -> None:
     """Solve ``problem`` with Clarabel; IdentificationError unless it ends optimal."""
     try:
         problem.solve(solver=cp.CLARABEL)
     except cp.error.SolverError as exc:
-        raise IdentificationError(f"method='consistent': the semidefinite program failed in "
-                                  f"Clarabel: {exc}") from exc
+        raise _SolverFailed(f"method='consistent': the semidefinite program failed in "
+                            f"Clarabel: {exc}") from exc
     if problem.status in ("infeasible", "infeasible_inaccurate"):
         raise IdentificationError(
             "method='consistent': the semidefinite program is infeasible: no physically "
             "consistent parameters (pseudo-inertia >= 0, rotor inertia and friction >= 0)"
             + (f" satisfy the bounds {dict(bounds)}" if bounds else ""))
     if problem.status not in ("optimal", "optimal_inaccurate") or problem.variables()[0].value is None:
-        raise IdentificationError(f"method='consistent': the semidefinite program ended with "
+        raise _SolverFailed(f"method='consistent': the semidefinite program ended with "
                                   f"status {problem.status!r}")
 
 
