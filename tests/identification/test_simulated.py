@@ -254,3 +254,32 @@ def test_consistent_program_keeps_the_data_base_parameters_when_the_truth_is_ins
     true = ident.relations.to_base(plant)
     scale = np.abs(true).max()
     np.testing.assert_allclose(ident.base_parameters.values, true, rtol=0, atol=1e-6 * scale)
+
+
+@pytest.mark.parametrize("failing_call", [1, 2])
+def test_consistent_program_goes_on_where_the_solver_fails(monkeypatch, failing_call):
+    """Clarabel failing in stage 1 (call 1: the program is tried again with a larger uniqueness
+    weight) or in stage 2 (call 2: stage 1's set is kept) still gives a consistent estimate whose
+    base parameters are those of the undisturbed run to within their standard deviations."""
+    import cvxpy as cp
+
+    robot = load_quiet("planar_2r")
+    model = rd.compile_model(robot)
+    rec, _ = simulated(model, seconds=6.0, dt=0.02, seed=5, noise=0.05)
+    reference = rd.identify(robot, rec, method="consistent", cutoff=None, regularization=None, model=model)
+    calls = []
+    solve = cp.Problem.solve
+
+    def failing(self, *args, **kwargs):
+        calls.append(len(calls) + 1)
+        if len(calls) == failing_call:
+            raise cp.error.SolverError("stalled (test)")
+        return solve(self, *args, **kwargs)
+
+    monkeypatch.setattr(cp.Problem, "solve", failing)
+    ident = rd.identify(robot, rec, method="consistent", cutoff=None, regularization=None, model=model)
+    assert len(calls) == (3 if failing_call == 1 else 2)
+    for j in range(robot.dof):
+        assert np.linalg.eigvalsh(pseudo_inertia(ident.standard, j)).min() > 0
+    np.testing.assert_array_less(np.abs(ident.base_parameters.values - reference.base_parameters.values),
+                                 reference.base_parameters.std + 1e-12)
