@@ -148,22 +148,15 @@ def consistent_standard(robot: Robot, relations: BaseRelations, phi: np.ndarray,
             if i == len(UNIQUE) - 1:
                 raise
     first = np.asarray(p.value, dtype=float)
+    best = float(fit_term.value)  # f* = f(first)
     # stage 2: among the consistent sets that the data cannot tell from the best (within the
     # base parameters' confidence region), the one closest to the description
-    best = _fit_value(first, k, r_mat, r_rhs, fit.lam, scale, theta0)
     bound = best + _allowance(best, a.shape) + FLOOR_TOL * float(r_rhs @ r_rhs)
-    # |(R theta - r, sqrt(lam) D (theta - theta0))| <= sqrt(bound): the same set as f <= bound,
-    # better scaled for the solver than the squared form
     residual = r_mat @ theta - r_rhs
     if fit.lam > 0:
         residual = cp.hstack([residual, np.sqrt(fit.lam) * cp.multiply(scale, theta - theta0)])
-    closest = cp.Problem(cp.Minimize(cp.norm(offset)), [*constraints, cp.norm(residual) <= np.sqrt(bound)])
-    try:
-        closest.solve(solver=cp.CLARABEL)
-    except cp.error.SolverError:
+    if not _closest(cp, offset, residual, bound, constraints):
         p.value = first  # the stage-1 set stands (consistent, best fit; not the closest)
-    if closest.status not in ("optimal", "optimal_inaccurate") or p.value is None:
-        p.value = first
     out = np.asarray(p.value, dtype=float)
     for j in range(n):
         _project_link(out, j)
@@ -209,7 +202,7 @@ def _solve(cp, problem, bounds: Mapping[str, tuple[float, float]] | None) -> Non
             + (f" satisfy the bounds {dict(bounds)}" if bounds else ""))
     if problem.status not in ("optimal", "optimal_inaccurate") or problem.variables()[0].value is None:
         raise _SolverFailed(f"method='consistent': the semidefinite program ended with "
-                                  f"status {problem.status!r}")
+                            f"status {problem.status!r}")
 
 
 def _allowance(best: float, shape: tuple[int, int]) -> float:
@@ -224,12 +217,16 @@ def _allowance(best: float, shape: tuple[int, int]) -> float:
     return b * best / max(m - b, 1)
 
 
-def _fit_value(p: np.ndarray, k: np.ndarray, r_mat: np.ndarray, r_rhs: np.ndarray, lam: float,
-               scale: np.ndarray, theta0: np.ndarray) -> float:
-    """Stage 1's objective at the standard set ``p`` (15 n,)."""
-    theta = k @ p
-    # |R theta - r|^2 + lam |D (theta - theta0)|^2
-    return float(np.sum((r_mat @ theta - r_rhs) ** 2) + lam * np.sum((scale * (theta - theta0)) ** 2))
+def _closest(cp, offset, residual, bound: float, constraints: list) -> bool:
+    """Stage 2: minimise ``|offset|`` subject to ``constraints`` and ``|residual| <= sqrt(bound)``
+    (the same set as ``f <= bound``, better scaled for the solver than the squared form);
+    False where Clarabel fails (the variable's value is then not this program's)."""
+    closest = cp.Problem(cp.Minimize(cp.norm(offset)), [*constraints, cp.norm(residual) <= np.sqrt(bound)])
+    try:
+        closest.solve(solver=cp.CLARABEL)
+    except cp.error.SolverError:
+        return False
+    return closest.status in ("optimal", "optimal_inaccurate") and closest.variables()[0].value is not None
 
 
 def _project_link(p: np.ndarray, j: int) -> None:
