@@ -114,7 +114,8 @@ class Choices:
         Whether ``ripple="auto"`` kept the position ripple (:mod:`robodyn.identification.ripple`),
         else None.
     ripple_scores : tuple of (str, float)
-        Relative held-out error of the model's residual without and with the ripple.
+        Relative held-out error of the model's residual without and with the ripple; empty
+        where no joint's travel separates a ripple from a constant.
     prediction_cutoff : float or None
         The cut-off of the states ``ident.predict`` uses, chosen by ``prediction_cutoff="auto"``
         (:mod:`robodyn.identification.bandwidth`), Hz; else None.
@@ -164,7 +165,10 @@ class Choices:
                  + (", thermal friction" if self.thermal else "") + f": {self.reason}"]
         if self.friction is not None:
             lines.append(f"  friction law {self.friction} ({self.friction_reason})")
-        if self.ripple is not None:
+        if self.ripple is not None and not self.ripple_scores:
+            lines.append("  position ripple not kept (no joint travels far enough in the fit data "
+                         "to tell a once-per-turn term from a constant)")
+        elif self.ripple is not None:
             scores = ", ".join(f"{k} {v:.4f}" for k, v in self.ripple_scores)
             lines.append(f"  position ripple {'kept' if self.ripple else 'not kept'} (held-out "
                          f"blocks of the model's residual: {scores})")
