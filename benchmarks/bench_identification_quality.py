@@ -117,9 +117,10 @@ METHODS: Sequence[tuple[str, dict, str]] = (
      "weight, velocity source, cut-off, friction law (linear or Stribeck), position ripple and "
      "drive modes (one second-order mode per joint) chosen by held-out time blocks of the fit "
      "data, and the predictions' Coulomb step smoothed over the fit data's velocity noise (over "
-     "at least 1e-3 rad/s where a joint is held); gross one-sample glitches of the fit data "
-     "dropped (spikes='auto'); a held-out recording that moves faster than the fit data "
-     "predicted at its own motion band (prediction_cutoff='motion', since 2026-12-06)"),
+     "at least 1e-3 rad/s where a joint is held); gross glitches (one-sample spikes, bursts "
+     "of 3-5 rows) of the fit data dropped (spikes='auto'); a held-out recording that moves "
+     "faster than the fit data predicted at its own motion band (prediction_cutoff='motion', "
+     "since 2026-12-06)"),
     ("no Coulomb smoothing", {"coulomb_width": 0.0},
      "the default with the Coulomb step kept in predictions (coulomb_width=0): the default of "
      "the previous version"),

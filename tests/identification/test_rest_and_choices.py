@@ -424,7 +424,7 @@ def test_a_few_corrupt_rows_are_dropped_as_spikes(puma):
     assert not spike_rows(t, fit.q, noisy_tau).any()  # clean data: nothing
     assert held_out(q, tau) < 1.02 * clean
     assert set(np.flatnonzero(spike_rows(t, q, tau, threshold=GROSS_THRESHOLD))) == set(rows)
-    with pytest.warns(RecordingWarning, match=r"5 row\(s\) dropped as one-sample glitches"):
+    with pytest.warns(RecordingWarning, match=r"5 row\(s\) dropped as glitches"):
         assert held_out(q, tau, "auto") < 1.02 * clean
 
 

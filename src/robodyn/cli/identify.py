@@ -490,8 +490,9 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
                         "step; 0: none; auto: per joint, from the noise of the identification "
                         "data's processed velocity (default: %(default)s)")
     p.add_argument("--spikes", choices=SPIKES, default="auto",
-                   help="one-sample glitches (a position or target sample far off the line "
-                        "through its neighbours) in the identification recordings: keep them, "
+                   help="glitches (a position or target sample far off the line through its "
+                        "neighbours, or a burst of up to 5 such rows) in the identification "
+                        "recordings: keep them, "
                         "drop those rows before the fit (beyond 12 robust standard deviations), "
                         "or auto: drop gross glitches only (beyond 100), with a warning "
                         "(default: %(default)s)")

@@ -160,7 +160,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         IdentificationError)
     recs, target, pays = checked_inputs(robot, recordings, target, opts.sensor, payloads)
     check_prediction_cutoff(recs, opts.prediction_cutoff)
-    recs = without_spikes(recs, target, opts.spikes)  # one-sample glitches of the fit's recordings
+    recs = without_spikes(recs, target, opts.spikes)  # glitches of the fit's recordings (spikes, bursts)
     model = model if model is not None else compile_model(robot)
     measured = all(r.qd is not None and "qd" not in getattr(r, "estimated", frozenset()) for r in recs)
     temps = all(getattr(r, "temperature", None) is not None for r in recs)
