@@ -42,6 +42,11 @@ def _readonly(a: np.ndarray) -> np.ndarray:
 #: Largest joint position a recording may hold, rad or m (10^6 rad is 160,000 turns).
 MAX_POSITION = 1e6
 
+#: Median sample period (s) above which a recording's stamps are probably not seconds (a joint
+#: logger samples at 10 Hz or faster; 10 ms stamps read as seconds give a period of 10 s):
+#: a warning, not an error (a slow log of a slow motion is possible).
+SLOW_PERIOD = 1.0
+
 #: Per field: the largest magnitude a recording may hold and what the field is. Far beyond any
 #: arm (10^5 rad/s is a million rpm at the joint; 10^8 N m, 10^6 A): one corrupt cell would
 #: otherwise set every scale of the run (a filter's overflow, a duration of 1e304 s).
@@ -224,6 +229,11 @@ class Recording:
         object.__setattr__(self, "tool_points", _readonly(pts))
 
     def _estimate(self) -> None:
+        if self.dt > SLOW_PERIOD:
+            warnings.warn(f"{self._where('t')}: median period {self.dt:.6g} s ({1 / self.dt:.3g} "
+                          "samples per second); robodyn's stamps are seconds: if these are "
+                          "milliseconds, microseconds or nanoseconds, divide them by 1e3, 1e6 or "
+                          "1e9 first", RecordingWarning, stacklevel=4)
         gaps = self.gaps
         if gaps:
             k, dt = gaps[0]
