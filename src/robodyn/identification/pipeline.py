@@ -34,6 +34,7 @@ from robodyn.identification.completion import consistent_completion
 from robodyn.identification.drive_gains import estimate_drive_gains
 from robodyn.identification.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identification.friction import without_friction
+from robodyn.identification.hydro_load import HydroLoad, hydro_load, without_hydro
 from robodyn.identification.inputs import check_recording, checked_inputs
 from robodyn.identification.options import IdentifyOptions
 from robodyn.identification.payload import Payload, payload_standard, payload_torque
@@ -162,12 +163,13 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     check_prediction_cutoff(recs, opts.prediction_cutoff)
     recs = without_spikes(recs, target, opts.spikes)  # glitches of the fit's recordings (spikes, bursts)
     model = model if model is not None else compile_model(robot)
+    hydro = hydro_load(robot, model, target)  # None for a dry robot
     measured = all(r.qd is not None and "qd" not in getattr(r, "estimated", frozenset()) for r in recs)
     temps = all(getattr(r, "temperature", None) is not None for r in recs)
 
     def stacked(c: Candidate) -> Problem:
         data = _prepared(robot, recs, target, opts.friction, c.cutoff, opts.decimate, c.velocity,
-                         c.dead_band, model, c.thermal, opts.sensor, rule, shared)
+                         c.dead_band, model, c.thermal, opts.sensor, rule, shared, hydro)
         drive, prior, loads = _gains_and_prior(robot, data, pays, target, opts.gains, opts.friction,
                                                opts.sensor)
         cols = data.relations.independent
@@ -180,8 +182,10 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         theta0 = np.concatenate([data.relations.to_base(prior), np.zeros(phi.shape[1] - cols.size)])
         d = data.settings.decimate
         # the common held-out target at the same samples, torque units, payload torque taken off
-        held = np.concatenate([(ref[::d] * drive.k - load).reshape(-1)
-                               for ref, load in zip(reference, loads, strict=True)])
+        wet = data.hydro or [0.0] * len(loads)  # the fluid's share (target units)
+        held = np.concatenate([((ref[::d] - h[::d] if data.hydro else ref[::d]) * drive.k
+                                - load).reshape(-1)
+                               for ref, h, load in zip(reference, wet, loads, strict=True)])
         return Problem(phi, y, theta0, joint, blocks,
                        np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), held,
                        (data, drive, prior, loads))
@@ -208,7 +212,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
               if len(scored) > 1 else "as given")
     result = replace(result, choices=Choices(best.velocity, best.dead_band, data.settings.cutoff,
                                              step.fit.lam, tuple(scored), reason, best.thermal, best),
-                     thermal_fit=thermal_fit)
+                     thermal_fit=thermal_fit, hydro=hydro)
     return with_prediction_terms(result, recs, pays, target, opts, data.samples, data.y_full,
                                  data.full, data.settings)
 
@@ -235,6 +239,9 @@ class _Prepared:
         The thermal friction columns (``thermal=True``).
     full : list of Samples
         The processed samples before decimation (N_k, n).
+    hydro : list of ndarray or None
+        The filtered hydrodynamic target taken off each recording's ``full`` target (N_k, n),
+        target units (:mod:`robodyn.identification.hydro_load`); None for a dry robot.
     """
 
     settings: Preprocess
@@ -245,6 +252,7 @@ class _Prepared:
     count: int
     thermal: ThermalData | None = None
     full: list[Samples] | None = None
+    hydro: list[np.ndarray] | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -297,7 +305,7 @@ class _LinearStep:
 def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff: float | str | None,
               decimate: int | str, velocity: str, dead_band: float, model: Model,
               thermal: bool = False, sensor: str = "motor", rule: float | None = None,
-              shared: SharedRows | None = None) -> _Prepared:
+              shared: SharedRows | None = None, hydro: HydroLoad | None = None) -> _Prepared:
     """Preprocessed samples, filtered regressors and base relations of ``recs`` (steps 2 and 3).
 
     ``rule``: the recordings' "auto" cut-off when already computed (Hz); ``shared``: the
@@ -307,6 +315,9 @@ def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff:
     """
     settings = resolve_preprocess(recs, cutoff, decimate, velocity, dead_band=dead_band, auto=rule)
     full, y_full = (shared or SharedRows(model)).get(recs, settings, target)
+    taken = None
+    if hydro is not None:  # the fluid's torque, from the description, off the target
+        full, taken = without_hydro(hydro, full, settings)
     samples = [_decimated(s, settings) for s in full]
     rotor = np.arange(robot.dof) * PER_JOINT + len(INERTIAL_NAMES)
     relations = base_relations(model, at_rest=_at_rest(samples, settings.dead_band),
@@ -321,7 +332,7 @@ def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff:
             f"= {count * robot.dof} equations after decimation by {settings.decimate} for {b} base "
             f"parameters (at least {2 * b} needed; record longer or pass decimate=1)")
     return _Prepared(settings, model, relations, samples, y_full, count,
-                     thermal_data(recs, full, settings) if thermal else None, full)
+                     thermal_data(recs, full, settings) if thermal else None, full, taken)
 
 
 def _cutoff_candidates(recs: list[Any], cutoff: float | str | None,

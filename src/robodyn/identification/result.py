@@ -167,6 +167,10 @@ class Identification:
         One lightly damped mode per joint (:mod:`robodyn.identification.resonance`):
         :meth:`predict` evaluates the model on states at the mode's band and adds what the modes
         add to it; ``robot`` does not carry them.
+    hydro : HydroLoad or None
+        An underwater arm's hydrodynamic torque from its description
+        (:mod:`robodyn.identification.hydro_load`): taken off the target before the fit;
+        :meth:`effort` adds it; ``robot`` keeps the hydrodynamic blocks.
     """
 
     robot: Robot
@@ -194,6 +198,7 @@ class Identification:
     prediction: Preprocess | None = None
     resonance_fit: ResonanceFit | None = None
     coulomb_width: float | np.ndarray = 0.0
+    hydro: Any = None
 
     @property
     def gains_identified(self) -> bool:
@@ -320,4 +325,6 @@ class Identification:
             from robodyn.identification.payload import payload_torque
 
             tau = tau + payload_torque(y, payload)
+        if self.hydro is not None:  # the fluid's share, from the description (target units)
+            return tau / self.gains[None, :] + self.hydro.target(s.q, s.qd, s.qdd)
         return tau / self.gains[None, :]

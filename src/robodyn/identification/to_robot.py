@@ -6,12 +6,16 @@ the centre of mass ``I_c = I_O - M (|c|^2 1 - c c^T)`` (parallel axis theorem, `
 rotor inertia ``Ia / G^2`` on the motor side (the drive's gear ratio ``G`` is kept; ``G = 1`` when
 the description has none); friction ``(Fv, Fcp, Fcn, Fo)``. Drive gains identified from current
 become ``torque_constant = K / G`` so that ``G * torque_constant = K``. Geometry, limits and names
-are the nominal robot's; the named parameters are dropped (the new values are numbers).
+are the nominal robot's; the named parameters are dropped (the new values are numbers). The
+links' hydrodynamic blocks and the fluid are kept, their named parameters replaced by the
+nominal values (an underwater arm's identification takes the description's hydrodynamic torque
+as known: :mod:`robodyn.identification.hydro_load`).
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import fields, is_dataclass, replace
+from typing import Any
 
 import numpy as np
 import sympy as sp
@@ -28,6 +32,19 @@ def _f(x: float) -> sp.Expr:
 
 def _num(value: sp.Expr | None, subs: dict) -> sp.Expr | None:
     return None if value is None else sp.sympify(value).xreplace(subs)
+
+
+def _numeric(value: Any, subs: dict) -> Any:
+    """``value`` (a hydrodynamic block, a fluid, or a part of one) with ``subs`` substituted
+    into every SymPy expression it holds."""
+    if isinstance(value, sp.Basic):
+        return value.xreplace(subs)
+    if isinstance(value, tuple):
+        return tuple(_numeric(v, subs) for v in value)
+    if is_dataclass(value) and not isinstance(value, type):
+        return replace(value, **{f.name: _numeric(getattr(value, f.name), subs)
+                                 for f in fields(value) if f.init})
+    return value
 
 
 def robot_with_parameters(nominal: Robot, standard: np.ndarray, gains: np.ndarray | None = None, *,
@@ -59,7 +76,8 @@ def robot_with_parameters(nominal: Robot, standard: np.ndarray, gains: np.ndarra
         # I_c = I_O - m (|c|^2 1 - c c^T)
         i_c = i_o - m * (float(c @ c) * np.eye(3) - np.outer(c, c))
         links.append(replace(link, mass=_f(m), com=sp.ImmutableMatrix([_f(v) for v in c]),
-                             inertia=sp.ImmutableMatrix([[_f(v) for v in row] for row in i_c])))
+                             inertia=sp.ImmutableMatrix([[_f(v) for v in row] for row in i_c]),
+                             hydro=_numeric(link.hydro, subs)))
         g = float(sp.sympify(joint.drive.gear_ratio).xreplace(subs))
         g = g if g != 0 else 1.0
         drive = replace(joint.drive, gear_ratio=_f(g), rotor_inertia=_f(ia / g**2),
@@ -87,4 +105,5 @@ def robot_with_parameters(nominal: Robot, standard: np.ndarray, gains: np.ndarra
         gravity=sp.ImmutableMatrix(nominal.gravity.xreplace(subs)),
         parameters={},
         source=source or f"identified from {nominal.source}",
+        fluid=_numeric(nominal.fluid, subs),
     )
