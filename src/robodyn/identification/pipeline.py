@@ -213,7 +213,11 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     result = replace(result, choices=Choices(best.velocity, best.dead_band, data.settings.cutoff,
                                              step.fit.lam, tuple(scored), reason, best.thermal, best),
                      thermal_fit=thermal_fit, hydro=hydro)
-    return with_prediction_terms(result, recs, pays, target, opts, data.samples, data.y_full,
+    # the terms fitted after the linear step see the target without the payloads' torque too
+    # (the linear step took it off; K y - P = Y p, so y - P / K in the target's unit)
+    samples = [s if not np.any(load) else replace(s, y=s.y - load / result.gains[None, :])
+               for s, load in zip(data.samples, loads, strict=True)]
+    return with_prediction_terms(result, recs, pays, target, opts, samples, data.y_full,
                                  data.full, data.settings)
 
 
