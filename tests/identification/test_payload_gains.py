@@ -110,6 +110,27 @@ def test_the_terms_after_the_linear_step_see_the_target_without_the_payload(lab)
     assert max(v for _, v in ident.choices.friction_scores) < 1e-6
 
 
+def test_the_prior_does_not_take_a_known_payload_for_friction(lab):
+    # the per-joint friction fit of the prior (the pull of the regularisation) explains the
+    # target by the description's torque; a known payload's torque belongs to that explained
+    # part: the same motion run with and without it gives the same prior and the same fit
+    # (before, the payload's gravity went into the prior's friction, offset and rotor terms)
+    robot, model, runs, true = lab
+    loaded = true.copy()
+    loaded[PER_JOINT:PER_JOINT + 10] += payload_standard(robot, PAYLOAD)
+    tr = runs[0].truth
+    recs = [rd.Recording(t=tr.t[1:], q=tr.q[1:], qd=tr.qd[1:], qdd=tr.qdd[1:], source=f"run {k}",
+                         tau=rd.compile_model(robot_with_parameters(robot, p)).inverse_dynamics(
+                             tr.q, tr.qd, tr.qdd)[1:]) for k, p in enumerate((true, loaded))]
+    assert np.abs(recs[1].tau - recs[0].tau).max() > 0.5  # the payload's torque is not small
+    plain = rd.identify(robot, recs[0], target="tau", cutoff=None, model=model, ripple=False)
+    with_payload = rd.identify(robot, recs[1], target="tau", cutoff=None, model=model,
+                               ripple=False, payloads=[PAYLOAD])
+    a, b = plain.base_parameters, with_payload.base_parameters
+    np.testing.assert_allclose(b.nominal, a.nominal, rtol=0, atol=1e-9 * np.abs(a.nominal).max())
+    np.testing.assert_allclose(b.values, a.values, rtol=0, atol=1e-6 * np.abs(a.values).max())
+
+
 def test_without_payload_the_gains_are_absorbed_and_reported_so(lab):
     robot, model, runs, _ = lab
     gain = runs[0].truth.drive_gain

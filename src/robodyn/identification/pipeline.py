@@ -386,7 +386,8 @@ def _gains_and_prior(robot: Robot, data: _Prepared, pays: list[Payload | None], 
     loads = [np.zeros_like(s.q) if p is None else payload_torque(y, payload_standard(robot, p))
              for s, y, p in zip(data.samples, data.y_full, pays, strict=True)]
     has_payload = any(p is not None for p in pays)
-    k, k_source, prior = joint_prior(robot, data.samples, data.y_full, nominal, target, gains)
+    k, k_source, prior = joint_prior(robot, data.samples, data.y_full, nominal, target, gains,
+                                     loads)
     drive = _Drive(k, k_source, np.full(robot.dof, np.inf if k_source.startswith("absorbed") else np.nan))
     if target == "current" and has_payload:
         drive, prior = _payload_gains(robot, data, loads, drive, prior)

@@ -64,7 +64,8 @@ def _joint_columns(y: np.ndarray, j: int) -> np.ndarray:
 
 
 def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.ndarray],
-                nominal: np.ndarray, target: str, mode: str
+                nominal: np.ndarray, target: str, mode: str,
+                known: Sequence[np.ndarray] | None = None
                 ) -> tuple[np.ndarray, str, np.ndarray]:
     """Drive gains, their source and the prior standard vector (module docstring).
 
@@ -78,6 +79,9 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
     nominal : numpy.ndarray, shape (15 n,)
     target : {"tau", "current"}
     mode : {"auto", "description", "absorbed"}
+    known : sequence of numpy.ndarray, shape (N_k, n), optional
+        Known torque in each recording's target, N m (a payload's): added to the nominal
+        rigid-body torque, so that the per-joint fit does not take it for friction.
 
     Returns
     -------
@@ -107,10 +111,13 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
     gains = np.ones(n) if fixed is None else fixed.copy()
     prior = rigid.copy()
     failed = []
-    flip = current_directions(samples, y_full, nominal) if target == "current" else np.ones(n)
+    flip = current_directions(samples, y_full, nominal, known) if target == "current" else np.ones(n)
+
+    extra = [np.zeros((len(s.y), n)) for s in samples] if known is None else known
 
     def fit(j: int, gain: float | None) -> bool:
-        tau_nom = np.concatenate([y[:, j, :] @ rigid for y in y_full])
+        # the torque the description and the known loads explain: Y p_rigid + tau_known
+        tau_nom = np.concatenate([y[:, j, :] @ rigid + e[:, j] for y, e in zip(y_full, extra, strict=True)])
         cols = np.vstack([_joint_columns(y, j) for y in y_full])
         b = np.concatenate([s.y[:, j] for s in samples]) * flip[j]  # current in the torque's sense
         a = np.column_stack([tau_nom, cols]) if gain is None else cols
@@ -154,18 +161,20 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
     return gains * flip, source, prior
 
 
-def current_directions(samples: Sequence[Samples], y_full: Sequence[np.ndarray], nominal: np.ndarray
-                       ) -> np.ndarray:
+def current_directions(samples: Sequence[Samples], y_full: Sequence[np.ndarray], nominal: np.ndarray,
+                       known: Sequence[np.ndarray] | None = None) -> np.ndarray:
     """Sense (n,) of each joint's current relative to its torque: -1 where the current is
     strongly anti-correlated with the description's joint torque ``Y p_nominal`` (rigid body,
     rotor inertia and friction; correlation below
     ``-REVERSED_CORRELATION``: a motor-side current sensor on a drive turning against the
     joint, or a log's sign convention), else +1. A weak correlation (a joint whose torque the
-    description barely explains) keeps +1."""
+    description barely explains) keeps +1. ``known`` (N_k, n), N m: torque the description does
+    not hold (a payload's), added to it."""
     n = samples[0].q.shape[1]
     out = np.ones(n)
+    extra = [np.zeros((len(s.y), n)) for s in samples] if known is None else known
     for j in range(n):
-        tau = np.concatenate([y[:, j, :] @ nominal for y in y_full])
+        tau = np.concatenate([y[:, j, :] @ nominal + e[:, j] for y, e in zip(y_full, extra, strict=True)])
         cur = np.concatenate([s.y[:, j] for s in samples])
         if np.std(tau) > 0 and np.std(cur) > 0 and np.corrcoef(tau, cur)[0, 1] < -REVERSED_CORRELATION:
             out[j] = -1.0
