@@ -182,9 +182,8 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         theta0 = np.concatenate([data.relations.to_base(prior), np.zeros(phi.shape[1] - cols.size)])
         d = data.settings.decimate
         # the common held-out target at the same samples, torque units, payload torque taken off
-        wet = data.hydro or [0.0] * len(loads)  # the fluid's share (target units)
-        held = np.concatenate([((ref[::d] - h[::d] if data.hydro else ref[::d]) * drive.k
-                                - load).reshape(-1)
+        wet = data.hydro or [np.zeros_like(ref) for ref in reference]  # the fluid's share (target units)
+        held = np.concatenate([((ref[::d] - h[::d]) * drive.k - load).reshape(-1)
                                for ref, h, load in zip(reference, wet, loads, strict=True)])
         return Problem(phi, y, theta0, joint, blocks,
                        np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), held,
