@@ -25,6 +25,7 @@ from collections.abc import Sequence
 
 import robodyn as rd
 from robodyn.cli import cache, equations, excite, identify, record, sweep, underwater, workflows
+from robodyn.cli.args import lock
 from robodyn.robot.errors import RobodynError
 from robodyn.text import err as _err
 
@@ -70,6 +71,12 @@ def _parser() -> argparse.ArgumentParser:
             help="URDF only: the link whose frame is the end effector, e.g. tool0 or flange "
                  "(default: the end of the fixed joints after the last moving joint, or the "
                  "last moving link when they branch)")
+        sub.choices[command].add_argument(
+            "--lock", metavar="JOINT=VALUE", type=lock, action="append",
+            help="URDF only, repeatable: hold a moving joint still at this position (rad, or m "
+                 "for a prismatic joint) and treat it as fixed, e.g. a gripper's fingers "
+                 "(--lock finger_joint1=0.04; a <mimic> joint follows the joint it mimics); the "
+                 "robot's joints, and the recordings' columns, are the others")
     for each in (parser, *sub.choices.values()):
         each.description = textwrap.fill(each.description or "", width=88)
     return parser

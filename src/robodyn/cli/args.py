@@ -10,9 +10,10 @@ import argparse
 
 import numpy as np
 
+from robodyn.robot.errors import InputError
 from robodyn.text import err
 
-__all__ = ["BACKENDS", "BACKEND_HELP", "ROBOT_HELP", "floats", "resolve_backend"]
+__all__ = ["BACKENDS", "BACKEND_HELP", "ROBOT_HELP", "floats", "lock", "locked_joints", "resolve_backend"]
 
 #: Help of every command's ROBOT argument.
 ROBOT_HELP = "built-in robot name (see 'robodyn list') or path to a .yaml/.yml/.urdf description"
@@ -32,6 +33,30 @@ def floats(text: str) -> np.ndarray:
         return np.array([float(v) for v in text.replace(" ", "").split(",") if v], dtype=float)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
+
+
+def lock(text: str) -> tuple[str, float]:
+    """``JOINT=VALUE`` (a joint name and its position, rad or m); an argparse type."""
+    name, sep, value = text.partition("=")
+    try:
+        number = float(value)
+    except ValueError:
+        number = float("nan")
+    if not sep or not name.strip() or not np.isfinite(number):
+        raise argparse.ArgumentTypeError(f"expected JOINT=VALUE (a joint name and a position in "
+                                         f"rad or m, e.g. finger_joint1=0.04), got {text!r}")
+    return name.strip(), number
+
+
+def locked_joints(args: argparse.Namespace) -> dict[str, float] | None:
+    """The ``--lock`` options as ``rd.load``'s ``locked`` (None when none is given)."""
+    pairs = getattr(args, "lock", None) or []
+    out: dict[str, float] = {}
+    for name, value in pairs:
+        if name in out and out[name] != value:
+            raise InputError(f"--lock: joint {name!r} given twice ({out[name]:g} and {value:g})")
+        out[name] = value
+    return out or None
 
 
 #: ``--backend`` choices of the commands that compile a model; "auto": C when a compiler is found.

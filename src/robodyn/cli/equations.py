@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import robodyn as rd
 from robodyn.cli.args import ROBOT_HELP as _ROBOT_HELP
-from robodyn.cli.args import positive_int
+from robodyn.cli.args import locked_joints, positive_int
 from robodyn.text import err as _err
 from robodyn.text import progress as _progress
 from robodyn.text import steps as _steps
@@ -67,7 +67,7 @@ def _transform(mat: sp.MatrixBase) -> str:
 
 def _load(args: argparse.Namespace) -> rd.Robot:
     """The ROBOT argument, its tool frame at the ``--tool`` link of a URDF file when given."""
-    return rd.load(args.robot, tool=args.tool)
+    return rd.load(args.robot, tool=args.tool, locked=locked_joints(args))
 
 
 def _write(text: str, target: str | None) -> None:

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 import robodyn as rd
-from robodyn.cli.args import ROBOT_HELP, floats
+from robodyn.cli.args import ROBOT_HELP, floats, locked_joints
 from robodyn.output_names import check_stem
 from robodyn.robot.errors import InputError
 from robodyn.text import err, progress
@@ -114,7 +114,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
     from robodyn.report.identification_report import identification_html
     from robodyn.robot.yaml_writer import dump_yaml
 
-    robot = rd.load(args.robot, tool=args.tool)
+    robot = rd.load(args.robot, tool=args.tool, locked=locked_joints(args))
     stem = check_stem(f"{robot.name}_identified", what="robot name")  # data, never a path
     gains = _gains(args.gains, robot.dof)
     if gains is not None:
@@ -321,7 +321,7 @@ def _check_loadable(path: Path) -> int:
 def _cmd_validate(args: argparse.Namespace) -> int:
     from robodyn.report.identification_report import validation_html
 
-    robot = rd.load(args.robot, tool=args.tool)
+    robot = rd.load(args.robot, tool=args.tool, locked=locked_joints(args))
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
     recs = _read(args.data, args.spec, robot, "data")

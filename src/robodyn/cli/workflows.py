@@ -16,7 +16,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 import robodyn as rd
-from robodyn.cli.args import BACKEND_HELP, BACKENDS, ROBOT_HELP, floats, resolve_backend
+from robodyn.cli.args import BACKEND_HELP, BACKENDS, ROBOT_HELP, floats, locked_joints, resolve_backend
 from robodyn.output_names import check_stem, output_path
 from robodyn.robot.errors import InputError
 from robodyn.text import err, progress, table
@@ -106,7 +106,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     from robodyn.measure.recording import Recording
     from robodyn.studies.simulation_plots import trajectory_figure
 
-    robot = rd.load(args.robot, tool=args.tool)
+    robot = rd.load(args.robot, tool=args.tool, locked=locked_joints(args))
     n = robot.dof
     csv_path = output_path(args.output, robot.name, "_simulation.csv", what="robot name")
     q0 = _vector(args.q0, n, "--q0")
@@ -197,7 +197,7 @@ def calibration_inputs(args: argparse.Namespace) -> CalibrationInputs:
     from robodyn.calibration.io import read_calibration_csv, read_joint_map
     from robodyn.robot.numbers_cache import load_numbers
 
-    robot = load_numbers(args.robot, tool=args.tool)
+    robot = load_numbers(args.robot, tool=args.tool, locked=locked_joints(args))
     stem = check_stem(args.stem) if args.stem is not None else \
         check_stem(f"{robot.name}_calibrated", what="robot name")
     jmap = read_joint_map(args.joint_map, robot) if args.joint_map else None

@@ -45,7 +45,8 @@ def builtin_names() -> list[str]:
     return sorted(f.name[:-5] for f in files if f.name.endswith(".yaml"))
 
 
-def load(source: str | Path, *, strict: bool = False, tool: str | None = None) -> Robot:
+def load(source: str | Path, *, strict: bool = False, tool: str | None = None,
+         locked: Mapping[str, float] | None = None) -> Robot:
     """Load a robot description.
 
     Parameters
@@ -61,6 +62,10 @@ def load(source: str | Path, *, strict: bool = False, tool: str | None = None) -
         URDF only: the link whose frame is the end effector (``Robot.tool``, the pose
         ``model.forward_kinematics`` returns), e.g. ``"tool0"``; see
         :func:`robodyn.robot.urdf.load_urdf` for the default.
+    locked : mapping of str to float, optional
+        URDF only: moving joints held still at these positions (rad, or m for a prismatic
+        joint) and treated as fixed, e.g. ``{"finger_joint1": 0.04}`` for a gripper's fingers
+        (a ``<mimic>`` joint follows the joint it mimics): the robot's joints are the others.
 
     Returns
     -------
@@ -70,7 +75,7 @@ def load(source: str | Path, *, strict: bool = False, tool: str | None = None) -
     ------
     DescriptionError
         The description is invalid (the message names the file, field and reason), or ``tool``
-        is given for a description that is not a URDF file.
+        or ``locked`` is given for a description that is not a URDF file.
     FileNotFoundError
         ``source`` is neither a built-in name nor an existing file.
     """
@@ -81,6 +86,11 @@ def load(source: str | Path, *, strict: bool = False, tool: str | None = None) -
         source = text = ALIASES[text]
     path = Path(source)
     suffix = path.suffix.lower()
+    if locked and (text in builtin_names() or suffix != ".urdf"):
+        raise DescriptionError(
+            f"{text}: locked= holds joints of a URDF file still; this description is not one "
+            "(remove the joints from a robodyn YAML file instead)"
+        )
     if tool is not None and (text in builtin_names() or suffix != ".urdf"):
         raise DescriptionError(
             f"{text}: tool={tool!r} selects a link of a URDF file; this description's tool "
@@ -99,7 +109,7 @@ def load(source: str | Path, *, strict: bool = False, tool: str | None = None) -
     if suffix == ".urdf":
         from robodyn.robot import urdf  # yourdfpy and trimesh: only for URDF files
 
-        return urdf.load_urdf(path, strict=strict, tool=tool)
+        return urdf.load_urdf(path, strict=strict, tool=tool, locked=locked)
     raise InputError(f"{path}: unknown description format {suffix!r} (expected .yaml, .yml or .urdf)")
 
 

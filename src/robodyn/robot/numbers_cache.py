@@ -5,7 +5,7 @@ The first load of a description (a built-in name, a YAML or URDF file) goes thro
 (:class:`~robodyn.robot.numbers.RobotNumbers`) to ``rd_robot_<hash>.json`` in robodyn's cache
 folder (:func:`robodyn.cache.cache_dir`). Later loads of the same content read that file and
 import no SymPy. The hash covers the description file's bytes, where it came from, the ``tool``
-argument, the entry format and the source of the loader itself (the ``robodyn.robot``
+and ``locked`` arguments, the entry format and the source of the loader itself (the ``robodyn.robot``
 package's modules): an edited description, another tool link or a changed loader is loaded in
 full again. The warnings the full load gave (implausible inertia, say) are stored with the numbers
 and given again on every load from the cache.
@@ -25,6 +25,7 @@ import math
 import os
 import tempfile
 import warnings
+from collections.abc import Mapping
 from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -72,16 +73,20 @@ def _description(source: str | Path) -> tuple[str, bytes] | None:
     return str(path.resolve()), path.read_bytes()
 
 
-def numbers_key(origin: str, data: bytes, tool: str | None) -> str:
-    """The cache key (24 hex digits) of a description's bytes ``data`` read from ``origin``."""
+def numbers_key(origin: str, data: bytes, tool: str | None,
+                locked: Mapping[str, float] | None = None) -> str:
+    """The cache key (24 hex digits) of a description's bytes ``data`` read from ``origin``
+    (with the load's ``tool`` and ``locked`` joints)."""
     h = hashlib.sha256()
-    for part in (str(ENTRY_FORMAT), _loader_digest(), origin, repr(tool)):
+    held = sorted((str(k), float(v)) for k, v in (locked or {}).items())
+    for part in (str(ENTRY_FORMAT), _loader_digest(), origin, repr(tool), repr(held)):
         h.update(part.encode() + b"\0")
     h.update(data)
     return h.hexdigest()[:24]
 
 
-def load_numbers(source: str | Path, *, tool: str | None = None) -> RobotNumbers:
+def load_numbers(source: str | Path, *, tool: str | None = None,
+                 locked: Mapping[str, float] | None = None) -> RobotNumbers:
     """A robot description's numbers, from robodyn's cache where its content was loaded before.
 
     Parameters
@@ -90,6 +95,8 @@ def load_numbers(source: str | Path, *, tool: str | None = None) -> RobotNumbers
         As :func:`robodyn.load`: a built-in name or a ``.yaml``/``.yml``/``.urdf`` file.
     tool : str, optional
         URDF only: the end-effector link (as :func:`robodyn.load`).
+    locked : mapping of str to float, optional
+        URDF only: joints held still (as :func:`robodyn.load`).
 
     Returns
     -------
@@ -105,13 +112,13 @@ def load_numbers(source: str | Path, *, tool: str | None = None) -> RobotNumbers
     found = _description(source)
     entry = None
     if found is not None:
-        entry = cache_dir(create=False) / f"rd_robot_{numbers_key(*found, tool)}.json"
-        numbers = _read(entry, _loader(source, tool))
+        entry = cache_dir(create=False) / f"rd_robot_{numbers_key(*found, tool, locked)}.json"
+        numbers = _read(entry, _loader(source, tool, locked))
         if numbers is not None:
             return numbers
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        robot = load(source, tool=tool)
+        robot = load(source, tool=tool, locked=locked)
     given = [(w.category.__name__, str(w.message)) for w in caught]
     _warn(given)
     numbers = robot_numbers(robot)
@@ -120,7 +127,8 @@ def load_numbers(source: str | Path, *, tool: str | None = None) -> RobotNumbers
     return dataclasses.replace(numbers, loader=lambda: robot)  # this Robot, held
 
 
-def _loader(source: str | Path, tool: str | None) -> Callable[[], Robot]:
+def _loader(source: str | Path, tool: str | None, locked: Mapping[str, float] | None
+            ) -> Callable[[], Robot]:
     """The ``Robot`` of a cache hit: loaded on the first call only (its warnings were given when
     the numbers were read, so they are not given again)."""
 
@@ -128,7 +136,7 @@ def _loader(source: str | Path, tool: str | None) -> Callable[[], Robot]:
     def robot() -> Robot:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return load(source, tool=tool)
+            return load(source, tool=tool, locked=locked)
 
     return robot
 

@@ -23,7 +23,10 @@ joint become the tool frame). Fixed side branches add their mass and inertia to 
 they are welded to; frames without ``<inertial>`` add nothing.
 
 Movable trees (two moving joints on different branches, e.g. gripper fingers), ``floating`` and
-``planar`` joints and ``<mimic>`` joints raise :class:`~robodyn.robot.errors.DescriptionError`.
+``planar`` joints and ``<mimic>`` joints raise :class:`~robodyn.robot.errors.DescriptionError`,
+unless ``locked=`` holds the extra joints still: a locked joint becomes a fixed joint at the given
+position (``origin @ motion(axis, value)``, as Pinocchio's ``buildReducedModel`` does), and a
+``<mimic>`` joint of a locked joint is locked with it at ``multiplier x value + offset``.
 A link without ``<inertial>`` has zero mass; when that leaves a moving joint that moves no
 inertia (a singular mass matrix), a :class:`~robodyn.robot.errors.DescriptionWarning` names the
 joint and the links (an error under ``strict=True``).
@@ -100,7 +103,8 @@ def number(x: float | str, *, where: str) -> sp.Expr:
     return sp.Float(v)
 
 
-def load_urdf(path: str | Path, *, strict: bool = False, tool: str | None = None) -> Robot:
+def load_urdf(path: str | Path, *, strict: bool = False, tool: str | None = None,
+              locked: Mapping[str, float] | None = None) -> Robot:
     """Load a URDF file whose moving joints form a serial chain.
 
     Parameters
@@ -116,6 +120,10 @@ def load_urdf(path: str | Path, *, strict: bool = False, tool: str | None = None
         beyond the last moving joint. By default: the end of the unbranched run of fixed joints
         after the last moving joint, or the last moving link itself when that run branches
         (e.g. ``ee_link`` and ``tool0`` both fixed to the last link).
+    locked : mapping of str to float, optional
+        Moving joints held still at the given position (rad for ``revolute`` and ``continuous``,
+        m for ``prismatic``) and treated as fixed, e.g. a gripper's fingers; the robot's joints
+        are the others. A ``<mimic>`` joint that follows a locked joint is locked with it.
 
     Returns
     -------
@@ -130,8 +138,10 @@ def load_urdf(path: str | Path, *, strict: bool = False, tool: str | None = None
         joint refers to an undefined link, the links do not form one tree (several roots, a
         loop), the moving joints do not lie on one path from the root (a branching movable
         tree), a joint is ``floating``, ``planar`` or a ``<mimic>`` joint, a moving joint has a
-        zero axis, there is no moving joint, or ``tool`` is not a link beyond the last moving
-        joint. Every message starts with the file name and names the joint or link at fault.
+        zero axis, there is no moving joint, ``tool`` is not a link beyond the last moving
+        joint, or a ``locked`` joint is not a moving joint of the file or its position is not a
+        finite number within the joint's limits. Every message starts with the file name and
+        names the joint or link at fault.
     FileNotFoundError
         If ``path`` does not exist.
 
@@ -163,15 +173,17 @@ def load_urdf(path: str | Path, *, strict: bool = False, tool: str | None = None
     joint_xml = {j.get("name"): j for j in root.findall("joint")}
     link_xml = {lk.get("name"): lk for lk in root.findall("link")}
     _check_names(model, name)
-    chain, side = _serial_chain(model, name, tool)
+    lock = _locked_positions(model, locked or {}, name)
+    chain, side = _serial_chain(model, name, tool, lock)
     bodies: dict[str, Link] = {}
     for lk in model.links:
         where = f"{name}: links.{lk.name}"
         bodies[lk.name] = _link(lk, link_xml[lk.name], where)
         validation.check_link(bodies[lk.name], where=where, strict=strict, defaults={})
     chain_links = {chain[0].parent} | {j.child for j in chain}
-    bodies = _merge_side_branches(bodies, side, chain_links, joint_xml, name)
-    elements = [_element(j, joint_xml[j.name], bodies[j.child], name) for j in chain]
+    bodies = _merge_side_branches(bodies, side, chain_links, joint_xml, name, lock)
+    elements = [_element(j, joint_xml[j.name], bodies[j.child], name, lock.get(j.name))
+                for j in chain]
     try:
         robot = assemble(model.name, elements, source=name)
     except ValueError as exc:
@@ -235,8 +247,8 @@ def _check_names(model: yourdfpy.Robot, name: str) -> None:
                 )
 
 
-def _check_joint_types(model: yourdfpy.Robot, name: str) -> None:
-    """Reject unknown, floating, planar and ``<mimic>`` joints, naming the joint."""
+def _check_joint_types(model: yourdfpy.Robot, name: str, lock: Mapping[str, sp.Expr]) -> None:
+    """Reject unknown, floating, planar and ``<mimic>`` joints (unless locked), naming the joint."""
     if not model.joints:
         raise DescriptionError(
             f"{name}: robot {model.name!r} has no joints (a serial chain needs at least one)"
@@ -252,10 +264,11 @@ def _check_joint_types(model: yourdfpy.Robot, name: str) -> None:
                 f"{name}: joint {j.name!r}: unknown joint type {j.type!r} "
                 f"(supported: {', '.join(_SUPPORTED)})"
             )
-        if j.mimic is not None:
+        if j.mimic is not None and j.name not in lock:
             raise DescriptionError(
                 f"{name}: joint {j.name!r}: <mimic> joints (coupled to joint {j.mimic.joint!r}) "
-                "are not supported yet"
+                "are not supported yet (a gripper's: hold it or the joint it mimics still, "
+                "rd.load(..., locked=...) or --lock)"
             )
 
 
@@ -306,7 +319,7 @@ def _path(link: str, parent_joint: Mapping[str, yourdfpy.Joint]) -> list[yourdfp
 
 
 def _serial_chain(
-    model: yourdfpy.Robot, name: str, tool: str | None
+    model: yourdfpy.Robot, name: str, tool: str | None, lock: Mapping[str, sp.Expr]
 ) -> tuple[list[yourdfpy.Joint], list[yourdfpy.Joint]]:
     """The joints from the root link to the tool link, and the fixed joints off that path.
 
@@ -315,9 +328,9 @@ def _serial_chain(
     lie beyond the last moving joint), else the end of the unbranched run of fixed joints after
     the last moving joint (the last moving link itself when that run branches).
     """
-    _check_joint_types(model, name)
+    _check_joint_types(model, name, lock)
     root, parent_joint, children = _tree(model, name)
-    moving = [j for j in model.joints if j.type != "fixed"]
+    moving = [j for j in model.joints if j.type != "fixed" and j.name not in lock]
     if not moving:
         raise DescriptionError(f"{name}: robot {model.name!r} has no moving joint")
     paths = {j.name: _path(j.child, parent_joint) for j in moving}
@@ -351,7 +364,8 @@ def _raise_branching(name: str, a: list[yourdfpy.Joint], b: list[yourdfpy.Joint]
         f"{name}: link {link!r} has {len(branches)} child joints "
         f"({', '.join(map(repr, branches))}) leading to the moving joints {ja.name!r} and "
         f"{jb.name!r}: branching trees are not supported, only serial chains (fixed side "
-        "branches are)"
+        "branches are; hold the extra joints still: rd.load(..., locked=...) or --lock, e.g. a "
+        "gripper's fingers)"
     )
 
 
@@ -373,16 +387,62 @@ def _tool_link(model: yourdfpy.Robot, name: str, tool: str, last: yourdfpy.Joint
     return tool
 
 
-def _fixed_transform(elem: Any, where: str) -> sp.ImmutableMatrix:
-    """The ``<origin>`` transform of a fixed joint, shape (4, 4)."""
+def _fixed_transform(elem: Any, where: str, j: yourdfpy.Joint | None = None,
+                     value: sp.Expr | None = None) -> sp.ImmutableMatrix:
+    """The transform of a fixed joint (its ``<origin>``), or of joint ``j`` locked at ``value``
+    (``origin @ motion(axis, value)``), shape (4, 4)."""
     xyz, rpy = _origin(elem.find("origin"), where)
-    pre, _, post = placement.from_origin(xyz, rpy, (0, 0, 1))
-    return sp.ImmutableMatrix(pre * post)
+    if value is None:
+        pre, _, post = placement.from_origin(xyz, rpy, (0, 0, 1))
+        return sp.ImmutableMatrix(pre * post)
+    pre, unit, post = placement.from_origin(xyz, rpy, _axis(j, where))
+    motion = S.trans(*(unit * value)) if j.type == "prismatic" else S.rot_h(S.axis_angle(unit, value))
+    return sp.ImmutableMatrix(pre * motion * post)
+
+
+def _axis(j: yourdfpy.Joint, where: str) -> list[sp.Expr]:
+    """A moving joint's ``<axis>`` (an error for the zero vector)."""
+    axis = _vector(j.axis, f"{where}: axis")
+    if all(a == 0 for a in axis):
+        raise DescriptionError(f"{where}: the axis is the zero vector")
+    return axis
+
+
+def _locked_positions(model: yourdfpy.Robot, locked: Mapping[str, float], name: str
+                      ) -> dict[str, sp.Expr]:
+    """The positions of the locked joints (the user's, and those of the ``<mimic>`` joints that
+    follow one: ``multiplier x value + offset``), checked against the file and its limits."""
+    joints = {j.name: j for j in model.joints}
+    moving = [j.name for j in model.joints if j.type != "fixed"]
+    out: dict[str, sp.Expr] = {}
+    for key, value in locked.items():
+        where = f"{name}: locked[{key!r}]"
+        if key not in joints:
+            raise DescriptionError(f"{where}: not a joint of the file (moving joints: "
+                                   f"{', '.join(map(repr, moving))})")
+        if joints[key].type == "fixed":
+            raise DescriptionError(f"{where}: the joint is already fixed")
+        if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
+            raise DescriptionError(f"{where}: the position must be a number, got {value!r}")
+        out[key] = number(value, where=where)
+    for j in model.joints:  # a mimic joint follows the joint it mimics
+        if j.mimic is not None and j.name not in out and j.mimic.joint in out:
+            mult = 1.0 if j.mimic.multiplier is None else j.mimic.multiplier
+            offset = 0.0 if j.mimic.offset is None else j.mimic.offset
+            out[j.name] = number(mult * float(out[j.mimic.joint]) + offset,
+                                 where=f"{name}: joint {j.name!r}: mimic")
+    for key, value in out.items():
+        lim, where = joints[key].limit, f"{name}: locked[{key!r}]"
+        if joints[key].type != "continuous" and lim is not None and lim.lower is not None \
+                and lim.upper is not None and not lim.lower <= float(value) <= lim.upper:
+            raise DescriptionError(f"{where}: position {float(value):g} is outside the joint's "
+                                   f"limits [{lim.lower:g}, {lim.upper:g}]")
+    return out
 
 
 def _merge_side_branches(
     bodies: dict[str, Link], side: Sequence[yourdfpy.Joint], chain_links: set[str],
-    joint_xml: Mapping[str, Any], name: str,
+    joint_xml: Mapping[str, Any], name: str, lock: Mapping[str, sp.Expr],
 ) -> dict[str, Link]:
     """Chain links with the mass of every fixed side branch welded to them (inputs unchanged).
 
@@ -398,8 +458,8 @@ def _merge_side_branches(
         stack = [(j, sp.ImmutableMatrix(sp.eye(4))) for j in by_parent.get(anchor, [])]
         while stack:
             j, t_parent = stack.pop()
-            t = sp.ImmutableMatrix(t_parent * _fixed_transform(joint_xml[j.name],
-                                                                f"{name}: joint {j.name!r}"))
+            t = sp.ImmutableMatrix(t_parent * _fixed_transform(
+                joint_xml[j.name], f"{name}: joint {j.name!r}", j, lock.get(j.name)))
             link = bodies[j.child]
             if link.mass != 0 or link.inertia != sp.zeros(3):
                 out[anchor] = combine_links(out[anchor], link, t)
@@ -447,18 +507,17 @@ def _link(lk: yourdfpy.Link, elem: Any, where: str) -> Link:
     return Link(lk.name, mass, sp.ImmutableMatrix(xyz), sp.ImmutableMatrix(i_link))
 
 
-def _element(j: yourdfpy.Joint, elem: Any, link: Link, name: str) -> ChainElement:
-    """One :class:`ChainElement` (joint + the link it carries) from a URDF joint."""
+def _element(j: yourdfpy.Joint, elem: Any, link: Link, name: str,
+             locked: sp.Expr | None = None) -> ChainElement:
+    """One :class:`ChainElement` (joint + the link it carries) from a URDF joint (a fixed one
+    where the joint is ``locked`` at that position)."""
     where = f"{name}: joint {j.name!r}"
     xyz, rpy = _origin(elem.find("origin"), where)
     source_params = dict(zip(("x", "y", "z", "roll", "pitch", "yaw"), (*xyz, *rpy), strict=True))
-    if j.type == "fixed":
-        pre, _, post = placement.from_origin(xyz, rpy, (0, 0, 1))
-        return ChainElement(j.name, "fixed", pre, _Z_AXIS, post, link)
-    axis = _vector(j.axis, f"{where}: axis")
-    if all(a == 0 for a in axis):
-        raise DescriptionError(f"{where}: the axis is the zero vector")
-    pre, unit, post = placement.from_origin(xyz, rpy, axis)
+    if j.type == "fixed" or locked is not None:
+        pre = _fixed_transform(elem, where, j, locked)
+        return ChainElement(j.name, "fixed", pre, _Z_AXIS, sp.ImmutableMatrix(sp.eye(4)), link)
+    pre, unit, post = placement.from_origin(xyz, rpy, _axis(j, where))
     fields: dict[str, Any] = {"convention": "origin", "source_params": source_params}
     fields.update(_limits(j, where))
     if j.dynamics is not None:
