@@ -27,9 +27,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
-import sympy as sp
 
 from robodyn.identification.preprocess import Preprocess, Samples, filtered_rows
+from robodyn.identification.prior import description_gains
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
@@ -81,9 +81,7 @@ def hydro_load(robot: Robot, model: Model, target: str) -> HydroLoad | None:
     dry = replace(robot, links=tuple(replace(link, hydro=None) for link in robot.links), fluid=None)
     scale = np.ones(robot.dof)
     if target == "current":
-        subs = robot.defaults()
-        k = np.array([float(sp.sympify(j.drive.gear_ratio * j.drive.torque_constant).xreplace(subs))
-                      for j in robot.joints])
+        k = description_gains(robot, signed=True)
         if np.any(k == 0) or not np.all(np.isfinite(k)):
             bad = [robot.joint_names[j] for j in np.flatnonzero((k == 0) | ~np.isfinite(k))]
             raise IdentificationError(
