@@ -5,6 +5,8 @@
 description, textbook script, robodyn's default and other methods, noise floor), which rows the
 default is at or below the textbook, issue 20's targets judged from the figures, and the speed of
 the whole identification against the textbook script on the same data.
+``RENDERERS["identification_quality_table"]`` renders the run and the table alone (the quality
+table of ``docs/identification.md``).
 
 Registered by ``render_readme.py`` (``RENDERER_MODULES``). Standard library only; nothing here
 times anything.
@@ -173,5 +175,16 @@ def render_identification_quality(data: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def render_identification_quality_table(data: dict[str, Any]) -> str:
+    """Markdown of the ``identification_quality`` entry's run and table alone (docs/identification.md
+    quotes the same run as the README, from the same file)."""
+    e = data["benchmarks"]["identification_quality"]
+    lines = rc.wrap(rc.run(data, e, "Held-out prediction error, "
+                           f"{len(e['rows'])} rows") + f" Figures: {e['error']}; each cell raw / "
+                    "filtered (one figure where they agree to three digits).")
+    return "\n".join([*lines, "", *_table(e)]) + "\n"
+
+
 RENDERERS: dict[str, Callable[[dict[str, Any]], str]] = {
-    "identification_quality": render_identification_quality}
+    "identification_quality": render_identification_quality,
+    "identification_quality_table": render_identification_quality_table}

@@ -12,7 +12,10 @@ at another file first (e.g. the one ``make bench`` just wrote on this machine); 
 changes nothing and exits 1 if the README differs from its rendering (what
 ``tests/test_readme_results.py`` asserts).
 
-Run: ``.venv/bin/python benchmarks/render_readme.py [--results PATH] [--check]``.
+The same is done for the documents in :data:`DOCUMENTS` (``docs/identification.md``'s quality
+table).
+
+Run: ``.venv/bin/python benchmarks/render_readme.py [--results PATH] [--check] [--readme FILE]``.
 Standard library only; nothing here times anything.
 """
 
@@ -32,6 +35,8 @@ import render_common as rc  # noqa: E402 - sibling module of a script folder
 
 ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "README.md"
+#: Other documents with marked sections, rendered and checked with the README.
+DOCUMENTS = (ROOT / "docs" / "identification.md",)
 MARKER = re.compile(r"<!-- results:(?P<name>[\w-]+) (?P<path>\S+) -->\n(?P<body>.*?)"
                     r"<!-- /results:(?P=name) -->", re.S)
 LIBRARIES = {"robodyn": "robodyn, no friction", "robodyn (friction)": "robodyn, PUMA friction",
@@ -386,23 +391,27 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--results", help="results file (relative to the repository) to render from")
     parser.add_argument("--check", action="store_true", help="exit 1 if README.md is not rendered")
-    parser.add_argument("--readme", type=Path, default=README)
+    parser.add_argument("--readme", type=Path, default=None,
+                        help="render this file only (default: README.md and DOCUMENTS)")
     args = parser.parse_args(argv)
     results = args.results
     if results is not None and Path(results).is_absolute():
         results = str(Path(results).resolve().relative_to(ROOT))
-    text = args.readme.read_text()
-    new = render(text, ROOT, results)
-    if args.check:
+    status = 0
+    for path in [args.readme] if args.readme is not None else [README, *DOCUMENTS]:
+        text = path.read_text()
+        new = render(text, ROOT, results)
+        if args.check:
+            if new != text:
+                print(f"{path} differs from its rendering: run benchmarks/render_readme.py")
+                status = 1
+            else:
+                print(f"{path} matches its results file(s)")
+            continue
         if new != text:
-            print(f"{args.readme} differs from its rendering: run benchmarks/render_readme.py")
-            return 1
-        print(f"{args.readme} matches its results file(s)")
-        return 0
-    if new != text:
-        args.readme.write_text(new)
-    print(f"{args.readme}: benchmark section(s) rendered")
-    return 0
+            path.write_text(new)
+        print(f"{path}: benchmark section(s) rendered")
+    return status
 
 
 if __name__ == "__main__":

@@ -60,3 +60,18 @@ def test_a_changed_figure_changes_the_rendering(renderer, readme):
 def test_rendering_needs_a_marked_section(renderer):
     with pytest.raises(ValueError, match="no <!-- results"):
         renderer.render("# README without figures\n", ROOT)
+
+
+def test_documents_quote_the_readmes_run(renderer, readme):
+    # docs/identification.md's quality table is rendered from the same results file as the
+    # README's section of the same benchmark: one run, quoted alike
+    readme_paths = {m["name"]: m["path"] for m in renderer.MARKER.finditer(readme)}
+    for path in renderer.DOCUMENTS:
+        text = path.read_text()
+        sections = list(renderer.MARKER.finditer(text))
+        assert sections, f"{path} has no marked section"
+        for m in sections:
+            assert m["path"] == readme_paths[m["name"].removesuffix("_table")]
+        assert renderer.render(text, ROOT) == text, (
+            f"{path.name}'s figures differ from the results file: run "
+            ".venv/bin/python benchmarks/render_readme.py")
