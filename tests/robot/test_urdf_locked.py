@@ -49,17 +49,37 @@ def _gripper(tmp_path: Path, mimic: bool) -> Path:
     return path
 
 
+def _rail(tmp_path: Path) -> Path:
+    """The UR5 fixture on a 20 kg car that a prismatic rail moves along its (turned) x axis."""
+    rail = ('<link name="car"><inertial><origin xyz="0.1 0 0.05"/><mass value="20"/>'
+            '<inertia ixx="1" iyy="2" izz="3" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+            '<joint name="rail" type="prismatic"><parent link="world"/><child link="car"/>'
+            '<origin xyz="0 0 0.3" rpy="0 0 0.5"/><axis xyz="1 0 0"/>'
+            '<limit lower="-2" upper="2" effort="100" velocity="1"/></joint>')
+    text = UR5.read_text()
+    on_world = '<joint name="world_joint" type="fixed">\n    <parent link="world"/>'
+    assert on_world in text
+    text = text.replace(on_world, on_world.replace('"world"', '"car"')).replace("</robot>", rail + "</robot>")
+    path = tmp_path / "rail.urdf"
+    path.write_text(text)
+    return path
+
+
 @pytest.mark.oracle("pinocchio")
-def test_locked_joints_match_pinocchios_reduced_model(tmp_path: Path) -> None:
-    path = _gripper(tmp_path, mimic=False)
-    robot = rd.load(path, locked=LOCKS, tool="tool0")
-    assert robot.joint_names == tuple(j for j in UR5_JOINTS if j != "wrist_2_joint")
+@pytest.mark.parametrize(("make", "locks", "kept"), [
+    (lambda tmp: _gripper(tmp, mimic=False), LOCKS, tuple(j for j in UR5_JOINTS if j != "wrist_2_joint")),
+    (_rail, {"rail": 0.8}, UR5_JOINTS),
+], ids=["fingers-and-wrist", "rail-before-the-arm"])
+def test_locked_joints_match_pinocchios_reduced_model(tmp_path: Path, make, locks, kept) -> None:
+    path = make(tmp_path)
+    robot = rd.load(path, locked=locks, tool="tool0")
+    assert robot.joint_names == kept
     model = rd.compile_model(robot)
     full = pin.buildModelFromUrdf(str(path))
     q_ref = pin.neutral(full)
-    for name, value in LOCKS.items():
+    for name, value in locks.items():
         q_ref[full.joints[full.getJointId(name)].idx_q] = value
-    reduced = pin.buildReducedModel(full, [full.getJointId(n) for n in LOCKS], q_ref)
+    reduced = pin.buildReducedModel(full, [full.getJointId(n) for n in locks], q_ref)
     data = reduced.createData()
     assert list(reduced.names)[1:] == list(robot.joint_names)
     rng = np.random.default_rng(5)
