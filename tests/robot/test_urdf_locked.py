@@ -109,6 +109,25 @@ def test_a_mimic_joint_follows_the_joint_it_mimics(tmp_path: Path) -> None:
     assert np.abs(m.inverse_dynamics(q, q, q) - o.inverse_dynamics(q, q, q)).max() > 1e-5
 
 
+def test_a_mimic_of_a_mimic_follows_too(tmp_path: Path) -> None:
+    # "third" mimics "right" (0.5 x), which mimics "left", and comes first in the file:
+    # left 0.01 -> right 0.03 -> third 0.015
+    right = '<mimic joint="left_joint" multiplier="-1" offset="0.04"/>'
+    text = UR5.read_text().replace("</robot>", _finger("third", '<mimic joint="right_joint" '
+                                                       'multiplier="0.5"/>') + _finger("left")
+                                   + _finger("right", right) + "</robot>")
+    (tmp_path / "chained.urdf").write_text(text)
+    plain = text.replace(right, "").replace('<mimic joint="right_joint" multiplier="0.5"/>', "")
+    (tmp_path / "plain.urdf").write_text(plain)
+    chained = rd.load(tmp_path / "chained.urdf", locked={"left_joint": 0.01})
+    by_hand = rd.load(tmp_path / "plain.urdf",
+                      locked={"left_joint": 0.01, "right_joint": 0.03, "third_joint": 0.015})
+    q = np.random.default_rng(3).uniform(-2, 2, (4, 6))
+    a, b = rd.compile_model(chained), rd.compile_model(by_hand)
+    np.testing.assert_allclose(a.inverse_dynamics(q, q, q), b.inverse_dynamics(q, q, q),
+                               rtol=1e-13, atol=1e-13)
+
+
 @pytest.mark.parametrize(("locked", "match"), [
     ({"left": 0.0}, r"locked\['left'\]: not a joint of the file \(moving joints: "
                     r"'shoulder_pan_joint'.*'right_joint'\)"),

@@ -425,8 +425,12 @@ def _locked_positions(model: yourdfpy.Robot, locked: Mapping[str, float], name: 
         if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
             raise DescriptionError(f"{where}: the position must be a number, got {value!r}")
         out[key] = number(value, where=where)
-    for j in model.joints:  # a mimic joint follows the joint it mimics
-        if j.mimic is not None and j.name not in out and j.mimic.joint in out:
+    followers = [j for j in model.joints if j.mimic is not None and j.name not in out]
+    while True:  # a mimic joint follows the joint it mimics (that may itself be a mimic joint)
+        ready = [j for j in followers if j.name not in out and j.mimic.joint in out]
+        if not ready:
+            break
+        for j in ready:
             mult = 1.0 if j.mimic.multiplier is None else j.mimic.multiplier
             offset = 0.0 if j.mimic.offset is None else j.mimic.offset
             out[j.name] = number(mult * float(out[j.mimic.joint]) + offset,
