@@ -34,7 +34,7 @@ from robodyn.identification.completion import consistent_completion
 from robodyn.identification.drive_gains import estimate_drive_gains
 from robodyn.identification.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identification.friction import without_friction
-from robodyn.identification.hydro_load import HydroLoad, hydro_load, without_hydro
+from robodyn.identification.hydro_load import HydroLoad, hydro_load, hydro_rows
 from robodyn.identification.inputs import check_recording, checked_inputs
 from robodyn.identification.options import IdentifyOptions
 from robodyn.identification.payload import Payload, payload_standard, payload_torque
@@ -163,7 +163,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     check_prediction_cutoff(recs, opts.prediction_cutoff)
     recs = without_spikes(recs, target, opts.spikes)  # glitches of the fit's recordings (spikes, bursts)
     model = model if model is not None else compile_model(robot)
-    hydro = hydro_load(robot, model, target)  # None for a dry robot
+    hydro = hydro_load(robot, model)  # None for a dry robot
     measured = all(r.qd is not None and "qd" not in getattr(r, "estimated", frozenset()) for r in recs)
     temps = all(getattr(r, "temperature", None) is not None for r in recs)
 
@@ -181,10 +181,9 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
             test = [np.concatenate([a, b], axis=2) for a, b in zip(test, th.test_rows, strict=True)]
         theta0 = np.concatenate([data.relations.to_base(prior), np.zeros(phi.shape[1] - cols.size)])
         d = data.settings.decimate
-        # the common held-out target at the same samples, torque units, payload torque taken off
-        wet = data.hydro or [np.zeros_like(ref) for ref in reference]  # the fluid's share (target units)
-        held = np.concatenate([((ref[::d] - h[::d]) * drive.k - load).reshape(-1)
-                               for ref, h, load in zip(reference, wet, loads, strict=True)])
+        # the common held-out target at the same samples, torque units, known loads taken off
+        held = np.concatenate([(ref[::d] * drive.k - load).reshape(-1)
+                               for ref, load in zip(reference, loads, strict=True)])
         return Problem(phi, y, theta0, joint, blocks,
                        np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), held,
                        (data, drive, prior, loads))
@@ -212,7 +211,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     result = replace(result, choices=Choices(best.velocity, best.dead_band, data.settings.cutoff,
                                              step.fit.lam, tuple(scored), reason, best.thermal, best),
                      thermal_fit=thermal_fit, hydro=hydro)
-    # the terms fitted after the linear step see the target without the payloads' torque too
+    # the terms fitted after the linear step see the target without the known loads too
     # (the linear step took it off; K y - P = Y p, so y - P / K in the target's unit)
     samples = [s if not np.any(load) else replace(s, y=s.y - load / result.gains[None, :])
                for s, load in zip(data.samples, loads, strict=True)]
@@ -243,8 +242,9 @@ class _Prepared:
     full : list of Samples
         The processed samples before decimation (N_k, n).
     hydro : list of ndarray or None
-        The filtered hydrodynamic target taken off each recording's ``full`` target (N_k, n),
-        target units (:mod:`robodyn.identification.hydro_load`); None for a dry robot.
+        The filtered hydrodynamic torque at each recording's ``full`` samples (N_k, n), N m, a
+        known load like a payload's (:mod:`robodyn.identification.hydro_load`); None for a dry
+        robot.
     """
 
     settings: Preprocess
@@ -318,9 +318,8 @@ def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff:
     """
     settings = resolve_preprocess(recs, cutoff, decimate, velocity, dead_band=dead_band, auto=rule)
     full, y_full = (shared or SharedRows(model)).get(recs, settings, target)
-    taken = None
-    if hydro is not None:  # the fluid's torque, from the description, off the target
-        full, taken = without_hydro(hydro, full, settings)
+    # the fluid's torque, from the description: a known load (taken off in _gains_and_prior)
+    taken = None if hydro is None else hydro_rows(hydro, full, settings)
     samples = [_decimated(s, settings) for s in full]
     rotor = np.arange(robot.dof) * PER_JOINT + len(INERTIAL_NAMES)
     relations = base_relations(model, at_rest=_at_rest(samples, settings.dead_band),
@@ -376,7 +375,8 @@ def _at_rest(samples: Sequence[Samples], band: float) -> np.ndarray:
 def _gains_and_prior(robot: Robot, data: _Prepared, pays: list[Payload | None], target: str,
                      gains: str, friction: str, sensor: str = "motor"
                      ) -> tuple[_Drive, np.ndarray, list[np.ndarray]]:
-    """Drive gains, the prior (15 n,) and the payload torque (N_k, n), N m, of each recording (step 5).
+    """Drive gains, the prior (15 n,) and the known torque (N_k, n), N m, of each recording: its
+    payload's and an underwater arm's hydrodynamic torque (step 5).
 
     With ``target="current"`` and a payload in some recording, the gains are estimated from the
     payload runs (:func:`_payload_gains`); for ``friction="none"`` the prior has no friction.
@@ -384,6 +384,9 @@ def _gains_and_prior(robot: Robot, data: _Prepared, pays: list[Payload | None], 
     nominal = nominal_standard(robot)
     loads = [np.zeros_like(s.q) if p is None else payload_torque(y, payload_standard(robot, p))
              for s, y, p in zip(data.samples, data.y_full, pays, strict=True)]
+    if data.hydro is not None:  # the fluid's torque at the decimated samples
+        d = data.settings.decimate
+        loads = [load + h[::d] for load, h in zip(loads, data.hydro, strict=True)]
     has_payload = any(p is not None for p in pays)
     k, k_source, prior = joint_prior(robot, data.samples, data.y_full, nominal, target, gains,
                                      loads)

@@ -169,8 +169,9 @@ class Identification:
         add to it; ``robot`` does not carry them.
     hydro : HydroLoad or None
         An underwater arm's hydrodynamic torque from its description
-        (:mod:`robodyn.identification.hydro_load`): taken off the target before the fit;
-        :meth:`effort` adds it; ``robot`` keeps the hydrodynamic blocks.
+        (:mod:`robodyn.identification.hydro_load`): a known load, taken off the target before
+        the fit; :meth:`effort` adds it (before the drive gains); ``robot`` keeps the
+        hydrodynamic blocks.
     """
 
     robot: Robot
@@ -325,6 +326,6 @@ class Identification:
             from robodyn.identification.payload import payload_torque
 
             tau = tau + payload_torque(y, payload)
-        if self.hydro is not None:  # the fluid's share, from the description (target units)
-            return tau / self.gains[None, :] + self.hydro.target(s.q, s.qd, s.qdd)
+        if self.hydro is not None:  # the fluid's torque, from the description
+            tau = tau + self.hydro.torque(s.q, s.qd, s.qdd)
         return tau / self.gains[None, :]
