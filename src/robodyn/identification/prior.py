@@ -50,13 +50,11 @@ class IdentificationWarning(UserWarning):
     """An identification went ahead with a fallback the user should know about."""
 
 
-def description_gains(robot: Robot, signed: bool = False) -> np.ndarray:
-    """``|gear_ratio x torque_constant|`` of each joint (n,), N m / A (with its sign: a drive
-    turning against its joint negative, where ``signed``)."""
+def description_gains(robot: Robot) -> np.ndarray:
+    """``|gear_ratio x torque_constant|`` of each joint (n,), N m / A."""
     subs = robot.defaults()
-    k = np.array([float(sp.sympify(j.drive.gear_ratio * j.drive.torque_constant).xreplace(subs))
-                  for j in robot.joints])
-    return k if signed else np.abs(k)
+    return np.array([abs(float(sp.sympify(j.drive.gear_ratio * j.drive.torque_constant).xreplace(subs)))
+                     for j in robot.joints])
 
 
 def _joint_columns(y: np.ndarray, j: int) -> np.ndarray:
