@@ -211,8 +211,12 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     result = replace(result, choices=Choices(best.velocity, best.dead_band, data.settings.cutoff,
                                              step.fit.lam, tuple(scored), reason, best.thermal, best),
                      thermal_fit=thermal_fit, hydro=hydro)
-    # the terms fitted after the linear step see the target without the known loads too
-    # (the linear step took it off; K y - P = Y p, so y - P / K in the target's unit)
+    # the terms fitted after the linear step see the target without the known loads and the
+    # thermal friction too (the linear step took them off; K y - P - tau_T = Y p, so
+    # y - (P + tau_T) / K in the target's unit)
+    if thermal_fit is not None:
+        loads = [load + rows @ thermal_fit.coefficients
+                 for load, rows in zip(loads, data.thermal.fit_rows, strict=True)]
     samples = [s if not np.any(load) else replace(s, y=s.y - load / result.gains[None, :])
                for s, load in zip(data.samples, loads, strict=True)]
     return with_prediction_terms(result, recs, pays, target, opts, samples, data.y_full,
