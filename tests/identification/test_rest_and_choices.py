@@ -197,13 +197,18 @@ def _thermal_run(model, seed: int, temp: float, cv: np.ndarray, cc: np.ndarray, 
                         joint_names=model.robot.joint_names, source=f"T{temp:g}"), tau
 
 
-def test_thermal_friction_recovered_and_predicted_at_another_temperature(planar):
-    robot, model = planar
+def _thermal_runs(model):
+    """``cv``, ``cc``, ``T_ref`` and two runs at 25 and 40 deg C (T_ref: their mean temperature)."""
     cv, cc = np.array([-0.02, -0.01]), np.array([-0.03, 0.015])
     t = np.arange(0.0, 15.0, 0.01)
-    # T_ref is the mean temperature of the identification data: runs at 25 and 40 deg C
     t_ref = np.full(2, np.mean([25.0 + 0.1 * np.sin(0.3 * t), 40.0 + 0.1 * np.sin(0.3 * t)]))
     runs = [_thermal_run(model, seed, temp, cv, cc, t_ref)[0] for seed, temp in ((11, 25.0), (12, 40.0))]
+    return cv, cc, t_ref, runs
+
+
+def test_thermal_friction_recovered_and_predicted_at_another_temperature(planar):
+    robot, model = planar
+    cv, cc, t_ref, runs = _thermal_runs(model)
     ident = rd.identify(robot, runs, method="ols", cutoff=None, regularization=None, model=model,
                         thermal=True)
     fit = ident.thermal_fit
@@ -227,10 +232,7 @@ def test_the_ripple_does_not_take_up_the_thermal_friction(planar):
     # level and the prediction stays exact (before: 0.016 N m amplitudes from the thermal torque,
     # predictions off by 0.018 N m)
     robot, model = planar
-    cv, cc = np.array([-0.02, -0.01]), np.array([-0.03, 0.015])
-    t = np.arange(0.0, 15.0, 0.01)
-    t_ref = np.full(2, np.mean([25.0 + 0.1 * np.sin(0.3 * t), 40.0 + 0.1 * np.sin(0.3 * t)]))
-    runs = [_thermal_run(model, seed, temp, cv, cc, t_ref)[0] for seed, temp in ((11, 25.0), (12, 40.0))]
+    cv, cc, t_ref, runs = _thermal_runs(model)
     ident = rd.identify(robot, runs, method="ols", cutoff=None, regularization=None, model=model,
                         thermal=True, ripple=True)
     assert ident.ripple_fit is not None
