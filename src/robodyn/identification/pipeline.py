@@ -214,11 +214,11 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     # the terms fitted after the linear step see the target without the known loads and the
     # thermal friction too (the linear step took them off; K y - P - tau_T = Y p, so
     # y - (P + tau_T) / K in the target's unit)
-    if thermal_fit is not None:
-        loads = [load + rows @ thermal_fit.coefficients
-                 for load, rows in zip(loads, data.thermal.fit_rows, strict=True)]
-    samples = [s if not np.any(load) else replace(s, y=s.y - load / result.gains[None, :])
-               for s, load in zip(data.samples, loads, strict=True)]
+    known = loads if thermal_fit is None else [
+        load + rows @ thermal_fit.coefficients
+        for load, rows in zip(loads, data.thermal.fit_rows, strict=True)]
+    samples = [s if not np.any(k) else replace(s, y=s.y - k / result.gains[None, :])
+               for s, k in zip(data.samples, known, strict=True)]
     return with_prediction_terms(result, recs, pays, target, opts, samples, data.y_full,
                                  data.full, data.settings)
 

@@ -80,7 +80,7 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
     target : {"tau", "current"}
     mode : {"auto", "description", "absorbed"}
     known : sequence of numpy.ndarray, shape (N_k, n), optional
-        Known torque in each recording's target, N m (a payload's): added to the nominal
+        Known torque in each recording's target, N m (a payload's, the fluid's): added to the nominal
         rigid-body torque, so that the per-joint fit does not take it for friction.
 
     Returns
@@ -111,9 +111,8 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
     gains = np.ones(n) if fixed is None else fixed.copy()
     prior = rigid.copy()
     failed = []
-    flip = current_directions(samples, y_full, nominal, known) if target == "current" else np.ones(n)
-
     extra = [np.zeros((len(s.y), n)) for s in samples] if known is None else known
+    flip = current_directions(samples, y_full, nominal, extra) if target == "current" else np.ones(n)
 
     def fit(j: int, gain: float | None) -> bool:
         # the torque the description and the known loads explain: Y p_rigid + tau_known
@@ -162,19 +161,18 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
 
 
 def current_directions(samples: Sequence[Samples], y_full: Sequence[np.ndarray], nominal: np.ndarray,
-                       known: Sequence[np.ndarray] | None = None) -> np.ndarray:
+                       known: Sequence[np.ndarray]) -> np.ndarray:
     """Sense (n,) of each joint's current relative to its torque: -1 where the current is
     strongly anti-correlated with the description's joint torque ``Y p_nominal`` (rigid body,
     rotor inertia and friction; correlation below
     ``-REVERSED_CORRELATION``: a motor-side current sensor on a drive turning against the
     joint, or a log's sign convention), else +1. A weak correlation (a joint whose torque the
     description barely explains) keeps +1. ``known`` (N_k, n), N m: torque the description does
-    not hold (a payload's), added to it."""
+    not hold (a payload's, the fluid's), added to it."""
     n = samples[0].q.shape[1]
     out = np.ones(n)
-    extra = [np.zeros((len(s.y), n)) for s in samples] if known is None else known
     for j in range(n):
-        tau = np.concatenate([y[:, j, :] @ nominal + e[:, j] for y, e in zip(y_full, extra, strict=True)])
+        tau = np.concatenate([y[:, j, :] @ nominal + e[:, j] for y, e in zip(y_full, known, strict=True)])
         cur = np.concatenate([s.y[:, j] for s in samples])
         if np.std(tau) > 0 and np.std(cur) > 0 and np.corrcoef(tau, cur)[0, 1] < -REVERSED_CORRELATION:
             out[j] = -1.0
