@@ -32,6 +32,8 @@ class Case:
     check: list
     target: str
     note: str = ""
+    #: The joints scored (default: all); a joint without data in the held-out target is left out.
+    joints: tuple[int, ...] | None = None
 
 
 def kuka_cases() -> list[Case]:
@@ -53,12 +55,14 @@ def kuka_cases() -> list[Case]:
 
 
 def kinova_cases() -> list[Case]:
-    """The Kinova Gen3 splits: 70/30 pooled, across runs, whole runs -> jointwise (current)."""
+    """The Kinova Gen3 splits: 70/30 pooled, across runs, whole runs -> jointwise (current), and
+    the torque-sensor run 70/30 (joint torque, joints 2-7)."""
     robot = rd.load("kinova_gen3")
     urdf = str(KINOVA / "gen3.urdf")
     runs = {name: read(p) for name, p in zip(WHOLE_ARM, WHOLE_ARM_FILES, strict=True)}
     halves = {name: split(rec) for name, rec in runs.items()}
     jointwise = [read(p) for p in JOINTWISE_FILES]
+    torque = split(runs["RunTrajectory1"])  # the one run with torque-sensor data
     return [
         Case("Kinova 70/30 pooled", robot, urdf, [h[0] for h in halves.values()],
              [h[1] for h in halves.values()], "current",
@@ -66,6 +70,10 @@ def kinova_cases() -> list[Case]:
         Case("Kinova across runs", robot, urdf,
              [runs["RunTrajectory1"], runs["RecordTrajectory_quadratic"]], [runs["Trajectory1"]],
              "current", "RunTrajectory1 + RecordTrajectory_quadratic -> Trajectory1"),
+        Case("Kinova torque sensors 70/30 (joints 2-7)", robot, urdf, [torque[0]], [torque[1]], "tau",
+             "RunTrajectory1's joint torque sensors, first 70 % -> the last 30 % (1.96 s in all); "
+             "joint 1 has no sensor data (an all-NaN column), its rows are left out and it is not "
+             "scored", joints=tuple(range(1, 7))),
         Case("Kinova whole runs -> jointwise", robot, urdf, list(runs.values()), jointwise, "current",
              "the three whole runs -> the seven jointwise runs, all joints (the held ones too)"),
     ]

@@ -9,7 +9,8 @@ What a robotics engineer writes in an afternoon, independent of robodyn's own co
   (``scipy.signal.filtfilt`` at the median sampling rate, as such a script does), acceleration
   by central differences of the filtered velocity on the time stamps; positions as measured;
 * base columns by QR with column pivoting of the stacked matrix, ordinary least squares;
-* for motor currents, the drive gains absorbed per joint (the fit is in amperes).
+* for motor currents, the drive gains absorbed per joint (the fit is in amperes);
+* the rows of a joint without data (an all-NaN target column: no sensor) left out.
 
 It needs the ``pin`` package (a test and benchmark dependency).
 """
@@ -105,6 +106,8 @@ def fit(pmodel, recordings, target: str) -> Textbook:
         phis.append(y_full.reshape(-1, y_full.shape[2]))
         ys.append(_filtered(t, np.asarray(getattr(rec, target), float)).reshape(-1))
     phi, y = np.vstack(phis), np.concatenate(ys)
+    known = np.isfinite(y)  # a joint without data (an all-NaN column): its rows left out
+    phi, y = phi[known], y[known]
     norms = np.linalg.norm(phi, axis=0)
     used = np.flatnonzero(norms > 1e-10 * norms.max())
     _, r, piv = scipy.linalg.qr(phi[:, used] / norms[used], mode="economic", pivoting=True)

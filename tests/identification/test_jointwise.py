@@ -40,6 +40,25 @@ def test_2r_closed_form_inertia_and_gravity():
     np.testing.assert_allclose(fit.predict(rec), rec.tau[:, 0], atol=1e-9)
 
 
+def test_a_held_joint_without_a_sensor_does_not_stop_the_moving_one():
+    # the held joint 2's torque missing (an all-NaN column): joint 1 is identified as with it
+    # (the same values); the moving joint's own torque missing: it has no data, said so
+    robot = load_quiet("planar_2r")
+    model = rd.compile_model(robot)
+    rec = _one_joint_moving(model)
+
+    def without(j: int) -> rd.Recording:
+        tau = rec.tau.copy()
+        tau[:, j] = np.nan
+        return rd.Recording(t=rec.t, q=rec.q, qd=rec.qd, qdd=rec.qdd, tau=tau, source="one.csv")
+
+    full = identify_joint(robot, rec, target="tau", cutoff=None)
+    fit = identify_joint(robot, without(1), target="tau", cutoff=None)
+    np.testing.assert_array_equal(fit.values, full.values)
+    with pytest.raises(IdentificationError, match=r"one.csv: tau: joint 'q1' has no data"):
+        identify_joint(robot, without(0), target="tau", cutoff=None)
+
+
 def test_joint_that_never_moves_is_unidentifiable():
     robot = load_quiet("planar_2r")
     model = rd.compile_model(robot)

@@ -255,21 +255,21 @@ def test_thermal_friction_needs_temperatures(planar):
 
 
 def test_cutoff_candidates_are_the_rule_and_a_wider_one(planar):
-    from robodyn.identification.pipeline import CUTOFF_WIDER, _cutoff_candidates
+    from robodyn.identification.choices import CUTOFF_WIDER, cutoff_candidates
     from robodyn.identification.preprocess import resolve_preprocess
 
     robot, model = planar
     rec = _velocity_case(model, 10, quantum=0.0, qd_noise=0.0)
     rule = resolve_preprocess([rec], "auto", "auto").cutoff
-    assert _cutoff_candidates([rec], "auto") == ("auto", CUTOFF_WIDER * rule)
+    assert cutoff_candidates([rec], "auto") == ("auto", CUTOFF_WIDER * rule)
     # the rule computed once (auto_cutoff) and handed on gives the same settings
     from robodyn.identification.preprocess import auto_cutoff
 
     assert auto_cutoff([rec]) == rule
     assert resolve_preprocess([rec], "auto", "auto", auto=auto_cutoff([rec])) == \
         resolve_preprocess([rec], "auto", "auto")
-    assert _cutoff_candidates([rec], "auto", rule) == ("auto", CUTOFF_WIDER * rule)
-    assert _cutoff_candidates([rec], 3.0) == (3.0,)
+    assert cutoff_candidates([rec], "auto", rule) == ("auto", CUTOFF_WIDER * rule)
+    assert cutoff_candidates([rec], 3.0) == (3.0,)
     ident = rd.identify(robot, rec, model=model, velocity="position")
     labels = [c.label for c in ident.choices.candidates]
     assert len(labels) == 2 and "cutoff=auto" in labels[0]

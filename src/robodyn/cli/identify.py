@@ -170,6 +170,9 @@ def _cmd_identify(args: argparse.Namespace) -> int:
           f"({args.method}, target {ident.target}); condition number {ident.condition:.3g}, "
           f"Tikhonov weight {ident.regularization:.3g}")
     print(f"choices: {ident.choices.summary()}")
+    if ident.unobserved:
+        print(f"no {ident.target} data for joint(s) {', '.join(ident.unobserved)} (all-NaN columns): "
+              "not fitted; their own terms are the description's")
     print(ident.base_parameters)
     for head, v in vals:
         print(f"\n{head}")

@@ -38,8 +38,14 @@ from typing import Any
 import numpy as np
 
 from robodyn.identification.estimate import LAMBDA_GRID, candidate_cv_errors, paired_se
+from robodyn.identification.preprocess import resolve_preprocess, slowest_rate
+from robodyn.measure.filtering import lowpass
 
-__all__ = ["Candidate", "Choices", "Problem", "candidates", "choose"]
+__all__ = ["CUTOFF_WIDER", "Candidate", "Choices", "Problem", "candidates", "choose",
+           "cutoff_candidates", "reference_targets"]
+
+#: The wider cut-off tried by cross-validation, as a multiple of the rule's (cutoff="auto").
+CUTOFF_WIDER = 2.5
 
 
 @dataclass(frozen=True)
@@ -279,3 +285,30 @@ def choose(cands: Sequence[Candidate], stacked: Callable[[Candidate], Problem]
         if d.sum() < -paired_se(d) and scored[i].score < scored[best].score:
             best = i
     return scored[best], problems[best], scored
+
+
+def cutoff_candidates(recs: list[Any], cutoff: float | str | None,
+                       rule: float | None = None) -> tuple[float | str | None, ...]:
+    """The cut-offs to try: a given one alone; for "auto" its rule's value and ``CUTOFF_WIDER``
+    times it (below 0.2 x the slowest sampling rate), for a record whose torque holds more above
+    the motion's own bandwidth (a stiff controller, a fast excitation) than its noise."""
+    if cutoff != "auto":
+        return (cutoff,)
+    rule = resolve_preprocess(recs, "auto", "auto", auto=rule).cutoff
+    fs = slowest_rate(recs)
+    wide = min(CUTOFF_WIDER * rule, 0.2 * fs)
+    return ("auto", wide) if wide > 1.01 * rule else ("auto",)
+
+
+def reference_targets(recs: list[Any], target: str, cutoff: float | str | None,
+                       rule: float | None = None) -> list[np.ndarray]:
+    """The held-out target of the cross-validated choices, (N_k, n) per recording: each
+    recording's target low-passed at the first (plain) candidate's cut-off, the same for every
+    candidate, so that a wider cut-off wins only by better parameters, not by following the
+    target's noise (the raw target when the plain candidate has no filter)."""
+    cut = resolve_preprocess(recs, cutoff, 1, auto=rule).cutoff
+    out = []
+    for r in recs:
+        y = np.asarray(getattr(r, target), float)
+        out.append(y if cut is None else lowpass(np.asarray(r.t, float), y, cut, order=4))
+    return out

@@ -31,11 +31,14 @@ def _first_bad(a: np.ndarray) -> tuple[int, int]:
     return int(rows[0]), int(cols[0])
 
 
-def check_recording(robot: Robot, rec: Any, index: int, target: str | None) -> None:
+def check_recording(robot: Robot, rec: Any, index: int, target: str | None,
+                    unobserved: bool = False) -> None:
     """Raise :class:`IdentificationError` when ``rec`` cannot be used with ``robot``.
 
     Checks: joint names equal the robot's (same order), ``q`` (N, n), finite ``t``/``q``/target
-    (the first bad row and column named), and the target signal present.
+    (the first bad row and column named), and the target signal present. ``unobserved``: a
+    target column that is not finite in any row (a joint without a sensor, as
+    :class:`~robodyn.measure.recording.Recording` marks it) is allowed, unless every column is.
     """
     src = _src(rec, index)
     names = getattr(rec, "joint_names", None)
@@ -61,12 +64,19 @@ def check_recording(robot: Robot, rec: Any, index: int, target: str | None) -> N
         y = np.asarray(y, dtype=float)
         if y.shape != q.shape:
             raise IdentificationError(f"{src}: {target}: shape {y.shape} differs from q {q.shape}")
-        fields.append((target, y))
+        empty = ~np.isfinite(y).any(axis=0) if unobserved and y.size else np.zeros(n, bool)
+        if empty.all():
+            raise IdentificationError(f"{src}: {target}: no joint has a finite value (no sensor "
+                                      f"data to fit)")
+        fields.append((target, y[:, ~empty]))
     for name, a in fields:
         if not np.all(np.isfinite(a)):
             row, col = _first_bad(a)
+            value = a[row, col]
+            if name == target:  # the column among the joints with data
+                col = int(np.flatnonzero(~empty)[col])
             column = "" if name == "t" else f", column {col} ({robot.joint_names[col]})"
-            raise IdentificationError(f"{src}: {name}: value {a[row, col]} is not finite at row "
+            raise IdentificationError(f"{src}: {name}: value {value} is not finite at row "
                                       f"{row}{column}")
     check_within_limits(robot, q, src)
 
@@ -114,7 +124,7 @@ def checked_inputs(robot: Robot, recordings: Any, target: str | None, sensor: st
         raise IdentificationError("sensor: 'link' (a joint torque sensor after the gear) needs "
                                   f"target='tau', got target={target!r}")
     for i, rec in enumerate(recs):
-        check_recording(robot, rec, i, target)
+        check_recording(robot, rec, i, target, unobserved=True)
         _note_wraps(robot, rec, i)
     return recs, target, check_payloads(payloads, len(recs))
 

@@ -126,7 +126,7 @@ def identify_joint(robot: Robot, recording: Any, joint: int | str | None = None,
     """
     from robodyn.identification.inputs import check_recording
 
-    check_recording(robot, recording, 0, target)
+    check_recording(robot, recording, 0, target, unobserved=True)  # other joints' sensors may be absent
     src = str(getattr(recording, "source", "") or "recording")
     span = np.ptp(unwrap_turns(recording.q), axis=0)
     if joint is None:
@@ -142,6 +142,9 @@ def identify_joint(robot: Robot, recording: Any, joint: int | str | None = None,
         raise IdentificationError(
             f"{src}: q: joint {name!r} never moves (position span {span[j]:.3g} < {MOVING_RAD:g}): "
             f"its inertia, gravity and friction are unidentifiable from this recording")
+    if not np.isfinite(np.asarray(getattr(recording, target), float)[:, j]).any():
+        raise IdentificationError(f"{src}: {target}: joint {name!r} has no data (an all-NaN column): "
+                                  f"nothing to identify it from")
     settings = resolve_preprocess([recording], cutoff, decimate)
     s = preprocess(recording, settings, target)
     d = settings.decimate

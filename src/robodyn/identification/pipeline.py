@@ -29,7 +29,15 @@ import sympy as sp
 
 from robodyn.identification.bandwidth import check_prediction_cutoff
 from robodyn.identification.base import BaseRelations, base_relations
-from robodyn.identification.choices import Candidate, Choices, Problem, candidates, choose
+from robodyn.identification.choices import (
+    Candidate,
+    Choices,
+    Problem,
+    candidates,
+    choose,
+    cutoff_candidates,
+    reference_targets,
+)
 from robodyn.identification.completion import consistent_completion
 from robodyn.identification.drive_gains import estimate_drive_gains
 from robodyn.identification.estimate import FOLDS, LinearFit, fit_linear
@@ -47,7 +55,6 @@ from robodyn.identification.preprocess import (
     auto_cutoff,
     prediction_rows,
     resolve_preprocess,
-    slowest_rate,
 )
 from robodyn.identification.prior import joint_prior
 from robodyn.identification.result import BaseParameters, Identification
@@ -55,8 +62,15 @@ from robodyn.identification.spikes import without_spikes
 from robodyn.identification.state_noise import state_noise_std, torque_variance
 from robodyn.identification.thermal import ThermalData, ThermalFit, thermal_data
 from robodyn.identification.to_robot import robot_with_parameters
+from robodyn.identification.unobserved import (
+    filled,
+    imputed_samples,
+    note_unobserved,
+    observed_joints,
+    unobserved_names,
+    with_data,
+)
 from robodyn.keywords import resolve
-from robodyn.measure.filtering import lowpass
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
@@ -66,8 +80,6 @@ __all__ = ["check_recording", "identify", "nominal_standard"]
 
 #: Floor of the measurement variance, as a fraction of the first fit's residual variance.
 MEAS_FLOOR = 0.01
-#: The wider cut-off tried by cross-validation, as a multiple of the rule's (cutoff="auto").
-CUTOFF_WIDER = 2.5
 #: Fraction of a joint's samples at rest from which its friction offset is its own base parameter.
 REST_FRACTION = 0.01
 #: Unit directions whose singular value is below this fraction of the largest are reported.
@@ -82,11 +94,13 @@ def nominal_standard(robot: Robot) -> np.ndarray:
 
 def _stack(samples: Sequence[Samples], y_full: Sequence[np.ndarray], columns: np.ndarray,
            gains: np.ndarray, loads: Sequence[np.ndarray],
-           extra: Sequence[np.ndarray] | None = None
+           extra: Sequence[np.ndarray] | None = None,
+           observed: Sequence[np.ndarray] | None = None
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``Phi`` (m, b + e), ``y`` (m,), joint of each row, CV block of each row (m = sum N_k n);
     ``loads`` (N_k, n): the known payload torque of each recording, taken off the target;
-    ``extra`` (N_k, n, e): further columns appended after the base columns (thermal friction)."""
+    ``extra`` (N_k, n, e): further columns appended after the base columns (thermal friction);
+    ``observed`` (n,) bool per recording: only the rows of joints with data are kept."""
     phis, ys, joints, blocks = [], [], [], []
     for i, (s, y, load) in enumerate(zip(samples, y_full, loads, strict=True)):
         count, n = s.q.shape
@@ -97,7 +111,8 @@ def _stack(samples: Sequence[Samples], y_full: Sequence[np.ndarray], columns: np
         ys.append((s.y * gains[None, :] - load).reshape(-1))  # K_j i_j - P_j (or tau_j - P_j)
         joints.append(np.tile(np.arange(n), count))
         blocks.append(np.repeat(np.arange(count) * FOLDS // count, n))
-    return np.vstack(phis), np.concatenate(ys), np.concatenate(joints), np.concatenate(blocks)
+    counts = [s.q.shape[0] for s in samples]
+    return tuple(with_data(np.concatenate(a), observed, counts) for a in (phis, ys, joints, blocks))
 
 
 def identify(robot: Robot, recordings: Any, target: str | None = None, method: str = "consistent", *,
@@ -160,6 +175,9 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         prediction_cutoff=prediction_cutoff),
         IdentificationError)
     recs, target, pays = checked_inputs(robot, recordings, target, opts.sensor, payloads)
+    observed = observed_joints(recs, target)
+    note_unobserved(observed, robot.joint_names, target)
+    recs = filled(recs, target, observed)  # copies: a joint without data holds 0, its rows unused
     check_prediction_cutoff(recs, opts.prediction_cutoff)
     recs = without_spikes(recs, target, opts.spikes)  # glitches of the fit's recordings (spikes, bursts)
     model = model if model is not None else compile_model(robot)
@@ -168,14 +186,15 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     temps = all(getattr(r, "temperature", None) is not None for r in recs)
 
     def stacked(c: Candidate) -> Problem:
-        data = _prepared(robot, recs, target, opts.friction, c.cutoff, opts.decimate, c.velocity,
-                         c.dead_band, model, c.thermal, opts.sensor, rule, shared, hydro)
+        data = replace(_prepared(robot, recs, target, opts.friction, c.cutoff, opts.decimate,
+                                 c.velocity, c.dead_band, model, c.thermal, opts.sensor, rule, shared,
+                                 hydro), observed=observed)
         drive, prior, loads = _gains_and_prior(robot, data, pays, target, opts.gains, opts.friction,
                                                opts.sensor)
         cols = data.relations.independent
         th = data.thermal
         phi, y, joint, blocks = _stack(data.samples, data.y_full, cols, drive.k, loads,
-                                       None if th is None else th.fit_rows)
+                                       None if th is None else th.fit_rows, observed)
         test = [prediction_rows(model, s, data.settings)[:, :, cols] for s in data.samples]
         if th is not None:
             test = [np.concatenate([a, b], axis=2) for a, b in zip(test, th.test_rows, strict=True)]
@@ -184,14 +203,15 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         # the common held-out target at the same samples, torque units, known loads taken off
         held = np.concatenate([(ref[::d] * drive.k - load).reshape(-1)
                                for ref, load in zip(reference, loads, strict=True)])
-        return Problem(phi, y, theta0, joint, blocks,
-                       np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), held,
+        counts = [s.q.shape[0] for s in data.samples]
+        test = with_data(np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), observed, counts)
+        return Problem(phi, y, theta0, joint, blocks, test, with_data(held, observed, counts),
                        (data, drive, prior, loads))
 
     # the "auto" cut-off's rule, computed once for every candidate that uses it
     rule = auto_cutoff(recs) if opts.cutoff == "auto" else None
-    cutoffs = _cutoff_candidates(recs, opts.cutoff, rule)
-    reference = _reference_targets(recs, target, cutoffs[0], rule)
+    cutoffs = cutoff_candidates(recs, opts.cutoff, rule)
+    reference = reference_targets(recs, target, cutoffs[0], rule)
     cands = candidates(opts.velocity, opts.dead_band, opts.thermal, measured, temps, DEAD_BAND, cutoffs)
     shared = SharedRows(model)  # samples and rows of the candidates that differ in the band only
     best, problem, scored = choose(cands, stacked)
@@ -219,8 +239,10 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         for load, rows in zip(loads, data.thermal.fit_rows, strict=True)]
     samples = [s if not np.any(k) else replace(s, y=s.y - k / result.gains[None, :])
                for s, k in zip(data.samples, known, strict=True)]
+    samples = imputed_samples(samples, data.y_full, standard, result.gains, observed)
+    result = replace(result, unobserved=unobserved_names(observed, robot.joint_names))
     return with_prediction_terms(result, recs, pays, target, opts, samples, data.y_full,
-                                 data.full, data.settings)
+                                 data.full, data.settings, observed)
 
 
 @dataclass(frozen=True, eq=False)
@@ -249,6 +271,9 @@ class _Prepared:
         The filtered hydrodynamic torque at each recording's ``full`` samples (N_k, n), N m, a
         known load like a payload's (:mod:`robodyn.identification.hydro_load`); None for a dry
         robot.
+    observed : list of ndarray of bool, shape (n,), or None
+        The joints with target data in each recording (:mod:`robodyn.identification.unobserved`);
+        None: all.
     """
 
     settings: Preprocess
@@ -260,6 +285,7 @@ class _Prepared:
     thermal: ThermalData | None = None
     full: list[Samples] | None = None
     hydro: list[np.ndarray] | None = None
+    observed: list[np.ndarray] | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -341,33 +367,6 @@ def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff:
                      thermal_data(recs, full, settings) if thermal else None, full, taken)
 
 
-def _cutoff_candidates(recs: list[Any], cutoff: float | str | None,
-                       rule: float | None = None) -> tuple[float | str | None, ...]:
-    """The cut-offs to try: a given one alone; for "auto" its rule's value and ``CUTOFF_WIDER``
-    times it (below 0.2 x the slowest sampling rate), for a record whose torque holds more above
-    the motion's own bandwidth (a stiff controller, a fast excitation) than its noise."""
-    if cutoff != "auto":
-        return (cutoff,)
-    rule = resolve_preprocess(recs, "auto", "auto", auto=rule).cutoff
-    fs = slowest_rate(recs)
-    wide = min(CUTOFF_WIDER * rule, 0.2 * fs)
-    return ("auto", wide) if wide > 1.01 * rule else ("auto",)
-
-
-def _reference_targets(recs: list[Any], target: str, cutoff: float | str | None,
-                       rule: float | None = None) -> list[np.ndarray]:
-    """The held-out target of the cross-validated choices, (N_k, n) per recording: each
-    recording's target low-passed at the first (plain) candidate's cut-off, the same for every
-    candidate, so that a wider cut-off wins only by better parameters, not by following the
-    target's noise (the raw target when the plain candidate has no filter)."""
-    cut = resolve_preprocess(recs, cutoff, 1, auto=rule).cutoff
-    out = []
-    for r in recs:
-        y = np.asarray(getattr(r, target), float)
-        out.append(y if cut is None else lowpass(np.asarray(r.t, float), y, cut, order=4))
-    return out
-
-
 def _at_rest(samples: Sequence[Samples], band: float) -> np.ndarray:
     """Joints (n,) bool with at least ``REST_FRACTION`` of their fitted samples at rest
     (``|qd| < band``, or exactly 0: a joint held still): their offset ``Fo`` is then seen alone."""
@@ -393,7 +392,7 @@ def _gains_and_prior(robot: Robot, data: _Prepared, pays: list[Payload | None], 
         loads = [load + h[::d] for load, h in zip(loads, data.hydro, strict=True)]
     has_payload = any(p is not None for p in pays)
     k, k_source, prior = joint_prior(robot, data.samples, data.y_full, nominal, target, gains,
-                                     loads)
+                                     loads, data.observed)
     drive = _Drive(k, k_source, np.full(robot.dof, np.inf if k_source.startswith("absorbed") else np.nan))
     if target == "current" and has_payload:
         drive, prior = _payload_gains(robot, data, loads, drive, prior)
@@ -415,9 +414,10 @@ def _payload_gains(robot: Robot, data: _Prepared, loads: list[np.ndarray], drive
     """
     k = drive.k
     phi, y, joint, _ = _stack(data.samples, data.y_full, data.relations.independent, np.ones(robot.dof),
-                              [np.zeros_like(x) for x in loads])
-    est = estimate_drive_gains(phi, y, np.concatenate([x.reshape(-1) for x in loads]), joint,
-                               robot.joint_names)
+                              [np.zeros_like(x) for x in loads], observed=data.observed)
+    known = with_data(np.concatenate([x.reshape(-1) for x in loads]), data.observed,
+                      [len(x) for x in loads])
+    est = estimate_drive_gains(phi, y, known, joint, robot.joint_names)
     # the prior's drive and friction terms were fitted in the units of the absorbed gains
     prior = prior.copy()
     for j in range(robot.dof):
@@ -437,12 +437,14 @@ def _linear_step(robot: Robot, data: _Prepared, k: np.ndarray, loads: list[np.nd
     then taken off the target and the base parameters fitted again alone, so that every later
     step (weights, the consistent program) sees the base columns only.
     """
-    phi, y, joint, blocks = _stack(data.samples, data.y_full, data.relations.independent, k, loads)
+    th, cols = data.thermal, data.relations.independent
+    phi, y, joint, blocks = _stack(data.samples, data.y_full, cols, k, loads,
+                                   None if th is None else th.fit_rows, data.observed)
+    phi, extra = phi[:, :cols.size], phi[:, cols.size:]  # base columns, thermal columns
     theta0 = data.relations.to_base(prior)
     lin_method = "ols" if method == "ols" else "wls"
     thermal_fit = None
-    if data.thermal is not None:
-        extra = np.vstack([r.reshape(-1, r.shape[2]) for r in data.thermal.fit_rows])
+    if th is not None:
         coef = _thermal_coefficients(phi, y, theta0, joint, blocks, extra, lin_method, regularization)
         y = y - extra @ coef  # tau - (T - T_ref)(cv qd + cc sign qd)
         thermal_fit = ThermalFit(data.thermal.t_ref, coef[0::2], coef[1::2])
@@ -463,12 +465,15 @@ def _thermal_coefficients(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, jo
     ``theta`` the best ``c`` is ``E^+ (y - Phi theta)``, so ``theta`` is the usual fit of the
     rows projected off the thermal columns, ``P = 1 - Q Q^T`` with ``E = Q R``.
     """
-    q, _ = np.linalg.qr(extra)
+    used = np.linalg.norm(extra, axis=0) > 0  # a joint without data or motion: no column
+    q, _ = np.linalg.qr(extra[:, used])
     # P Phi, P y: the base problem with the thermal columns projected out
     fit = fit_linear(phi - q @ (q.T @ phi), y - q @ (q.T @ y), theta0, joint, blocks, method=method,
                      regularization=regularization)
     # c = E^+ (y - Phi theta)
-    return np.linalg.lstsq(extra, y - phi @ fit.theta, rcond=None)[0]
+    coef = np.zeros(extra.shape[1])
+    coef[used] = np.linalg.lstsq(extra[:, used], y - phi @ fit.theta, rcond=None)[0]
+    return coef
 
 
 def _state_noise_fit(robot: Robot, data: _Prepared, step: _LinearStep, prior: np.ndarray,
@@ -482,6 +487,7 @@ def _state_noise_fit(robot: Robot, data: _Prepared, step: _LinearStep, prior: np
     first = _complete(data.relations, step.fit.theta, prior)
     var = np.concatenate([torque_variance(data.model, s.q, s.qd, s.qdd, *noise, standard=first)
                           for s in data.samples]).reshape(-1)
+    var = with_data(var, data.observed, [len(s.q) for s in data.samples])
     # sigma_meas^2: what the propagated variance leaves of each joint's residual variance
     prop = np.array([np.mean(var[step.joint == j]) for j in range(robot.dof)])
     meas = np.maximum(step.fit.sigma**2 - prop, MEAS_FLOOR * step.fit.sigma**2)

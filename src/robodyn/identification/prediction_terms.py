@@ -29,6 +29,7 @@ from robodyn.identification.preprocess import Preprocess, Samples
 from robodyn.identification.resonance import with_resonance
 from robodyn.identification.result import Identification
 from robodyn.identification.ripple import gravity_free_joints, with_ripple
+from robodyn.identification.unobserved import imputed_recordings
 
 __all__ = ["with_prediction_terms"]
 
@@ -36,7 +37,8 @@ __all__ = ["with_prediction_terms"]
 def with_prediction_terms(result: Identification, recs: Sequence[Any], pays: Sequence[Any],
                           target: str, opts: IdentifyOptions, samples: Sequence[Samples],
                           y_full: Sequence[np.ndarray], full: Sequence[Samples],
-                          settings: Preprocess) -> Identification:
+                          settings: Preprocess,
+                          observed: Sequence[np.ndarray] | None = None) -> Identification:
     """``result`` (the linear step, its choices set) with the terms of the module docstring.
 
     Parameters
@@ -57,6 +59,10 @@ def with_prediction_terms(result: Identification, recs: Sequence[Any], pays: Seq
         The processed samples before decimation.
     settings : Preprocess
         The fit's processing.
+    observed : sequence of numpy.ndarray of bool, shape (n,), optional
+        The joints with target data in each recording (default: all). ``samples`` already hold
+        the model's prediction in place of the others; the recordings' are filled here, before
+        the prediction cut-off and the drive modes (:mod:`robodyn.identification.unobserved`).
 
     Returns
     -------
@@ -75,6 +81,8 @@ def with_prediction_terms(result: Identification, recs: Sequence[Any], pays: Seq
     revolute = np.array([j.type == "revolute" for j in result.robot.joints])
     result = with_ripple(result, full, samples, y_full, settings,
                          gravity_free_joints(model, revolute), opts.ripple)
+    if observed is not None:
+        recs = imputed_recordings(result, recs, pays, target, observed)
     result = with_prediction_cutoff(result, recs, pays, target, opts.prediction_cutoff)
     result = with_resonance(result, recs, pays, target, opts.resonance)
     # last: the prediction's Coulomb step smoothed (the fit and every choice made with the step)

@@ -65,7 +65,8 @@ def _joint_columns(y: np.ndarray, j: int) -> np.ndarray:
 
 def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.ndarray],
                 nominal: np.ndarray, target: str, mode: str,
-                known: Sequence[np.ndarray] | None = None
+                known: Sequence[np.ndarray] | None = None,
+                observed: Sequence[np.ndarray] | None = None
                 ) -> tuple[np.ndarray, str, np.ndarray]:
     """Drive gains, their source and the prior standard vector (module docstring).
 
@@ -82,6 +83,10 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
     known : sequence of numpy.ndarray, shape (N_k, n), optional
         Known torque in each recording's target, N m (a payload's, the fluid's): added to the nominal
         rigid-body torque, so that the per-joint fit does not take it for friction.
+    observed : sequence of numpy.ndarray of bool, shape (n,), optional
+        The joints with target data in each recording (default: all): a joint is fitted on the
+        recordings where it has data, and keeps the description's terms (and drive gain, or 1)
+        where none has (:mod:`robodyn.identification.unobserved`).
 
     Returns
     -------
@@ -112,13 +117,19 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
     prior = rigid.copy()
     failed = []
     extra = [np.zeros((len(s.y), n)) for s in samples] if known is None else known
-    flip = current_directions(samples, y_full, nominal, extra) if target == "current" else np.ones(n)
+    seen = [np.ones(n, bool)] * len(samples) if observed is None else list(observed)
+    flip = current_directions(samples, y_full, nominal, extra, seen) if target == "current" \
+        else np.ones(n)
 
     def fit(j: int, gain: float | None) -> bool:
+        use = [k for k in range(len(samples)) if seen[k][j]]
+        if not use:  # no data on this joint: the description's own terms
+            prior[joint_columns(j)] = nominal[joint_columns(j)]
+            return True
         # the torque the description and the known loads explain: Y p_rigid + tau_known
-        tau_nom = np.concatenate([y[:, j, :] @ rigid + e[:, j] for y, e in zip(y_full, extra, strict=True)])
-        cols = np.vstack([_joint_columns(y, j) for y in y_full])
-        b = np.concatenate([s.y[:, j] for s in samples]) * flip[j]  # current in the torque's sense
+        tau_nom = np.concatenate([y_full[k][:, j, :] @ rigid + extra[k][:, j] for k in use])
+        cols = np.vstack([_joint_columns(y_full[k], j) for k in use])
+        b = np.concatenate([samples[k].y[:, j] for k in use]) * flip[j]  # current in the torque's sense
         a = np.column_stack([tau_nom, cols]) if gain is None else cols
         if gain is not None:
             b = b - tau_nom / gain
@@ -161,19 +172,24 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
 
 
 def current_directions(samples: Sequence[Samples], y_full: Sequence[np.ndarray], nominal: np.ndarray,
-                       known: Sequence[np.ndarray]) -> np.ndarray:
+                       known: Sequence[np.ndarray],
+                       observed: Sequence[np.ndarray] | None = None) -> np.ndarray:
     """Sense (n,) of each joint's current relative to its torque: -1 where the current is
     strongly anti-correlated with the description's joint torque ``Y p_nominal`` (rigid body,
     rotor inertia and friction; correlation below
     ``-REVERSED_CORRELATION``: a motor-side current sensor on a drive turning against the
     joint, or a log's sign convention), else +1. A weak correlation (a joint whose torque the
     description barely explains) keeps +1. ``known`` (N_k, n), N m: torque the description does
-    not hold (a payload's, the fluid's), added to it."""
+    not hold (a payload's, the fluid's), added to it. ``observed`` (n,) bool per recording: the
+    joints with data there (default: all); a joint is judged on those recordings (+1 without)."""
     n = samples[0].q.shape[1]
     out = np.ones(n)
     for j in range(n):
-        tau = np.concatenate([y[:, j, :] @ nominal + e[:, j] for y, e in zip(y_full, known, strict=True)])
-        cur = np.concatenate([s.y[:, j] for s in samples])
+        use = [k for k in range(len(samples)) if observed is None or observed[k][j]]
+        if not use:
+            continue
+        tau = np.concatenate([y_full[k][:, j, :] @ nominal + known[k][:, j] for k in use])
+        cur = np.concatenate([samples[k].y[:, j] for k in use])
         if np.std(tau) > 0 and np.std(cur) > 0 and np.corrcoef(tau, cur)[0, 1] < -REVERSED_CORRELATION:
             out[j] = -1.0
     return out

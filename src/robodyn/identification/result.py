@@ -172,6 +172,10 @@ class Identification:
         (:mod:`robodyn.identification.hydro_load`): a known load, taken off the target before
         the fit; :meth:`effort` adds it (before the drive gains); ``robot`` keeps the
         hydrodynamic blocks.
+    unobserved : tuple of str
+        Joints without target data in any recording (an all-NaN column: no sensor,
+        :mod:`robodyn.identification.unobserved`): their rows were not fitted, their own terms
+        are the description's, and :meth:`predict` gives the model's value for them.
     """
 
     robot: Robot
@@ -200,6 +204,7 @@ class Identification:
     resonance_fit: ResonanceFit | None = None
     coulomb_width: float | np.ndarray = 0.0
     hydro: Any = None
+    unobserved: tuple[str, ...] = ()
 
     @property
     def gains_identified(self) -> bool:
