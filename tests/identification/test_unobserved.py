@@ -59,6 +59,7 @@ def test_the_other_joints_are_identified_and_the_missing_one_keeps_the_descripti
     with pytest.warns(IdentificationWarning, match=r"tau: no data for joint\(s\) q1 in any recording"):
         ident = rd.identify(robot, rec, method="ols", cutoff=None, regularization=None, model=model)
     assert ident.unobserved == ("q1",)
+    assert np.isnan(ident.residual_std[0]) and np.isfinite(ident.residual_std[1:]).all()
     assert np.isnan(rec.tau[:, 0]).all()  # the caller's recording is left as it was
     # another trajectory: the plant's torques on joints 2-6 (what their rows determine)
     check, tau = _run(plant, 2, 5.0)

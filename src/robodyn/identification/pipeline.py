@@ -240,7 +240,9 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     samples = [s if not np.any(k) else replace(s, y=s.y - k / result.gains[None, :])
                for s, k in zip(data.samples, known, strict=True)]
     samples = imputed_samples(samples, data.y_full, standard, result.gains, observed)
-    result = replace(result, unobserved=unobserved_names(observed, robot.joint_names))
+    seen = np.logical_or.reduce(observed)  # a joint without data anywhere has no residual
+    result = replace(result, unobserved=unobserved_names(observed, robot.joint_names),
+                     residual_std=np.where(seen, result.residual_std, np.nan))
     return with_prediction_terms(result, recs, pays, target, opts, samples, data.y_full,
                                  data.full, data.settings, observed)
 

@@ -129,7 +129,8 @@ class Identification:
         Unit directions in base-parameter space (column-scaled) whose singular value is below
         1e-6 of the largest: what the data cannot tell apart.
     residual_std : numpy.ndarray, shape (n,)
-        Per-joint residual standard deviation of the fit (target units).
+        Per-joint residual standard deviation of the fit (target units); NaN for a joint
+        without data (``unobserved``).
     samples : int
         Samples (after decimation) used in the fit.
     relations : BaseRelations
