@@ -453,8 +453,7 @@ def test_least_squares_writes_a_physical_completion_when_one_exists(puma, tmp_pa
     # principal moments 0, 0, 0.35 (triangle inequality broken); only Izz of that link reaches the
     # base parameters, so the plain completion with the description's values wrote an impossible
     # link although a physical one with the same base parameters (the same predictions) exists
-    from robodyn.identification.completion import physical
-    from robodyn.identification.pipeline import _complete
+    from robodyn.identification.completion import completed, physical
 
     robot, model = puma
     t = np.arange(0.0, 20.0, 0.01)
@@ -463,7 +462,7 @@ def test_least_squares_writes_a_physical_completion_when_one_exists(puma, tmp_pa
                        joint_names=robot.joint_names)
     ident = rd.identify(robot, rec, model=model, cutoff=None, regularization=None, method="ols")
     theta = ident.relations.to_base(ident.standard)
-    plain = _complete(ident.relations, theta, nominal_standard(robot))
+    plain = completed(ident.relations, theta, nominal_standard(robot))
     assert not physical(plain, robot.dof)  # what was written before
     assert physical(ident.standard, robot.dof)
     np.testing.assert_allclose(theta, ident.relations.to_base(plain), rtol=1e-7, atol=1e-9)

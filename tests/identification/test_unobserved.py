@@ -120,3 +120,33 @@ def test_partly_missing_and_all_missing_targets_are_refused(arm):
                         joint_names=robot.joint_names, source="none.csv")
     with pytest.raises(IdentificationError, match=r"none.csv: tau: no joint has a finite value"):
         rd.identify(robot, none, model=model, cutoff=None)
+
+
+def test_drive_gains_from_a_payload_run_with_a_joint_without_current(arm):
+    # target current through drive gains 2-9 % off the description's, a run with a known payload:
+    # the gains of the joints with current come back (noise-free), joint 1 keeps the
+    # description's gain, reported not estimated (std inf); before, the gain fit diverged
+    robot, model, (_, true), _ = arm
+    from robodyn.identification.payload import payload_standard
+    from robodyn.identification.prior import description_gains
+
+    pay = rd.Payload(mass=1.5, com=[0.0, 0.0, 0.05], inertia=np.diag([0.004, 0.006, 0.008]))
+    desc = description_gains(robot)
+    gains = desc * np.array([1.02, 0.95, 1.07, 0.91, 1.04, 0.97])
+    loaded = true.copy()
+    loaded[5 * PER_JOINT:5 * PER_JOINT + 10] += payload_standard(robot, pay)
+    runs = []
+    for k, p in enumerate((true, loaded)):
+        rng = np.random.default_rng(10 + k)
+        t = np.arange(0.0, 12.0, 0.01)
+        q, qd, qdd = fourier(t, robot.dof, rng)
+        current = (model.regressor(q, qd, qdd) @ p) / gains
+        current[:, 0] = np.nan
+        runs.append(rd.Recording(t=t, q=q, qd=qd, qdd=qdd, current=current,
+                                 joint_names=robot.joint_names, source=f"run{k}"))
+    with pytest.warns(IdentificationWarning, match="no data for joint"):
+        ident = rd.identify(robot, runs, target="current", model=model, payloads=[None, pay],
+                            method="ols", cutoff=None, regularization=None)
+    assert ident.gains_source == "payload"
+    np.testing.assert_allclose(ident.gains[1:], gains[1:], rtol=1e-6)
+    assert ident.gains[0] == desc[0] and np.isinf(ident.gains_std[0])

@@ -3,7 +3,7 @@
 Least squares (``method="wls"``/``"ols"``) estimates the base parameters ``theta = K p`` only;
 the standard set written into the identified description is one of the many ``p`` with
 ``K p = theta``, by default the description's values for the parameters that only appear in
-combinations (:func:`robodyn.identification.pipeline._complete`). That choice can put a link's
+combinations (:func:`completed`). That choice can put a link's
 inertia outside the physically possible set (a negative principal moment, a broken triangle
 inequality) although another ``p`` with the same base parameters, hence the very same
 predictions, is physical. :func:`consistent_completion` looks for it::
@@ -24,9 +24,9 @@ import numpy as np
 from robodyn.identification.base import BaseRelations
 from robodyn.identification.consistent import EPS, _project_link, _pseudo_expr, pseudo_inertia
 from robodyn.robot.validation import inertia_problems
-from robodyn.symbolic.regressor import PER_JOINT
+from robodyn.symbolic.regressor import PER_JOINT, joint_columns
 
-__all__ = ["consistent_completion", "physical"]
+__all__ = ["completed", "consistent_completion", "physical"]
 
 #: Largest relative change of the base parameters the solver's tolerance may leave, |dK p| / |K p0|.
 BASE_TOL = 1e-7
@@ -80,4 +80,46 @@ def consistent_completion(relations: BaseRelations, p0: np.ndarray, n: int) -> n
     drift = np.linalg.norm(k @ out - theta) / max(np.linalg.norm(theta), 1e-300)
     if drift > BASE_TOL or not physical(out, n):
         return p0
+    return out
+
+
+def completed(relations: BaseRelations, theta: np.ndarray, nominal: np.ndarray) -> np.ndarray:
+    """Standard vector with the dependent parameters at their nominal values and the
+    independent ones set so that its base parameters equal ``theta``."""
+    p = nominal.copy()
+    # theta = p_b + beta p_d  ->  p_b = theta - beta p_d
+    p[relations.independent] = theta - relations.beta @ nominal[relations.dependent]
+    return _split_coulomb(relations, p)
+
+
+def _split_coulomb(relations: BaseRelations, p: np.ndarray) -> np.ndarray:
+    """Move along the one direction the data cannot see among a joint's (Fcp, Fcn, Fo) (an
+    offset against asymmetric Coulomb friction) so that both Coulomb levels are non-negative,
+    as a description requires, staying as close as possible to the prior's split."""
+    k = relations.matrix
+    out = p.copy()
+    for j in range(p.size // PER_JOINT):
+        idx = np.arange(p.size)[joint_columns(j, "Fcp", "Fo")]  # Fcp, Fcn, Fo
+        _, sv, vt = np.linalg.svd(k[:, idx])
+        null = vt[np.sum(sv > 1e-9 * max(sv[0], 1e-300)):]
+        if null.shape[0] != 1:
+            continue
+        d = null[0]
+        c = out[idx[:2]]
+        # Fcp, Fcn + t d[:2] >= 0: an interval of t (or none)
+        lo, hi = -np.inf, np.inf
+        for ci, di in zip(c, d[:2], strict=True):
+            if abs(di) < 1e-12:
+                continue
+            if di > 0:
+                lo = max(lo, -ci / di)
+            else:
+                hi = min(hi, -ci / di)
+        if lo <= hi:
+            t = float(np.clip(0.0, lo, hi))
+        elif abs(d[0] - d[1]) > 1e-12:
+            t = float((c[1] - c[0]) / (d[0] - d[1]))  # no such split: equal levels
+        else:
+            continue
+        out[idx] += t * d
     return out

@@ -38,7 +38,7 @@ from robodyn.identification.choices import (
     cutoff_candidates,
     reference_targets,
 )
-from robodyn.identification.completion import consistent_completion
+from robodyn.identification.completion import completed, consistent_completion
 from robodyn.identification.drive_gains import estimate_drive_gains
 from robodyn.identification.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identification.friction import without_friction
@@ -419,12 +419,16 @@ def _payload_gains(robot: Robot, data: _Prepared, loads: list[np.ndarray], drive
                               [np.zeros_like(x) for x in loads], observed=data.observed)
     known = with_data(np.concatenate([x.reshape(-1) for x in loads]), data.observed,
                       [len(x) for x in loads])
-    est = estimate_drive_gains(phi, y, known, joint, robot.joint_names)
+    seen = np.unique(joint)  # a joint without data keeps its gain (std inf: not estimated)
+    est = estimate_drive_gains(phi, y, known, np.searchsorted(seen, joint),
+                               tuple(robot.joint_names[j] for j in seen))
+    gains, std = k.copy(), np.full(robot.dof, np.inf)
+    gains[seen], std[seen] = est.gains, est.std
     # the prior's drive and friction terms were fitted in the units of the absorbed gains
     prior = prior.copy()
     for j in range(robot.dof):
-        prior[joint_columns(j)] *= est.gains[j] / k[j]
-    return _Drive(est.gains, "payload", est.std), prior
+        prior[joint_columns(j)] *= gains[j] / k[j]
+    return _Drive(gains, "payload", std), prior
 
 
 def _linear_step(robot: Robot, data: _Prepared, k: np.ndarray, loads: list[np.ndarray],
@@ -486,7 +490,7 @@ def _state_noise_fit(robot: Robot, data: _Prepared, step: _LinearStep, prior: np
     measurement variance of each joint, floored at ``MEAS_FLOOR`` times its residual variance.
     """
     noise = state_noise_std(state_noise, robot.dof)
-    first = _complete(data.relations, step.fit.theta, prior)
+    first = completed(data.relations, step.fit.theta, prior)
     var = np.concatenate([torque_variance(data.model, s.q, s.qd, s.qdd, *noise, standard=first)
                           for s in data.samples]).reshape(-1)
     var = with_data(var, data.observed, [len(s.q) for s in data.samples])
@@ -515,7 +519,7 @@ def _estimate_standard(robot: Robot, relations: BaseRelations, step: _LinearStep
         return relations.to_base(standard), standard
     theta = step.fit.theta
     # the same base parameters, with a physical standard set when one exists
-    return theta, consistent_completion(relations, _complete(relations, theta, prior), robot.dof)
+    return theta, consistent_completion(relations, completed(relations, theta, prior), robot.dof)
 
 
 def _identification(robot: Robot, data: _Prepared, step: _LinearStep, theta: np.ndarray,
@@ -548,48 +552,6 @@ def _decimated(s: Samples, settings: Preprocess) -> Samples:
         return s
     return Samples(s.t[::d], s.q[::d], s.qd[::d], s.qdd[::d], None if s.y is None else s.y[::d],
                    s.source)
-
-
-def _complete(relations: Any, theta: np.ndarray, nominal: np.ndarray) -> np.ndarray:
-    """Standard vector with the dependent parameters at their nominal values and the
-    independent ones set so that its base parameters equal ``theta``."""
-    p = nominal.copy()
-    # theta = p_b + beta p_d  ->  p_b = theta - beta p_d
-    p[relations.independent] = theta - relations.beta @ nominal[relations.dependent]
-    return _split_coulomb(relations, p)
-
-
-def _split_coulomb(relations: BaseRelations, p: np.ndarray) -> np.ndarray:
-    """Move along the one direction the data cannot see among a joint's (Fcp, Fcn, Fo) (an
-    offset against asymmetric Coulomb friction) so that both Coulomb levels are non-negative,
-    as a description requires, staying as close as possible to the prior's split."""
-    k = relations.matrix
-    out = p.copy()
-    for j in range(p.size // PER_JOINT):
-        idx = np.arange(p.size)[joint_columns(j, "Fcp", "Fo")]  # Fcp, Fcn, Fo
-        _, sv, vt = np.linalg.svd(k[:, idx])
-        null = vt[np.sum(sv > 1e-9 * max(sv[0], 1e-300)):]
-        if null.shape[0] != 1:
-            continue
-        d = null[0]
-        c = out[idx[:2]]
-        # Fcp, Fcn + t d[:2] >= 0: an interval of t (or none)
-        lo, hi = -np.inf, np.inf
-        for ci, di in zip(c, d[:2], strict=True):
-            if abs(di) < 1e-12:
-                continue
-            if di > 0:
-                lo = max(lo, -ci / di)
-            else:
-                hi = min(hi, -ci / di)
-        if lo <= hi:
-            t = float(np.clip(0.0, lo, hi))
-        elif abs(d[0] - d[1]) > 1e-12:
-            t = float((c[1] - c[0]) / (d[0] - d[1]))  # no such split: equal levels
-        else:
-            continue
-        out[idx] += t * d
-    return out
 
 
 def _table(relations: Any, theta: np.ndarray, fit: LinearFit, theta0: np.ndarray) -> BaseParameters:
