@@ -34,9 +34,12 @@ from robodyn.identification.preprocess import Samples, preprocess, regressor_row
 from robodyn.robot.errors import IdentificationError
 from robodyn.symbolic.regressor import PER_JOINT, joint_columns
 
-__all__ = ["FRICTION_MODELS", "NONLINEAR", "V_EPS", "FrictionFit", "fit_friction"]
+__all__ = ["FRICTION_MODELS", "MIN_REVERSAL", "NONLINEAR", "V_EPS", "FrictionFit", "fit_friction"]
 
 V_EPS = 0.01
+#: Fraction of a joint's samples beyond ``V_EPS`` in each direction from which its offset is
+#: fitted with the law (:func:`_fit_law`).
+MIN_REVERSAL = 0.01
 NONLINEAR = ("stribeck", "load", "polynomial")
 FRICTION_MODELS = ("none", "linear", *NONLINEAR)
 _NAMES = {
@@ -78,10 +81,25 @@ def _law_jacobian(model: str, x: np.ndarray, v: np.ndarray, load: np.ndarray) ->
 def _fit_law(model: str, x0: np.ndarray, bounds: tuple[np.ndarray, np.ndarray], v: np.ndarray,
              load: np.ndarray, r: np.ndarray) -> np.ndarray:
     """Parameters of ``model`` minimising ``|f(v, load) - r|`` (trust-region reflective within
-    ``bounds``, from ``x0``, with the analytic Jacobian :func:`_law_jacobian`)."""
-    return least_squares(lambda x: _law(model, x, v, load) - r, x0,
-                         jac=lambda x: _law_jacobian(model, x, v, load),
-                         bounds=bounds, method="trf", x_scale="jac").x
+    ``bounds``, from ``x0``, with the analytic Jacobian :func:`_law_jacobian`).
+
+    A joint that does not reverse in the data (fewer than ``MIN_REVERSAL`` of its samples beyond
+    ``V_EPS`` on one side) has a constant sign: its Coulomb level and offset are not separable
+    (any split fits; a least-squares run drifts to large opposite values that a reversing
+    motion then shows), so the offset stays the start's, the linear step's.
+    """
+    free = np.ones(x0.size, bool)
+    free[-1] = min(np.mean(v > V_EPS), np.mean(v < -V_EPS)) >= MIN_REVERSAL  # Fo
+
+    def full(z: np.ndarray) -> np.ndarray:
+        x = x0.copy()
+        x[free] = z
+        return x
+
+    return full(least_squares(lambda z: _law(model, full(z), v, load) - r, x0[free],
+                              jac=lambda z: _law_jacobian(model, full(z), v, load)[:, free],
+                              bounds=(bounds[0][free], bounds[1][free]), method="trf",
+                              x_scale="jac").x)
 
 
 @dataclass(frozen=True, eq=False)
