@@ -150,7 +150,8 @@ def joint_prior(robot: Robot, samples: Sequence[Samples], y_full: Sequence[np.nd
         if not fit(j, None if fixed is None else float(fixed[j])):
             failed.append(j)
     if failed:
-        ok = [j for j in range(n) if j not in failed]
+        # the joints whose gain was absorbed from data (not those without data: gain 1)
+        ok = [j for j in range(n) if j not in failed and any(obs[j] for obs in seen)]
         if not ok:
             raise IdentificationError(
                 "recordings: no joint's drive gain can be absorbed (the description's torque "
