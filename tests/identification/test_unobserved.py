@@ -150,3 +150,32 @@ def test_drive_gains_from_a_payload_run_with_a_joint_without_current(arm):
     assert ident.gains_source == "payload"
     np.testing.assert_allclose(ident.gains[1:], gains[1:], rtol=1e-6)
     assert ident.gains[0] == desc[0] and np.isinf(ident.gains_std[0])
+
+
+def test_a_gain_that_cannot_be_absorbed_is_the_mean_of_the_joints_with_data(arm):
+    # gains absorbed, joint 1 without current and joint 6's current unrelated to its torque: joint
+    # 6 gets the geometric mean of joints 2-5's absorbed gains (joint 1's stand-in 1 left out)
+    robot, model, (_, true), nominal = arm
+    rng = np.random.default_rng(12)
+    t = np.arange(0.0, 12.0, 0.01)
+    q, qd, qdd = fourier(t, robot.dof, rng)
+    gains = np.array([20.0, 30.0, 15.0, 6.0, 5.0, 4.0])
+    current = (model.regressor(q, qd, qdd) @ true) / gains
+    current[:, 0] = np.nan
+    # joint 6: a current against the description's rigid-body torque, under an unrelated
+    # oscillation three times larger (correlation above -0.5: not a reversed sensor)
+    rigid = nominal.copy()
+    for j in range(robot.dof):
+        rigid[joint_columns(j)] = 0.0
+    against = -(model.regressor(q, qd, qdd) @ rigid)[:, 5] / gains[5]
+    current[:, 5] = against + 3 * against.std() * np.sin(2 * np.pi * 3.7 * t)
+    rec = rd.Recording(t=t, q=q, qd=qd, qdd=qdd, current=current, joint_names=robot.joint_names,
+                       source="run")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", IdentificationWarning)
+        ident = rd.identify(robot, rec, target="current", model=model, gains="absorbed",
+                            method="ols", cutoff=None, regularization=None)
+    assert "q6: mean of the others" in ident.gains_source, (ident.gains_source, ident.gains)
+    k = np.abs(ident.gains)
+    assert k[0] == 1.0
+    np.testing.assert_allclose(k[5], np.exp(np.mean(np.log(k[1:5]))), rtol=1e-12)
