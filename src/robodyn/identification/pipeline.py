@@ -67,6 +67,7 @@ from robodyn.identification.unobserved import (
     imputed_samples,
     note_unobserved,
     observed_joints,
+    seen_joints,
     unobserved_names,
     with_data,
 )
@@ -194,7 +195,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         cols = data.relations.independent
         th = data.thermal
         phi, y, joint, blocks = _stack(data.samples, data.y_full, cols, drive.k, loads,
-                                       None if th is None else th.fit_rows, observed)
+                                       None if th is None else th.fit_rows, data.observed)
         test = [prediction_rows(model, s, data.settings)[:, :, cols] for s in data.samples]
         if th is not None:
             test = [np.concatenate([a, b], axis=2) for a, b in zip(test, th.test_rows, strict=True)]
@@ -204,8 +205,9 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         held = np.concatenate([(ref[::d] * drive.k - load).reshape(-1)
                                for ref, load in zip(reference, loads, strict=True)])
         counts = [s.q.shape[0] for s in data.samples]
-        test = with_data(np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), observed, counts)
-        return Problem(phi, y, theta0, joint, blocks, test, with_data(held, observed, counts),
+        test = with_data(np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), data.observed,
+                         counts)
+        return Problem(phi, y, theta0, joint, blocks, test, with_data(held, data.observed, counts),
                        (data, drive, prior, loads))
 
     # the "auto" cut-off's rule, computed once for every candidate that uses it
@@ -240,9 +242,9 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     samples = [s if not np.any(k) else replace(s, y=s.y - k / result.gains[None, :])
                for s, k in zip(data.samples, known, strict=True)]
     samples = imputed_samples(samples, data.y_full, standard, result.gains, observed)
-    seen = np.logical_or.reduce(observed)  # a joint without data anywhere has no residual
+    # a joint without data anywhere has no residual
     result = replace(result, unobserved=unobserved_names(observed, robot.joint_names),
-                     residual_std=np.where(seen, result.residual_std, np.nan))
+                     residual_std=np.where(seen_joints(observed), result.residual_std, np.nan))
     return with_prediction_terms(result, recs, pays, target, opts, samples, data.y_full,
                                  data.full, data.settings, observed)
 

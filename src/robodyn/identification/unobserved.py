@@ -37,7 +37,7 @@ from robodyn.identification.prior import IdentificationWarning
 from robodyn.identification.thermal import temperatures
 
 __all__ = ["filled", "imputed_recordings", "imputed_samples", "kept_rows", "note_unobserved",
-           "observed_joints", "unobserved_names", "with_data"]
+           "observed_joints", "seen_joints", "unobserved_names", "with_data"]
 
 
 def observed_joints(recs: Sequence[Any], target: str) -> list[np.ndarray]:
@@ -45,10 +45,14 @@ def observed_joints(recs: Sequence[Any], target: str) -> list[np.ndarray]:
     return [np.isfinite(np.asarray(getattr(r, target), float)).any(axis=0) for r in recs]
 
 
+def seen_joints(observed: Sequence[np.ndarray]) -> np.ndarray:
+    """The joints (n,) bool with target data in at least one recording."""
+    return np.logical_or.reduce(list(observed))
+
+
 def unobserved_names(observed: Sequence[np.ndarray], names: Sequence[str]) -> tuple[str, ...]:
     """The joints without data in every recording."""
-    seen = np.logical_or.reduce(list(observed))
-    return tuple(name for name, s in zip(names, seen, strict=True) if not s)
+    return tuple(name for name, s in zip(names, seen_joints(observed), strict=True) if not s)
 
 
 def note_unobserved(observed: Sequence[np.ndarray], names: Sequence[str], target: str) -> None:
