@@ -8,14 +8,15 @@ Measured in one run:
      first allocation of a large matrix in a process costs more than later ones):
 
      * robodyn into a fresh matrix on 1 thread through ``regressor_rows_of``, the call
-       ``rd.identify`` makes to stack each recording's regressor
+       ``rd.identify`` makes to stack each recording's regressor for the fit
        (``identification.preprocess.regressor_rows`` / ``prediction_rows`` ->
        ``stacking.regressor_rows_of`` -> ``stacking.identification_matrix(model, q, qd, qdd)``:
-       every column, one thread, a fresh matrix); the run checks this by watching
+       every column, one thread, a fresh matrix); the model's own effort (the terms fitted
+       after the linear step, the predictions) goes through the same call a chunk of samples at
+       a time into one reused buffer (``out=``); the run checks both by watching
        ``identification_matrix`` during an untimed OLS identification before part 2's timed
        ones (it also warms up imports and first calls);
-     * the same on 2 threads, and into a reused matrix (``out=``, which ``rd.identify`` does not
-       use) on 1 and 2 threads;
+     * the same on 2 threads, and into a reused matrix (``out=``) on 1 and 2 threads;
      * the memory floor of each case: NumPy writing a fresh matrix of the same shape
        (``np.full``) and filling the reused one (``ndarray.fill``);
      * Pinocchio's ``computeJointTorqueRegressor`` called from a Python loop on the same arm (the
@@ -162,7 +163,8 @@ def whole_identifications(robot: rd.Robot, model: Any) -> dict[str, Any]:
 
     def spy(*args: Any, **kwargs: Any) -> np.ndarray:
         calls.append({"threads": kwargs.get("threads", 1), "out": kwargs.get("out") is not None,
-                      "columns": kwargs.get("columns") is not None or len(args) > 4})
+                      "columns": kwargs.get("columns") is not None or len(args) > 4,
+                      "samples": int(np.shape(args[1])[0])})
         return real(*args, **kwargs)
 
     with mock.patch.object(stacking, "identification_matrix", spy):
@@ -171,7 +173,11 @@ def whole_identifications(robot: rd.Robot, model: Any) -> dict[str, Any]:
                            "stacking_calls": {"count": len(calls),
                                               "threads": sorted({c["threads"] for c in calls}),
                                               "out": any(c["out"] for c in calls),
-                                              "columns": any(c["columns"] for c in calls)}}
+                                              "columns": any(c["columns"] for c in calls),
+                                              **{k: {"count": sum(c["out"] == o for c in calls),
+                                                     "samples": sum(c["samples"] for c in calls
+                                                                    if c["out"] == o)}
+                                                 for k, o in (("fresh", False), ("reused", True))}}}
     for method in ("ols", "wls", "consistent"):
         t0 = time.perf_counter()
         ident = rd.identify(robot, runs, target="current", method=method, model=model)
@@ -212,7 +218,8 @@ def print_entry(e: dict[str, Any]) -> None:
                   f"{m['decimate']}, {m['base_parameters']} base parameters)")
         c = i["stacking_calls"]
         print(f"  rd.identify (untimed OLS run) called identification_matrix {c['count']} times: threads "
-              f"{c['threads']}, out= {c['out']}, columns {c['columns']}")
+              f"{c['threads']}, fresh {c['fresh']['count']} ({c['fresh']['samples']} samples), "
+              f"out= {c['reused']['count']} ({c['reused']['samples']} samples), columns {c['columns']}")
 
 
 def main() -> None:

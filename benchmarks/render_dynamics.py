@@ -115,19 +115,28 @@ def _identify_rows(s: dict[str, Any]) -> list[list[str]]:
 
 def _stacking_path(e: dict[str, Any]) -> str:
     """The sentence on how ``rd.identify`` stacks, from the call the run watched."""
-    text = ("`rd.identify` stacks each recording's regressor through `regressor_rows_of`, which "
-            "calls `identification_matrix(model, q, qd, qdd)`: every column, one thread, a fresh "
-            "matrix (the first row).")
+    text = ("`rd.identify` stacks each recording's regressor for the fit through "
+            "`regressor_rows_of`, which calls `identification_matrix(model, q, qd, qdd)`: every "
+            "column, one thread, a fresh matrix (the first row); the model's own effort (the terms "
+            "fitted after the linear step, the predictions) goes through the same call a chunk of "
+            "samples at a time into one reused buffer (`out=`, the reused rows' case).")
     if "identifications" not in e:
         return text + " Not watched in this run (`--stacking-only`)."
     c = e["identifications"]["stacking_calls"]
     if not c["count"]:
         return ("In this run an untimed `rd.identify` made no call to `identification_matrix`: "
                 "the rows below do not time its stacking path.")
+    if "fresh" not in c:  # an entry written before the calls were told apart
+        return text + (
+            f" Watched in this run during an untimed `rd.identify`: {c['count']} calls, threads "
+            f"{', '.join(map(str, c['threads']))}, `out=` {'used' if c['out'] else 'never used'}, "
+            f"a column selection {'used' if c['columns'] else 'never used'}.")
+    f, r = c["fresh"], c["reused"]
     return text + (
         f" Watched in this run during an untimed `rd.identify`: {c['count']} calls, threads "
-        f"{', '.join(map(str, c['threads']))}, `out=` {'used' if c['out'] else 'never used'}, "
-        f"a column selection {'used' if c['columns'] else 'never used'}.")
+        f"{', '.join(map(str, c['threads']))}: {f['count']} into a fresh matrix "
+        f"({f['samples']:,} samples in all), {r['count']} into a reused buffer ({r['samples']:,} "
+        f"samples in all); a column selection {'used' if c['columns'] else 'never used'}.")
 
 
 def render_identify(data: dict[str, Any]) -> str:
