@@ -113,3 +113,30 @@ def test_candidates_differing_in_the_band_share_samples_and_regressor(model, mon
     shared.clear()
     shared.get([rec], Preprocess(cutoff=2.0, decimate=20, dead_band=0.0), "tau")
     assert calls == {"preprocess": 3, "regressor": 3}
+
+
+@pytest.mark.parametrize("irregular", [False, True])
+@pytest.mark.parametrize(("cutoff", "decimate"), [(None, 4), (2.0, 1), (2.0, 20)])
+def test_long_logs_evaluated_in_column_groups_give_the_same_bits(model, monkeypatch, irregular,
+                                                                 cutoff, decimate):
+    s = _samples(model.dof, irregular)
+    settings = Preprocess(cutoff=cutoff, decimate=decimate, dead_band=0.0)
+    whole = unbanded_rows(model, s, settings)
+    calls = []
+    real = pp.regressor_rows_of
+
+    def counted(*a, **k):
+        calls.append(np.shape(a[1])[0])
+        return real(*a, **k)
+
+    m = evaluation_step(s.t, settings, decimate)
+    count, n = s.q[::m].shape
+    # a budget of a fifth of the rows: 5 or 6 column groups, each evaluated 1/20 of the samples
+    # at a time
+    monkeypatch.setattr(pp, "ROWS_BYTES", count * n * 15 * n * 8 // 5)
+    monkeypatch.setattr(pp, "regressor_rows_of", counted)
+    grouped = unbanded_rows(model, s, settings)
+    assert len(calls) > 5 and max(calls) < count  # the grouped path ran, in blocks of samples
+    for name in ("rows", "t", "qd", "coulomb"):
+        np.testing.assert_array_equal(getattr(grouped, name), getattr(whole, name))
+    assert grouped.keep == whole.keep

@@ -70,6 +70,10 @@ MOVING_RAD = 1e-3
 DEAD_BAND = 1e-3
 #: Samples per cut-off period kept for the parallel filtering of the regressor.
 MID_RATE = 100
+#: Most bytes of regressor rows held at once before filtering (:func:`unbanded_rows`): longer
+#: logs are evaluated a group of columns at a time (each column is filtered on its own, so the
+#: rows are the same bits), and the groups' regressor a block of samples at a time.
+ROWS_BYTES = 2**30
 
 
 @dataclass(frozen=True)
@@ -316,13 +320,36 @@ class UnbandedRows:
 
 def unbanded_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool = True) -> UnbandedRows:
     """:func:`regressor_rows` of samples ``s`` without the dead band (``settings.dead_band`` is
-    not used), with the Coulomb columns :func:`banded_rows` needs."""
+    not used), with the Coulomb columns :func:`banded_rows` needs; at most about
+    :data:`ROWS_BYTES` of unfiltered rows held at once."""
     d = settings.decimate if decimate else 1
     m = evaluation_step(s.t, settings, d)
-    y = regressor_rows_of(model, s.q[::m], s.qd[::m], s.qdd[::m])
-    coulomb = np.stack([y[:, j, joint_columns(j, "Fcp", "Fcn")] for j in range(y.shape[1])], axis=1)
-    rows = filtered_rows(s.t[::m], y, settings, d // m)
-    return UnbandedRows(rows, s.t[::m], s.qd[::m], coulomb, d // m)
+    t, q, qd, qdd = s.t[::m], s.q[::m], s.qd[::m], s.qdd[::m]
+    count, n = q.shape
+    width = 15 * n
+    coulomb_cols = [joint_columns(j, "Fcp", "Fcn") for j in range(n)]
+    groups = -(-count * n * width * 8 // ROWS_BYTES)
+    if groups <= 1:
+        y = regressor_rows_of(model, q, qd, qdd)
+        coulomb = np.stack([y[:, j, coulomb_cols[j]] for j in range(n)], axis=1)
+        return UnbandedRows(filtered_rows(t, y, settings, d // m), t, qd, coulomb, d // m)
+    rows = np.empty((-(-count // (d // m)), n, width))
+    coulomb = np.empty((count, n, 2))
+    block = max(1, ROWS_BYTES // (4 * 8 * n * width))  # samples of regressor evaluated at once
+    buf = np.empty((min(block, count), n, width))
+    for g, cols in enumerate(np.array_split(np.arange(width), groups)):
+        cols = slice(int(cols[0]), int(cols[-1]) + 1)  # contiguous: a plain copy
+        part = np.empty((count, n, cols.stop - cols.start))
+        for a in range(0, count, block):
+            b = min(a + block, count)
+            # Y of samples a..b into the reused buffer; this group's columns kept
+            y = regressor_rows_of(model, q[a:b], qd[a:b], qdd[a:b], out=buf[:b - a])
+            part[a:b] = y[:, :, cols]
+            if g == 0:
+                for j in range(n):
+                    coulomb[a:b, j] = y[:, j, coulomb_cols[j]]
+        rows[:, :, cols] = filtered_rows(t, part, settings, d // m)
+    return UnbandedRows(rows, t, qd, coulomb, d // m)
 
 
 def banded_rows(u: UnbandedRows, settings: Preprocess) -> np.ndarray:
