@@ -54,7 +54,7 @@ from robodyn.identification.stacking import regressor_rows_of
 from robodyn.measure.angles import unwrap_turns
 from robodyn.measure.filtering import bandwidth_cutoff, differentiate, lowpass, lowpass_columns
 from robodyn.robot.errors import IdentificationError
-from robodyn.symbolic.regressor import joint_columns
+from robodyn.symbolic.regressor import PER_JOINT, joint_columns
 
 __all__ = ["AUTO_MAX_HZ", "AUTO_MIN_HZ", "DEAD_BAND", "MID_RATE", "MOVING_RAD", "Preprocess",
            "Samples", "SharedRows", "UnbandedRows", "auto_cutoff", "banded_rows",
@@ -326,7 +326,7 @@ def unbanded_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool =
     m = evaluation_step(s.t, settings, d)
     t, q, qd, qdd = s.t[::m], s.q[::m], s.qd[::m], s.qdd[::m]
     count, n = q.shape
-    width = 15 * n
+    width = PER_JOINT * n  # the regressor's columns (regressor_rows_of)
     coulomb_cols = [joint_columns(j, "Fcp", "Fcn") for j in range(n)]
     groups = -(-count * n * width * 8 // ROWS_BYTES)
     if groups <= 1:
