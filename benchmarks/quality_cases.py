@@ -37,7 +37,9 @@ class Case:
 
 
 def kuka_cases() -> list[Case]:
-    """The KUKA LWR4+ splits: run 1 -> run 2, runs 1+2 -> run 3, run 1 -> run 3 (joint torque)."""
+    """The KUKA LWR4+ splits: run 1 -> run 2, runs 1+2 -> run 3, run 1 -> run 3, and the last 30 %
+    of the runs (pooled, as the Kinova's 70/30 row, and of run 1 alone, as issue 20's
+    torque-sensing arm is validated on the held-out part of one run); joint torque."""
     urdf = str(KUKA / "kuka_lwr4.urdf")
     robot = rd.load(urdf)
 
@@ -47,11 +49,17 @@ def kuka_cases() -> list[Case]:
                             joint_names=robot.joint_names, source=f"kuka run {k}")
 
     r = {k: run(k) for k in (1, 2, 3)}
+    halves = {k: split(rec) for k, rec in r.items()}
     return [Case("KUKA run 1 -> run 2", robot, urdf, [r[1]], [r[2]], "tau",
                  "the same trajectory, another run; joint torque sensors"),
             Case("KUKA runs 1+2 -> run 3", robot, urdf, [r[1], r[2]], [r[3]], "tau",
                  "another trajectory"),
-            Case("KUKA run 1 -> run 3", robot, urdf, [r[1]], [r[3]], "tau", "another trajectory")]
+            Case("KUKA run 1 -> run 3", robot, urdf, [r[1]], [r[3]], "tau", "another trajectory"),
+            Case("KUKA 70/30 pooled", robot, urdf, [h[0] for h in halves.values()],
+                 [h[1] for h in halves.values()], "tau",
+                 "first 70 % of each of the three runs -> the last 30 %"),
+            Case("KUKA run 1 70/30", robot, urdf, [halves[1][0]], [halves[1][1]], "tau",
+                 "first 70 % of run 1 -> its last 30 % (7.5 s)")]
 
 
 def kinova_cases() -> list[Case]:

@@ -20,7 +20,8 @@ from tests.readme_results import section_data as _data
 ROOT = Path(__file__).resolve().parent.parent
 NAME = "identification_quality"
 #: Rows of a full run (``--quick`` runs three of them).
-FULL_ROWS = 13  # 3 KUKA, 4 Kinova (the torque-sensor run since 2026-12-07), 6 virtual
+FULL_ROWS = 15  # 5 KUKA (the 70/30 rows since 2026-12-07), 4 Kinova (the torque-sensor run
+# since 2026-12-07), 6 virtual
 FIGURES = ("raw", "filtered")
 
 
