@@ -121,7 +121,11 @@ METHODS: Sequence[tuple[str, dict, str]] = (
      "at least 1e-3 rad/s where a joint is held); gross glitches (one-sample spikes, bursts "
      "of 3-5 rows) of the fit data dropped (spikes='auto'); a held-out recording that moves "
      "faster than the fit data predicted at its own motion band (prediction_cutoff='motion', "
-     "since 2026-12-06)"),
+     "since 2026-12-06), and the residual's local correction near the fit data's states "
+     "(local='auto', since 2026-12-07)"),
+    ("no local correction", {"local": False},
+     "the default without the local correction of the residual (local=False): the default "
+     "before 2026-12-07"),
     ("no Coulomb smoothing", {"coulomb_width": 0.0},
      "the default with the Coulomb step kept in predictions (coulomb_width=0): the default of "
      "the previous version"),
@@ -147,14 +151,16 @@ def _figures(res: tuple[float, float, float]) -> dict[str, float]:
 
 
 def _choices(ident: Any) -> dict[str, Any] | None:
-    """What the default chose (velocity, cut-off, weight, friction law, ripple), as plain data."""
+    """What the default chose (velocity, cut-off, weight, friction law, ripple, drive modes,
+    Coulomb smoothing, local correction), as plain data."""
     c = ident.choices
     if c is None:
         return None
     return {"velocity": c.velocity, "cutoff_hz": c.cutoff, "regularization": c.regularization,
             "friction": c.friction, "ripple": c.ripple, "candidates": len(c.candidates),
             "modes": [[name, f0, zeta, round(gain, 3)] for name, f0, zeta, gain in c.resonance_modes],
-            "coulomb_width": [float(f"{w:.3g}") for w in np.atleast_1d(ident.coulomb_width)]}
+            "coulomb_width": [float(f"{w:.3g}") for w in np.atleast_1d(ident.coulomb_width)],
+            "local": list(c.local_setting[0]) if c.local_setting else None}
 
 
 def run_case(case: Case, rows: list[list[str]]) -> dict[str, Any]:

@@ -74,8 +74,11 @@ def _choices(c: dict[str, Any] | None) -> str:
     widths = [w for w in c.get("coulomb_width", []) if w > 0]
     smooth = ("" if not widths else f", Coulomb step smoothed over {min(widths):.2g}"
               + ("" if max(widths) == min(widths) else f"-{max(widths):.2g}") + " rad/s")
+    local = c.get("local")  # entries since 2026-12-07: [length, ridge] or None
+    corr = ("" if "local" not in c else ", no local correction" if local is None
+            else f", local correction kept (length {local[0]:g} sd, ridge {local[1]:g})")
     return (f"{c['velocity']} velocity, {cut}, weight {c['regularization']:.3g}{friction}{ripple}"
-            f"{drive}{smooth} (of {c['candidates']} preprocessing candidates)")
+            f"{drive}{smooth}{corr} (of {c['candidates']} preprocessing candidates)")
 
 
 def _best_other(models: dict[str, Any], figure: str) -> str:

@@ -57,7 +57,7 @@ def planar_run():
 def _identify(robot, model, rec, **kwargs):
     return rd.identify(robot, rec, method="ols", cutoff=None, regularization=None, model=model,
                        velocity="measured", ripple=False, resonance=False, friction="linear",
-                       **kwargs)
+                       local=False, **kwargs)
 
 
 def test_width_smooths_the_prediction_and_not_the_fit(planar_run):

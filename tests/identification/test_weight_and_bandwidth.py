@@ -72,9 +72,9 @@ def fast_run():
 def test_auto_prediction_cutoff_widens_to_the_motion_and_predicts_it_better(fast_run):
     robot, model, rec, tau = fast_run
     fit = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False, resonance=False,
-                      friction="linear")
+                      friction="linear", local=False)
     auto = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False, resonance=False,
-                       friction="linear", prediction_cutoff="auto")
+                       friction="linear", prediction_cutoff="auto", local=False)
     assert fit.choices.prediction_cutoff is None and fit.prediction is None
     # the motion reaches 6 Hz: the chosen cut-off is wider than the fit's
     assert auto.choices.prediction_cutoff > 1.5
@@ -87,7 +87,7 @@ def test_auto_prediction_cutoff_widens_to_the_motion_and_predicts_it_better(fast
     np.testing.assert_array_equal(auto.standard, fit.standard)
     # a fixed cut-off is used as given
     fixed = rd.identify(robot, rec, target="tau", cutoff=1.5, model=model, ripple=False, resonance=False,
-                        friction="linear", prediction_cutoff=9.0)
+                        friction="linear", prediction_cutoff=9.0, local=False)
     assert fixed.prediction_settings.cutoff == 9.0 and fixed.preprocess.cutoff == 1.5
     # a cut-off given to predict alone: the same prediction as a fit whose band it is, closer to
     # the noise-free torque than the fit's 1.5 Hz band, and the parameters untouched

@@ -138,7 +138,7 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                             spikes=args.spikes, cutoff=args.cutoff,
                             regularization=args.regularization, decimate=args.decimate,
                             sensor=args.sensor, ripple=args.ripple, resonance=args.resonance,
-                            prediction_cutoff=args.prediction_cutoff, **extra)
+                            prediction_cutoff=args.prediction_cutoff, local=args.local, **extra)
     paths = {"yaml": out / f"{stem}.yaml", "urdf": out / f"{stem}.urdf",
              "parameters": out / "parameters.csv"}
     paths["yaml"].write_text(dump_yaml(ident.robot), encoding="utf-8")
@@ -198,7 +198,7 @@ def _prediction_note(ident: Any, yaml_path: Path, recs: Sequence[Any]) -> str:
             + (f", Coulomb dead band {pre.dead_band:g} rad/s" if pre.dead_band else "")
             + _smoothing_note(ident.coulomb_width))
     fits = (ident.friction_fit, ident.thermal_fit, ident.ripple_fit, ident.resonance_fit,
-            ident.prediction)
+            ident.prediction, ident.local_fit)
     if pre.velocity == "position" and pre.cutoff is not None and not pre.dead_band and not wider \
             and not np.any(ident.coulomb_width) and all(f is None for f in fits):
         note += (f"; robodyn validate {yaml_path} --target {ident.target} --cutoff "
@@ -508,6 +508,11 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
                         "current loop) added to the prediction, its frequency, damping and share "
                         "fitted on what the model leaves: on, off, or auto: kept on a joint when "
                         "it predicts held-out time blocks better (default: %(default)s)")
+    p.add_argument("--local", type=_auto_on_off, default="auto", metavar="{auto,on,off}",
+                   help="a kernel correction of what the model leaves near the identification "
+                        "data's states, zero far from them (a repeated trajectory is predicted "
+                        "with it, new motion by the model alone): on, off, or auto: kept when it "
+                        "predicts held-out time blocks better (default: %(default)s)")
     p.add_argument("--prediction-cutoff", type=_prediction_cutoff, default="motion",
                    metavar="{motion,fit,auto,HZ}",
                    help="low-pass cut-off of the states the model is evaluated at in predictions: "

@@ -135,6 +135,14 @@ class Choices:
         Relative held-out error of the target without and with the modes.
     resonance_modes : tuple of (str, float, float, float)
         Each kept mode: joint name, frequency (Hz), damping ratio, share.
+    local : bool or None
+        Whether ``local="auto"`` (or True) kept the local correction of the residual
+        (:mod:`robodyn.identification.local_residual`), else None.
+    local_scores : tuple of (str, float)
+        Relative held-out error of the residual without and with the correction.
+    local_setting : tuple of (float, float)
+        The kept correction's kernel length (standard deviations) and ridge weight; empty when
+        none is kept.
     """
 
     velocity: str
@@ -154,6 +162,9 @@ class Choices:
     resonance: bool | None = None
     resonance_scores: tuple[tuple[str, float], ...] = ()
     resonance_modes: tuple[tuple[str, float, float, float], ...] = ()
+    local: bool | None = None
+    local_scores: tuple[tuple[str, float], ...] = ()
+    local_setting: tuple[tuple[float, float], ...] = ()
 
     @property
     def friction_reason(self) -> str:
@@ -184,6 +195,12 @@ class Choices:
                          f"blocks of the target: {scores})")
             lines += [f"    {name}: {f0:g} Hz, damping {zeta:g}, share {gain:.3g}"
                       for name, f0, zeta, gain in self.resonance_modes]
+        if self.local is not None:
+            scores = ", ".join(f"{k} {v:.4f}" for k, v in self.local_scores)
+            kept = (f"kept, kernel length {self.local_setting[0][0]:g} sd, ridge "
+                    f"{self.local_setting[0][1]:g}" if self.local else "not kept")
+            lines.append(f"  local correction of the residual {kept} (held-out blocks of the "
+                         f"residual: {scores})")
         if self.prediction_cutoff is not None:
             scores = ", ".join(f"{k} {v:.4f}" for k, v in self.prediction_scores)
             lines.append(f"  prediction cut-off {self.prediction_cutoff:g} Hz (raw target of the "

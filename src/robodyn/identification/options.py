@@ -112,6 +112,12 @@ class IdentifyOptions:
         wider ones on the identification recordings against their raw target and keeps a wider
         one only when it is better by more than one standard error (lower error against the raw
         target, higher against a low-passed one: see the module).
+    local : bool or "auto"
+        A kernel correction of the residual near the identification data's states, zero far
+        from them (:mod:`robodyn.identification.local_residual`): what the model repeatably
+        misses where the arm passes again; "auto": kept only when it predicts held-out time
+        blocks of the residual better than none by one standard error; True: the best setting
+        of its grid; False: none.
 
     Raises
     ------
@@ -137,6 +143,7 @@ class IdentifyOptions:
     ripple: bool | str = "auto"
     resonance: bool | str = "auto"
     prediction_cutoff: float | str = "motion"
+    local: bool | str = "auto"
 
     def __post_init__(self) -> None:
         _choice("method", self.method, METHODS)
@@ -160,7 +167,7 @@ class IdentifyOptions:
                                       f"[0, 1000) rad/s, got {cw!r}")
         _choice("gains", self.gains, ("auto", "description", "absorbed"))
         _choice("spikes", self.spikes, SPIKES)
-        for name in ("ripple", "resonance"):
+        for name in ("ripple", "resonance", "local"):
             value = getattr(self, name)
             if not any(value is v for v in (False, True)) and value != "auto":
                 raise IdentificationError(f"{name}: expected False, True or 'auto', got {value!r}")

@@ -125,7 +125,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
              payloads: Sequence[Payload | None] | None = None, weights: str = "residual",
              state_noise: Any = None, thermal: bool | str = False, sensor: str = "motor",
              spikes: str = "auto", ripple: bool | str = "auto", resonance: bool | str = "auto",
-             prediction_cutoff: float | str = "motion",
+             prediction_cutoff: float | str = "motion", local: bool | str = "auto",
              options: IdentifyOptions | None = None) -> Identification:
     """Identify the base inertial, drive and friction parameters of a robot from recordings.
 
@@ -144,7 +144,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         :class:`~robodyn.identification.options.IdentifyOptions` (what each does, its values
         and default). ``method``: "ols", "wls" or "consistent" (default).
     gains, bounds, weights, state_noise, thermal, sensor, spikes, ripple, resonance,
-    prediction_cutoff
+    prediction_cutoff, local
         Likewise.
     model : Model, optional
         A compiled model of ``robot`` to reuse (default ``rd.compile_model(robot)``).
@@ -173,7 +173,7 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
         decimate=decimate, velocity=velocity, dead_band=dead_band, coulomb_width=coulomb_width,
         gains=gains, bounds=bounds, weights=weights, state_noise=state_noise, thermal=thermal,
         sensor=sensor, spikes=spikes, ripple=ripple, resonance=resonance,
-        prediction_cutoff=prediction_cutoff),
+        prediction_cutoff=prediction_cutoff, local=local),
         IdentificationError)
     recs, target, pays = checked_inputs(robot, recordings, target, opts.sensor, payloads)
     observed = observed_joints(recs, target)

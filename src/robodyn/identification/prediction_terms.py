@@ -8,8 +8,10 @@ linear friction), in this order:
 2. the position ripple (:mod:`robodyn.identification.ripple`);
 3. the prediction's cut-off (:mod:`robodyn.identification.bandwidth`);
 4. the drive modes (:mod:`robodyn.identification.resonance`);
-5. last, the smoothed Coulomb step (:mod:`robodyn.identification.coulomb_width`): the fit and every
-   choice above are made with the step.
+5. the smoothed Coulomb step (:mod:`robodyn.identification.coulomb_width`): the fit and every
+   choice above are made with the step;
+6. last, the local correction of what the whole prediction leaves
+   (:mod:`robodyn.identification.local_residual`).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from robodyn.identification.bandwidth import with_prediction_cutoff
 from robodyn.identification.coulomb_width import auto_coulomb_width
 from robodyn.identification.friction import NONLINEAR, fit_friction_samples
 from robodyn.identification.friction_choice import choose_friction_law
+from robodyn.identification.local_residual import with_local_residual
 from robodyn.identification.options import IdentifyOptions
 from robodyn.identification.preprocess import Preprocess, Samples
 from robodyn.identification.resonance import with_resonance
@@ -49,7 +52,7 @@ def with_prediction_terms(result: Identification, recs: Sequence[Any], pays: Seq
         The fit's recordings and their payloads (None: none).
     target : {"tau", "current"}
     opts : IdentifyOptions
-        The run's options (``friction``, ``ripple``, ``prediction_cutoff``, ``resonance``,
+        The run's options (``friction``, ``ripple``, ``prediction_cutoff``, ``resonance``, ``local``,
         ``coulomb_width``); stored as ``result.options``.
     samples : sequence of Samples
         The fit's processed, decimated samples, (N_k, n).
@@ -88,4 +91,5 @@ def with_prediction_terms(result: Identification, recs: Sequence[Any], pays: Seq
     # last: the prediction's Coulomb step smoothed (the fit and every choice made with the step)
     width = (auto_coulomb_width(recs, result.preprocess) if opts.coulomb_width == "auto"
              else float(opts.coulomb_width))
-    return replace(result, options=opts, coulomb_width=width)
+    result = replace(result, options=opts, coulomb_width=width)
+    return with_local_residual(result, recs, pays, target, opts.local)

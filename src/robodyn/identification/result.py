@@ -14,6 +14,7 @@ from robodyn.identification.base import BaseRelations
 from robodyn.identification.choices import Choices
 from robodyn.identification.coulomb_width import held_widths
 from robodyn.identification.friction import FrictionFit, without_friction
+from robodyn.identification.local_residual import LocalResidualFit, local_features
 from robodyn.identification.options import IdentifyOptions, positive_frequency
 from robodyn.identification.preprocess import (
     Preprocess,
@@ -177,6 +178,10 @@ class Identification:
         Joints without target data in any recording (an all-NaN column: no sensor,
         :mod:`robodyn.identification.unobserved`): their rows were not fitted, their own terms
         are the description's, and :meth:`predict` gives the model's value for them.
+    local_fit : LocalResidualFit or None
+        A kernel correction of the residual near the identification data's states
+        (:mod:`robodyn.identification.local_residual`): :meth:`predict` adds it; it vanishes
+        far from those states; ``robot`` does not carry it.
     """
 
     robot: Robot
@@ -206,6 +211,7 @@ class Identification:
     coulomb_width: float | np.ndarray = 0.0
     hydro: Any = None
     unobserved: tuple[str, ...] = ()
+    local_fit: LocalResidualFit | None = None
 
     @property
     def gains_identified(self) -> bool:
@@ -249,6 +255,15 @@ class Identification:
         IdentificationError
             A recording that does not fit the robot, or ``cutoff`` outside (0, Nyquist).
         """
+        s = self.prediction_samples(recording, cutoff)
+        out = self._model_prediction(recording, s, payload)
+        if self.local_fit is not None:  # + k(x, U) a: the residual where the data were
+            out = out + self.local_fit.correction(local_features(s.q, s.qd, s.qdd))
+        return out
+
+    def prediction_samples(self, recording: Any, cutoff: float | None = None) -> Samples:
+        """The recording's states as :meth:`predict` processes them (its cut-off: as there),
+        (N, n) each."""
         from robodyn.identification.inputs import check_recording
 
         check_recording(self.robot, recording, 0, None)
@@ -257,8 +272,11 @@ class Identification:
             cut = positive_frequency(cutoff, "prediction_cutoff")
             check_prediction_cutoff([recording], cut)
             settings = replace(settings, cutoff=cut)
+        return preprocess(recording, settings, None)
+
+    def _model_prediction(self, recording: Any, s: Samples, payload: Any) -> np.ndarray:
+        """:meth:`predict` without the local correction, ``s`` the processed states (N, n)."""
         temp = temperatures(recording, 0, self.robot.dof) if self.thermal_fit is not None else None
-        s = preprocess(recording, settings, None)
         plain = self.effort(s, temp, payload)
         if self.resonance_fit is None:
             return plain
