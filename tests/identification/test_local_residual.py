@@ -56,6 +56,19 @@ def test_recovers_a_smooth_residual_and_vanishes_far_from_the_data():
     assert np.max(np.abs(fit.correction(far))) < 1e-12
 
 
+def test_long_recordings_are_thinned_evenly(monkeypatch):
+    import robodyn.identification.local_residual as local
+
+    monkeypatch.setattr(local, "MAX_ROWS", 1500)  # two recordings of 2000 rows: 750 rows each
+    t = np.arange(0.0, 20.0, 0.01)
+    x1, x2 = _states(t, 10.0), _states(t + 0.005, 10.0)
+    fit, _ = fit_local_residual([x1, x2], [_smooth(x1), _smooth(x2)], True)
+    assert fit is not None and len(fit.inducing) == min(local.INDUCING, 1500)
+    xc = _states(np.arange(0.0025, 10.0, 0.01), 10.0)
+    err = np.linalg.norm(fit.correction(xc) - _smooth(xc)) / np.linalg.norm(_smooth(xc))
+    assert err < 0.1
+
+
 def test_noise_alone_is_not_kept():
     rng = np.random.default_rng(1)
     t = np.arange(0.0, 20.0, 0.01)

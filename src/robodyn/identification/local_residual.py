@@ -16,7 +16,7 @@ of length ``ell`` (in standard deviations) and a zero prior mean: far from the d
 kernel value small) it vanishes, and the prediction is the model's. The semi-parametric model of
 Nguyen-Tuong and Peters, "Using model knowledge for learning inverse dynamics" (ICRA 2010), with
 the physical model as the mean. For cost it is a Nystrom approximation on ``m`` states evenly
-spaced in time (:data:`INDUCING`), fitted on at most :data:`MAX_ROWS` rows evenly spaced::
+spaced in time (:data:`INDUCING`), fitted on at most :data:`MAX_ROWS` rows in all, evenly spaced::
 
     r(x) = k(x, U) a,   a = (K_nm^T K_nm + rho N K_mm)^-1 K_nm^T R
 
@@ -50,8 +50,9 @@ LENGTH_GRID = (1.0, 1.5, 2.0)
 RIDGE_GRID = (1e-5, 1e-4, 1e-3)
 #: Nystrom states (at most).
 INDUCING = 400
-#: Identification rows the correction is fitted on (at most; evenly spaced).
-MAX_ROWS = 20000
+#: Identification rows the correction is fitted on, all recordings together (at most; each
+#: recording's share evenly spaced).
+MAX_ROWS = 10000
 #: Rows of the kernel evaluated at a time (bounds the memory of a long prediction).
 CHUNK = 8192
 
@@ -63,8 +64,13 @@ def local_features(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray
 
 def _kernel(a: np.ndarray, b: np.ndarray, ell: float) -> np.ndarray:
     """Gaussian kernel ``exp(-|a_i - b_j|^2 / (2 ell^2))`` of standardised states, (N_a, N_b)."""
-    d2 = (a * a).sum(axis=1)[:, None] + (b * b).sum(axis=1)[None, :] - 2.0 * (a @ b.T)
-    return np.exp(-0.5 * np.maximum(d2, 0.0) / (ell * ell))
+    k = a @ b.T  # in place from here: the (N_a, N_b) array is the only large one
+    k *= -2.0
+    k += (a * a).sum(axis=1)[:, None]
+    k += (b * b).sum(axis=1)[None, :]
+    np.maximum(k, 0.0, out=k)  # |a - b|^2, rounding below 0 clipped
+    k *= -0.5 / (ell * ell)
+    return np.exp(k, out=k)
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,9 +109,13 @@ class LocalResidualFit:
         return out
 
 
-def _rows(count: int) -> np.ndarray:
-    """At most MAX_ROWS indices of ``count``, evenly spaced."""
-    return np.arange(count) if count <= MAX_ROWS else np.linspace(0, count - 1, MAX_ROWS).round().astype(int)
+def _rows(count: int, total: int) -> np.ndarray:
+    """Indices of a recording of ``count`` rows, evenly spaced: all of them when the recordings
+    hold ``total <= MAX_ROWS`` rows together, else its share of MAX_ROWS."""
+    if total <= MAX_ROWS:
+        return np.arange(count)
+    share = max(1, int(round(MAX_ROWS * count / total)))
+    return np.unique(np.linspace(0, count - 1, share).round().astype(int))
 
 
 def fit_local_residual(features: Sequence[np.ndarray], residuals: Sequence[np.ndarray],
@@ -129,8 +139,9 @@ def fit_local_residual(features: Sequence[np.ndarray], residuals: Sequence[np.nd
         (1) and ``"local"`` (the best setting's), over the held-out time blocks of all joints.
     """
     xs, rs, bs = [], [], []
+    total = sum(len(x) for x in features)
     for k, (x, r) in enumerate(zip(features, residuals, strict=True)):
-        idx = _rows(len(x))
+        idx = _rows(len(x), total)
         ok = np.all(np.isfinite(x[idx]), axis=1)
         xs.append(x[idx][ok])
         rs.append(np.nan_to_num(np.asarray(r, float)[idx][ok], nan=0.0, posinf=0.0, neginf=0.0))
@@ -216,9 +227,10 @@ def with_local_residual(ident: Any, recordings: Sequence[Any], payloads: Sequenc
     pays = list(payloads) if payloads is not None else [None] * len(recordings)
     features, residuals = [], []
     for rec, pay in zip(recordings, pays, strict=True):
-        s = ident.prediction_samples(rec)
+        s = ident.prediction_samples(rec)  # the states predict() processes, processed once
         features.append(local_features(s.q, s.qd, s.qdd))
-        residuals.append(np.asarray(target_signal(rec, target), float) - ident.predict(rec, pay))
+        residuals.append(np.asarray(target_signal(rec, target), float)
+                         - ident._model_prediction(rec, s, pay))
     fit, scores = fit_local_residual(features, residuals, option)
     setting = () if fit is None else ((fit.length, fit.ridge),)
     choices = (replace(ident.choices, local=fit is not None, local_scores=tuple(scores.items()),
