@@ -165,11 +165,16 @@ def test_identify_prints_and_reports_the_friction_and_ripple_choices(files, tmp_
     assert rc == 0  # the default, physically consistent, writes a description that loads
     assert "friction law linear" in out or "friction law stribeck" in out
     assert "position ripple kept" in out or "position ripple not kept" in out
+    assert "local correction of the residual " in out and "(held-out blocks of the residual: none" in out
     page = (tmp_path / "report.html").read_text(encoding="utf-8")
     assert "Friction law <b>" in page and "Position ripple (a sin q + b cos q per joint) <b>" in page
+    assert "Local correction of the residual (a kernel regression" in page
     rc = main(["identify", "puma560", "--data", str(train), "--cutoff", "none", "--ripple", "off",
                "--no-report", "-o", str(tmp_path / "off")])
     assert rc == 0 and "position ripple" not in capsys.readouterr().out
+    rc = main(["identify", "puma560", "--data", str(train), "--cutoff", "none", "--local", "off",
+               "--no-report", "-o", str(tmp_path / "no-local")])
+    assert rc == 0 and "local correction" not in capsys.readouterr().out
     with pytest.raises(SystemExit) as exc:
         main(["identify", "puma560", "--data", str(train), "--ripple", "maybe", "-o", str(tmp_path)])
     assert exc.value.code == 2
@@ -301,11 +306,12 @@ def test_validate_and_underwater_without_a_c_compiler(files, tmp_path, monkeypat
 def test_validate_on_the_written_description_gives_identify_figures(files, tmp_path, capsys):
     # issue 25 item 3: one model, one verdict
     train, held = files
-    # a written description carries no drive modes, nonlinear friction law or smoothed Coulomb
-    # step: only a model without them is reproduced from it, so they are switched off
+    # a written description carries no drive modes, nonlinear friction law, smoothed Coulomb
+    # step or local correction: only a model without them is reproduced from it, so they are
+    # switched off
     rc = main(["identify", "puma560", "--data", str(train), "--validate", str(held), "--method",
                "consistent", "--velocity", "position", "--friction", "linear", "--resonance", "off",
-               "--coulomb-width", "0", "--no-report", "-o", str(tmp_path / "id")])
+               "--coulomb-width", "0", "--local", "off", "--no-report", "-o", str(tmp_path / "id")])
     out = capsys.readouterr().out
     assert rc in (0, 1)
     hint = out.split("robodyn validate ")[1].split(" reproduces")[0].split()
