@@ -163,8 +163,8 @@ def fit_local_residual(features: Sequence[np.ndarray], residuals: Sequence[np.nd
         for i, rho in enumerate(RIDGE_GRID):
             if err[i].sum() < best[0]:
                 best = (float(err[i].sum()), (ell, rho), err[i])
-    total, setting, err = best
-    scores = {"none": 1.0, "local": float(np.sqrt(total / max(none.sum(), 1e-300)))}
+    least, setting, err = best
+    scores = {"none": 1.0, "local": float(np.sqrt(least / max(none.sum(), 1e-300)))}
     d = err - none
     if setting is None or (keep == "auto" and not d.sum() < -paired_se(d)):
         return None, scores
