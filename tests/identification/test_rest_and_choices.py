@@ -134,21 +134,32 @@ def _velocity_case(model, seed: int, quantum: float, qd_noise: float) -> rd.Reco
                         joint_names=model.robot.joint_names, source=f"v{seed}")
 
 
-def test_velocity_source_chosen_by_held_out_blocks(planar):
+def test_velocity_source_chosen_by_the_finished_models(planar):
+    """Coarse encoder with a clean tachometer, and a fine encoder with a very noisy one: the
+    source kept is the one whose finished model leaves the smaller residual on the fit data,
+    each source's own model finished (both residuals reported), and it is the source the data
+    favour by construction."""
     robot, model = planar
-    # coarse encoder, clean tachometer: the measured velocity predicts better
     coarse = _velocity_case(model, 7, quantum=0.02, qd_noise=0.0)
     ident = rd.identify(robot, coarse, model=model, velocity="auto", cutoff=5.0)
     assert ident.choices.velocity == "measured"
     assert ident.preprocess.velocity == "measured"
     assert len(ident.choices.candidates) == 2
-    # fine encoder, very noisy tachometer: position differences
+    scores = dict(ident.choices.velocity_scores)
+    assert set(scores) == {"measured", "position"} and scores["measured"] < scores["position"]
+    assert "velocity source measured (residual of each source's model" in ident.choices.summary()
+    # each source's residual is that of the model identified with it alone
+    alone = rd.identify(robot, coarse, model=model, velocity="position", cutoff=5.0, local=False)
+    y = coarse.tau
+    assert scores["position"] == pytest.approx(
+        np.linalg.norm(y - alone.predict(coarse)) / np.linalg.norm(y), rel=1e-9)
     noisy = _velocity_case(model, 8, quantum=0.0, qd_noise=2.0)
     ident = rd.identify(robot, noisy, model=model, velocity="auto", cutoff=5.0)
     assert ident.choices.velocity == "position"
-    scores = {c.velocity: c.score for c in ident.choices.candidates}
+    scores = dict(ident.choices.velocity_scores)
     assert scores["position"] < scores["measured"]
-    assert "held-out" in ident.choices.summary()
+    blocks = {c.velocity: c.score for c in ident.choices.candidates}
+    assert blocks["position"] < blocks["measured"]  # the held-out blocks agree here
 
 
 def test_a_fixed_setting_is_reported_as_given(planar):

@@ -260,13 +260,15 @@ def test_consistent_program_keeps_the_data_base_parameters_when_the_truth_is_ins
 def test_consistent_program_goes_on_where_the_solver_fails(monkeypatch, failing_call):
     """Clarabel failing in stage 1 (call 1: the program is tried again with a larger uniqueness
     weight) or in stage 2 (call 2: stage 1's set is kept) still gives a consistent estimate whose
-    base parameters are those of the undisturbed run to within their standard deviations."""
+    base parameters are those of the undisturbed run to within their standard deviations. One
+    velocity source (with "auto" each source's model is finished: two programs)."""
     import cvxpy as cp
 
     robot = load_quiet("planar_2r")
     model = rd.compile_model(robot)
     rec, _ = simulated(model, seconds=6.0, dt=0.02, seed=5, noise=0.05)
-    reference = rd.identify(robot, rec, method="consistent", cutoff=None, regularization=None, model=model)
+    one = dict(method="consistent", cutoff=None, regularization=None, model=model, velocity="measured")
+    reference = rd.identify(robot, rec, **one)
     calls = []
     solve = cp.Problem.solve
 
@@ -277,7 +279,7 @@ def test_consistent_program_goes_on_where_the_solver_fails(monkeypatch, failing_
         return solve(self, *args, **kwargs)
 
     monkeypatch.setattr(cp.Problem, "solve", failing)
-    ident = rd.identify(robot, rec, method="consistent", cutoff=None, regularization=None, model=model)
+    ident = rd.identify(robot, rec, **one)
     assert len(calls) == (3 if failing_call == 1 else 2)
     for j in range(robot.dof):
         assert np.linalg.eigvalsh(pseudo_inertia(ident.standard, j)).min() > 0

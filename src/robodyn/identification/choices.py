@@ -143,6 +143,10 @@ class Choices:
     local_setting : tuple of (float, float)
         The kept correction's kernel length (standard deviations) and ridge weight; empty when
         none is kept.
+    velocity_scores : tuple of (str, float)
+        With ``velocity="auto"`` and a recorded velocity: each source's relative residual of
+        its finished model on the identification recordings' raw target
+        (:mod:`robodyn.identification.velocity_choice`); empty otherwise.
     """
 
     velocity: str
@@ -165,6 +169,7 @@ class Choices:
     local: bool | None = None
     local_scores: tuple[tuple[str, float], ...] = ()
     local_setting: tuple[tuple[float, float], ...] = ()
+    velocity_scores: tuple[tuple[str, float], ...] = ()
 
     @property
     def friction_reason(self) -> str:
@@ -180,6 +185,10 @@ class Choices:
         lines = [f"velocity {self.velocity}, Coulomb dead band {self.dead_band:g} rad/s, cut-off "
                  f"{cut}, regularization {self.regularization:g}"
                  + (", thermal friction" if self.thermal else "") + f": {self.reason}"]
+        if self.velocity_scores:
+            scores = ", ".join(f"{k} {v:.4f}" for k, v in self.velocity_scores)
+            lines.append(f"  velocity source {self.velocity} (residual of each source's model on "
+                         f"the identification recordings: {scores})")
         if self.friction is not None:
             lines.append(f"  friction law {self.friction} ({self.friction_reason})")
         if self.ripple is not None and not self.ripple_scores:
@@ -265,22 +274,29 @@ def candidates(velocity: str, dead_band: float | str, thermal: bool | str, measu
 
 
 def choose(cands: Sequence[Candidate], stacked: Callable[[Candidate], Problem]
-           ) -> tuple[Candidate, Problem, list[Candidate]]:
-    """Score each candidate and return the best, its problem and every scored candidate.
+           ) -> tuple[list[tuple[Candidate, Problem, list[Candidate]]], list[Candidate]]:
+    """Score each candidate and return the best of each velocity source, and every one scored.
+
+    Within the candidates of one velocity source, the first (plain) one is kept unless another
+    predicts the held-out blocks better by more than one standard error of the paired block
+    differences; between sources, :mod:`robodyn.identification.velocity_choice` decides on the
+    finished models.
 
     Parameters
     ----------
     cands : sequence of Candidate
     stacked : callable
-        ``stacked(candidate) -> Problem``; the winner's is returned so that the caller need not
+        ``stacked(candidate) -> Problem``; each winner's is returned so that the caller need not
         build it again.
 
     Returns
     -------
-    (Candidate, Problem, list of Candidate)
+    (list of (Candidate, Problem, list of Candidate), list of Candidate)
+        Per velocity source, in the order of ``cands``: its winner, the winner's problem and its
+        scored candidates; and every scored candidate.
     """
     if len(cands) == 1:
-        return cands[0], stacked(cands[0]), list(cands)
+        return [(cands[0], stacked(cands[0]), list(cands))], list(cands)
     scored, problems, blocks_err = [], [], []
     for cand in cands:
         pr = stacked(cand)
@@ -295,13 +311,17 @@ def choose(cands: Sequence[Candidate], stacked: Callable[[Candidate], Problem]
                               lam=float(LAMBDA_GRID[k])))
         blocks_err.append(per_block[:, k])
         problems.append(pr)
-    best = 0
-    for i in range(1, len(scored)):
-        # paired difference of the block errors against the plain candidate, and its SE
-        d = blocks_err[i] - blocks_err[0]
-        if d.sum() < -paired_se(d) and scored[i].score < scored[best].score:
-            best = i
-    return scored[best], problems[best], scored
+    out = []
+    for velocity in dict.fromkeys(c.velocity for c in cands):
+        group = [i for i, c in enumerate(cands) if c.velocity == velocity]
+        best = group[0]
+        for i in group[1:]:
+            # paired difference of the block errors against the group's plain candidate, its SE
+            d = blocks_err[i] - blocks_err[group[0]]
+            if d.sum() < -paired_se(d) and scored[i].score < scored[best].score:
+                best = i
+        out.append((scored[best], problems[best], [scored[i] for i in group]))
+    return out, scored
 
 
 def cutoff_candidates(recs: list[Any], cutoff: float | str | None,

@@ -34,15 +34,16 @@ another trajectory, a length of 4 costs 0.082 against 0.048 without a correction
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from robodyn.identification.estimate import FOLDS, paired_se
+from robodyn.identification.preprocess import target_signal
 
 __all__ = ["INDUCING", "LENGTH_GRID", "MAX_ROWS", "RIDGE_GRID", "LocalResidualFit",
-           "fit_local_residual", "local_features", "with_local_residual"]
+           "fit_local_residual", "local_features", "model_residuals", "with_local_residual"]
 
 #: Kernel lengths tried, in standard deviations of the identification data's states.
 LENGTH_GRID = (1.0, 1.5, 2.0)
@@ -204,8 +205,24 @@ def _cv_errors(phi: np.ndarray, r: np.ndarray, blocks: np.ndarray) -> np.ndarray
     return out
 
 
+def model_residuals(ident: Any, recordings: Sequence[Any], payloads: Sequence[Any] | None,
+                    target: str) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Each recording's states (:func:`local_features`, (N_k, 3 n)) and the raw target less the
+    prediction without a local correction ((N_k, n), NaN where the target is), as
+    :meth:`Identification.predict` processes it."""
+    pays = list(payloads) if payloads is not None else [None] * len(recordings)
+    features, residuals = [], []
+    for rec, pay in zip(recordings, pays, strict=True):
+        s = ident.prediction_samples(rec)  # the states predict() processes, processed once
+        features.append(local_features(s.q, s.qd, s.qdd))
+        residuals.append(np.asarray(target_signal(rec, target), float)
+                         - ident._model_prediction(rec, s, pay))
+    return features, residuals
+
+
 def with_local_residual(ident: Any, recordings: Sequence[Any], payloads: Sequence[Any] | None,
-                        target: str, option: bool | str) -> Any:
+                        target: str, option: bool | str,
+                        residuals: tuple[list[np.ndarray], list[np.ndarray]] | None = None) -> Any:
     """``ident`` with the correction of ``option`` (False, True or "auto") fitted and recorded.
 
     Parameters
@@ -217,21 +234,13 @@ def with_local_residual(ident: Any, recordings: Sequence[Any], payloads: Sequenc
     payloads : sequence of Payload or None, optional
     target : {"tau", "current"}
     option : bool or "auto"
+    residuals : (list, list), optional
+        :func:`model_residuals` of these arguments, when the caller has them already.
     """
-    from dataclasses import replace
-
-    from robodyn.identification.preprocess import target_signal
-
     if option is False:
         return ident
-    pays = list(payloads) if payloads is not None else [None] * len(recordings)
-    features, residuals = [], []
-    for rec, pay in zip(recordings, pays, strict=True):
-        s = ident.prediction_samples(rec)  # the states predict() processes, processed once
-        features.append(local_features(s.q, s.qd, s.qdd))
-        residuals.append(np.asarray(target_signal(rec, target), float)
-                         - ident._model_prediction(rec, s, pay))
-    fit, scores = fit_local_residual(features, residuals, option)
+    features, res = residuals or model_residuals(ident, recordings, payloads, target)
+    fit, scores = fit_local_residual(features, res, option)
     setting = () if fit is None else ((fit.length, fit.ridge),)
     choices = (replace(ident.choices, local=fit is not None, local_scores=tuple(scores.items()),
                        local_setting=setting) if ident.choices is not None else None)

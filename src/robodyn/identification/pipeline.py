@@ -44,9 +44,10 @@ from robodyn.identification.estimate import FOLDS, LinearFit, fit_linear
 from robodyn.identification.friction import without_friction
 from robodyn.identification.hydro_load import HydroLoad, hydro_load, hydro_rows
 from robodyn.identification.inputs import check_recording, checked_inputs
+from robodyn.identification.local_residual import model_residuals
 from robodyn.identification.options import IdentifyOptions
 from robodyn.identification.payload import Payload, payload_standard, payload_torque
-from robodyn.identification.prediction_terms import with_prediction_terms
+from robodyn.identification.prediction_terms import as_predicted, with_corrections, with_model_terms
 from robodyn.identification.preprocess import (
     DEAD_BAND,
     Preprocess,
@@ -71,6 +72,7 @@ from robodyn.identification.unobserved import (
     unobserved_names,
     with_data,
 )
+from robodyn.identification.velocity_choice import chosen_velocity, fit_residual
 from robodyn.keywords import resolve
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import IdentificationError
@@ -216,8 +218,28 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     reference = reference_targets(recs, target, cutoffs[0], rule)
     cands = candidates(opts.velocity, opts.dead_band, opts.thermal, measured, temps, DEAD_BAND, cutoffs)
     shared = SharedRows(model)  # samples and rows of the candidates that differ in the band only
-    best, problem, scored = choose(cands, stacked)
+    # each velocity source's candidates chosen by the blocks, its model finished; the source by
+    # the finished models' fit (robodyn.identification.velocity_choice)
+    winners, scored = choose(cands, stacked)
     shared.clear()
+    fits = [_model_fit(robot, recs, pays, target, opts, observed, hydro, *w) for w in winners]
+    del winners
+    if len(fits) == 1:
+        return with_corrections(*fits[0], pays, target, opts)
+    # each source's model as it predicts: its residual on the fit data (and the correction's)
+    res = [model_residuals(as_predicted(f, r, opts), r, pays, target) for f, r in fits]
+    scores = [fit_residual(r, e[1], target) for (_, r), e in zip(fits, res, strict=True)]
+    result, recs = chosen_velocity(fits, scores, scored)
+    return with_corrections(result, recs, pays, target, opts, res[int(np.argmin(scores))])
+
+
+def _model_fit(robot: Robot, recs: list[Any], pays: list[Payload | None], target: str,
+               opts: IdentifyOptions, observed: list[np.ndarray], hydro: Any, best: Candidate,
+               problem: Problem, scored: list[Candidate]) -> tuple[Identification, list[Any]]:
+    """The model of the chosen candidate ``best`` (its ``problem``; ``scored``: its group's
+    candidates): the linear step, the full parameters and the terms of
+    :func:`~robodyn.identification.prediction_terms.with_model_terms`; with the recordings the
+    later steps see."""
     data, drive, prior, loads = problem.payload
     # the consistent program's constraints bound what the weight bounds for least squares: its
     # weight is the smallest within one standard error of the best (estimate.cv_weight)
@@ -245,8 +267,8 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     # a joint without data anywhere has no residual
     result = replace(result, unobserved=unobserved_names(observed, robot.joint_names),
                      residual_std=np.where(seen_joints(observed), result.residual_std, np.nan))
-    return with_prediction_terms(result, recs, pays, target, opts, samples, data.y_full,
-                                 data.full, data.settings, observed)
+    return with_model_terms(result, recs, pays, target, opts, samples, data.y_full, data.full,
+                            data.settings, observed)
 
 
 @dataclass(frozen=True, eq=False)

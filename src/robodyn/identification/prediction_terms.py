@@ -34,15 +34,15 @@ from robodyn.identification.result import Identification
 from robodyn.identification.ripple import gravity_free_joints, with_ripple
 from robodyn.identification.unobserved import imputed_recordings
 
-__all__ = ["with_prediction_terms"]
+__all__ = ["as_predicted", "with_corrections", "with_model_terms"]
 
 
-def with_prediction_terms(result: Identification, recs: Sequence[Any], pays: Sequence[Any],
-                          target: str, opts: IdentifyOptions, samples: Sequence[Samples],
-                          y_full: Sequence[np.ndarray], full: Sequence[Samples],
-                          settings: Preprocess,
-                          observed: Sequence[np.ndarray] | None = None) -> Identification:
-    """``result`` (the linear step, its choices set) with the terms of the module docstring.
+def with_model_terms(result: Identification, recs: Sequence[Any], pays: Sequence[Any],
+                     target: str, opts: IdentifyOptions, samples: Sequence[Samples],
+                     y_full: Sequence[np.ndarray], full: Sequence[Samples], settings: Preprocess,
+                     observed: Sequence[np.ndarray] | None = None
+                     ) -> tuple[Identification, list[Any]]:
+    """``result`` (the linear step, its choices set) with steps 1-4 of the module docstring.
 
     Parameters
     ----------
@@ -52,8 +52,7 @@ def with_prediction_terms(result: Identification, recs: Sequence[Any], pays: Seq
         The fit's recordings and their payloads (None: none).
     target : {"tau", "current"}
     opts : IdentifyOptions
-        The run's options (``friction``, ``ripple``, ``prediction_cutoff``, ``resonance``, ``local``,
-        ``coulomb_width``); stored as ``result.options``.
+        The run's options (``friction``, ``ripple``, ``prediction_cutoff``, ``resonance``).
     samples : sequence of Samples
         The fit's processed, decimated samples, (N_k, n).
     y_full : sequence of numpy.ndarray, shape (N_k, n, 15 n)
@@ -69,7 +68,9 @@ def with_prediction_terms(result: Identification, recs: Sequence[Any], pays: Seq
 
     Returns
     -------
-    Identification
+    (Identification, list of Recording)
+        The identification and the recordings the later steps see (``recs``, a joint without
+        data filled with the model's prediction).
     """
     law = opts.friction
     if opts.friction == "auto":
@@ -84,12 +85,30 @@ def with_prediction_terms(result: Identification, recs: Sequence[Any], pays: Seq
     revolute = np.array([j.type == "revolute" for j in result.robot.joints])
     result = with_ripple(result, full, samples, y_full, settings,
                          gravity_free_joints(model, revolute), opts.ripple)
+    recs = list(recs)
     if observed is not None:
         recs = imputed_recordings(result, recs, pays, target, observed)
     result = with_prediction_cutoff(result, recs, pays, target, opts.prediction_cutoff)
-    result = with_resonance(result, recs, pays, target, opts.resonance)
-    # last: the prediction's Coulomb step smoothed (the fit and every choice made with the step)
+    return with_resonance(result, recs, pays, target, opts.resonance), recs
+
+
+def as_predicted(result: Identification, recs: Sequence[Any], opts: IdentifyOptions
+                 ) -> Identification:
+    """``result`` with the run's options and the smoothed Coulomb step (step 5) set: how
+    :meth:`~robodyn.identification.result.Identification.predict` uses it."""
     width = (auto_coulomb_width(recs, result.preprocess) if opts.coulomb_width == "auto"
              else float(opts.coulomb_width))
-    result = replace(result, options=opts, coulomb_width=width)
-    return with_local_residual(result, recs, pays, target, opts.local)
+    return replace(result, options=opts, coulomb_width=width)
+
+
+def with_corrections(result: Identification, recs: Sequence[Any], pays: Sequence[Any],
+                     target: str, opts: IdentifyOptions,
+                     residuals: tuple[list[np.ndarray], list[np.ndarray]] | None = None
+                     ) -> Identification:
+    """``result`` (:func:`with_model_terms`'s, ``recs`` its recordings) with steps 5 and 6 of
+    the module docstring (``opts``: ``coulomb_width``, ``local``); stored as
+    ``result.options``; ``residuals``: its
+    :func:`~robodyn.identification.local_residual.model_residuals`, when the caller has them."""
+    # the prediction's Coulomb step smoothed (the fit and every choice made with the step)
+    result = as_predicted(result, recs, opts)
+    return with_local_residual(result, recs, pays, target, opts.local, residuals)

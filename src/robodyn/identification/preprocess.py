@@ -318,10 +318,13 @@ class UnbandedRows:
     keep: int
 
 
-def unbanded_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool = True) -> UnbandedRows:
+def unbanded_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool = True,
+                  scratch: Any = None) -> UnbandedRows:
     """:func:`regressor_rows` of samples ``s`` without the dead band (``settings.dead_band`` is
     not used), with the Coulomb columns :func:`banded_rows` needs; at most about
-    :data:`ROWS_BYTES` of unfiltered rows held at once."""
+    :data:`ROWS_BYTES` of unfiltered rows held at once. ``scratch(size)``, optional: a flat
+    float64 buffer of at least ``size`` elements for the unfiltered rows (reused by the caller
+    across calls: fresh memory of this size costs more to first touch than to compute)."""
     d = settings.decimate if decimate else 1
     m = evaluation_step(s.t, settings, d)
     t, q, qd, qdd = s.t[::m], s.q[::m], s.qd[::m], s.qdd[::m]
@@ -330,9 +333,14 @@ def unbanded_rows(model: Any, s: Samples, settings: Preprocess, decimate: bool =
     coulomb_cols = [joint_columns(j, "Fcp", "Fcn") for j in range(n)]
     groups = -(-count * n * width * 8 // ROWS_BYTES)
     if groups <= 1:
-        y = regressor_rows_of(model, q, qd, qdd)
+        buf = None if scratch is None else scratch(count * n * width)[:count * n * width]
+        y = regressor_rows_of(model, q, qd, qdd,
+                              out=None if buf is None else buf.reshape(count, n, width))
         coulomb = np.stack([y[:, j, coulomb_cols[j]] for j in range(n)], axis=1)
-        return UnbandedRows(filtered_rows(t, y, settings, d // m), t, qd, coulomb, d // m)
+        rows = filtered_rows(t, y, settings, d // m)
+        if buf is not None and np.shares_memory(rows, buf):  # unfiltered: a view of the scratch
+            rows = rows.copy()
+        return UnbandedRows(rows, t, qd, coulomb, d // m)
     rows = np.empty((-(-count // (d // m)), n, width))
     coulomb = np.empty((count, n, 2))
     block = max(1, ROWS_BYTES // (4 * 8 * n * width))  # samples of regressor evaluated at once
@@ -414,6 +422,7 @@ class SharedRows:
     def __init__(self, model: Any) -> None:
         self._model = model
         self._memo: dict[tuple[Any, ...], tuple[list[Samples], list[UnbandedRows]]] = {}
+        self._scratch = np.empty(0)
 
     def get(self, recs: Sequence[Any], settings: Preprocess, target: str | None
             ) -> tuple[list[Samples], list[np.ndarray]]:
@@ -421,10 +430,20 @@ class SharedRows:
         key = (settings.cutoff, settings.order, settings.decimate, settings.velocity, target)
         if key not in self._memo:
             full = [preprocess(r, settings, target) for r in recs]
-            self._memo[key] = (full, [unbanded_rows(self._model, s, settings) for s in full])
+            self._memo[key] = (full, [unbanded_rows(self._model, s, settings, scratch=self._buffer)
+                                      for s in full])
         full, base = self._memo[key]
         return full, [banded_rows(u, settings) for u in base]
+
+    def _buffer(self, size: int) -> np.ndarray:
+        """The unfiltered rows' scratch buffer, at least ``size`` float64: grown to twice the
+        request when needed (memory never written costs nothing; a candidate evaluated at twice
+        the rate, a wider cut-off's, then touches only the second half)."""
+        if self._scratch.size < size:
+            self._scratch = np.empty(2 * size)
+        return self._scratch
 
     def clear(self) -> None:
         """Forget every setting's arrays."""
         self._memo.clear()
+        self._scratch = np.empty(0)

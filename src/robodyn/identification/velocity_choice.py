@@ -1,0 +1,81 @@
+"""The velocity source, chosen by how well each source's finished model fits the data.
+
+With ``velocity="auto"`` and a recorded velocity, :func:`robodyn.identify` can take the joint
+velocity from the recorder or from differences of the positions. Both give the same parameters
+to fit (the same columns, the same count), and they differ in what the fit and every later
+prediction see: a quantised encoder's differences are steps, a tachometer is noisy, a
+recorder's velocity may be filtered or lag. Which is better shows in the model finished with
+each (linear step, friction law, ripple, prediction cut-off; :func:`with_model_terms
+<robodyn.identification.prediction_terms.with_model_terms>`), predicting the identification
+recordings' raw target as :meth:`Identification.predict
+<robodyn.identification.result.Identification.predict>` would: the source whose model leaves
+the smaller residual is kept. With the same number of parameters on the same samples and the
+same target, the two residuals carry the same fitting optimism, so the comparison needs no
+held-out data; each source's other settings (cut-off, dead band, Tikhonov weight) are still
+chosen by the held-out time blocks of :func:`robodyn.identification.choices.choose`.
+
+Why not the time blocks for the source as well: their score is that of the linear step alone,
+against the target filtered at the plain cut-off, and on the real recordings in ``../shared``
+it disagreed with the finished models on three of nine splits (docs/identification.md,
+"Velocity source"); the finished models' residual picked, on every one of them, the source
+whose held-out prediction was better.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from robodyn.identification.choices import Candidate
+from robodyn.identification.preprocess import target_signal
+
+__all__ = ["chosen_velocity", "fit_residual"]
+
+
+def fit_residual(recs: Sequence[Any], residuals: Sequence[np.ndarray], target: str) -> float:
+    """``||y - p|| / ||y||`` over the finite target entries of all joints and recordings: the
+    raw target ``y`` of the identification recordings ``recs`` and ``residuals`` ``y - p``
+    (:func:`~robodyn.identification.local_residual.model_residuals`, (N_k, n) each)."""
+    num = den = 0.0
+    for rec, e in zip(recs, residuals, strict=True):
+        y = np.asarray(target_signal(rec, target), float)
+        ok = np.isfinite(y)
+        num += float(np.sum(e[ok] ** 2))
+        den += float(np.sum(y[ok] ** 2))
+    return float(np.sqrt(num / max(den, 1e-300)))
+
+
+def chosen_velocity(fits: Sequence[tuple[Any, list[Any]]], scores: Sequence[float],
+                    scored: Sequence[Candidate]) -> tuple[Any, list[Any]]:
+    """The fit of the smallest score (the first on a tie), its choices extended.
+
+    Parameters
+    ----------
+    fits : sequence of (Identification, list of Recording)
+        Each velocity source's finished model (its ``choices`` those of its own candidates) and
+        the recordings its later steps see.
+    scores : sequence of float
+        Each one's :func:`fit_residual`, computed as it predicts (Coulomb step smoothed).
+    scored : sequence of Candidate
+        Every candidate with its held-out block score (all sources).
+
+    Returns
+    -------
+    (Identification, list of Recording)
+        The kept one; its ``choices.candidates`` every source's scored candidates,
+        ``velocity_scores`` each source's residual, and the reason saying how the source was
+        chosen.
+    """
+    best = int(np.argmin(scores))
+    ident, recs = fits[best]
+    if len(fits) == 1:
+        return ident, recs
+    pairs = tuple((f.choices.velocity, float(s)) for (f, _), s in zip(fits, scores, strict=True))
+    own = f"{ident.choices.reason}; " if len(ident.choices.candidates) > 1 else ""  # its source's
+    reason = (f"{own}the velocity source: the smaller residual of each source's finished model "
+              "on the identification recordings")
+    return replace(ident, choices=replace(ident.choices, candidates=tuple(scored), velocity_scores=pairs,
+                                          reason=reason)), recs
