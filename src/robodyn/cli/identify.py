@@ -480,8 +480,9 @@ def _preprocessing(p: argparse.ArgumentParser) -> None:
     """The identification's preprocessing options (rd.identify's keywords of the same names)."""
     p.add_argument("--velocity", choices=VELOCITIES, default="auto",
                    help="joint velocity source: differences of the filtered positions, the "
-                        "filtered measured velocity, or auto: chosen by held-out time blocks "
-                        "(printed under 'choices') (default: %(default)s)")
+                        "filtered measured velocity, or auto: with a recorded velocity, the "
+                        "source whose finished model fits the data better (printed under "
+                        "'choices') (default: %(default)s)")
     p.add_argument("--dead-band", type=_auto_or(float), default=0.0, metavar="RAD_S",
                    help="Coulomb dead band in rad/s, in the fit and the prediction alike (below "
                         "it a joint carries only its friction offset), or auto: 0 or 1e-3 chosen "

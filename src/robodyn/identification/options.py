@@ -51,8 +51,10 @@ class IdentifyOptions:
         Keep every ``decimate``-th filtered sample.
     velocity : {"auto", "position", "measured"}
         Joint velocities from the filtered positions or the filtered measured ones; "auto":
-        chosen by time-block cross-validation (:mod:`robodyn.identification.choices`) when every
-        recording has a measured velocity, else "position".
+        when every recording has a measured velocity, each source's model is finished (its other
+        settings chosen by time-block cross-validation, :mod:`robodyn.identification.choices`)
+        and the one with the smaller residual on the identification data is kept
+        (:mod:`robodyn.identification.velocity_choice`), else "position".
     dead_band : "auto" or float
         Coulomb dead band, rad/s (m/s): below it a joint's Coulomb columns are zero and only the
         friction offset acts, in the fit and in :meth:`Identification.predict` alike; 0: none;

@@ -72,7 +72,13 @@ from robodyn.identification.unobserved import (
     unobserved_names,
     with_data,
 )
-from robodyn.identification.velocity_choice import chosen_velocity, fit_residual
+from robodyn.identification.velocity_choice import (
+    chosen_velocity,
+    fit_residual,
+    local_share,
+    same_law,
+    same_law_options,
+)
 from robodyn.keywords import resolve
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import IdentificationError
@@ -222,15 +228,21 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     # the finished models' fit (robodyn.identification.velocity_choice)
     winners, scored = choose(cands, stacked)
     shared.clear()
-    fits = [_model_fit(robot, recs, pays, target, opts, observed, hydro, *w) for w in winners]
-    del winners
-    if len(fits) == 1:
+    fits = [_model_fit(robot, recs, pays, target, opts, observed, hydro, *winners[0])]
+    if len(winners) == 1:
         return with_corrections(*fits[0], pays, target, opts)
-    # each source's model as it predicts: its residual on the fit data (and the correction's)
+    # the other source with the friction law chosen on the first: the same terms compared
+    fits += [same_law(_model_fit(robot, recs, pays, target, same_law_options(opts, fits[0][0]),
+                                 observed, hydro, *w), fits[0][0]) for w in winners[1:]]
+    del winners
+    # each source's model finished as it predicts: its residual on the fit data, times what the
+    # local correction leaves of it on held-out blocks where that is kept
     res = [model_residuals(as_predicted(f, r, opts), r, pays, target) for f, r in fits]
-    scores = [fit_residual(r, e[1], target) for (_, r), e in zip(fits, res, strict=True)]
-    result, recs = chosen_velocity(fits, scores, scored)
-    return with_corrections(result, recs, pays, target, opts, res[int(np.argmin(scores))])
+    done = [(with_corrections(f, r, pays, target, opts, e), r)
+            for (f, r), e in zip(fits, res, strict=True)]
+    scores = [fit_residual(r, e[1], target) * local_share(f)
+              for (f, r), e in zip(done, res, strict=True)]
+    return chosen_velocity(done, scores, scored)[0]
 
 
 def _model_fit(robot: Robot, recs: list[Any], pays: list[Payload | None], target: str,

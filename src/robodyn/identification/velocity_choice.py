@@ -32,7 +32,7 @@ import numpy as np
 from robodyn.identification.choices import Candidate
 from robodyn.identification.preprocess import target_signal
 
-__all__ = ["chosen_velocity", "fit_residual"]
+__all__ = ["chosen_velocity", "fit_residual", "local_share", "same_law", "same_law_options"]
 
 
 def fit_residual(recs: Sequence[Any], residuals: Sequence[np.ndarray], target: str) -> float:
@@ -46,6 +46,33 @@ def fit_residual(recs: Sequence[Any], residuals: Sequence[np.ndarray], target: s
         num += float(np.sum(e[ok] ** 2))
         den += float(np.sum(y[ok] ** 2))
     return float(np.sqrt(num / max(den, 1e-300)))
+
+
+def same_law_options(opts: Any, first: Any) -> Any:
+    """``opts`` with ``friction`` the law ``friction="auto"`` chose on the first source's model
+    ``first`` (unchanged when the law was given)."""
+    if opts.friction != "auto" or first.choices.friction is None:
+        return opts
+    return replace(opts, friction=first.choices.friction)
+
+
+def same_law(fit: tuple[Any, list[Any]], first: Any) -> tuple[Any, list[Any]]:
+    """``fit`` (an identification and its recordings) reporting the friction law and its scores
+    as chosen on ``first``'s model, with which it was fitted."""
+    ident, recs = fit
+    if first.choices.friction is None:
+        return fit
+    choices = replace(ident.choices, friction=first.choices.friction,
+                      friction_scores=first.choices.friction_scores)
+    return replace(ident, choices=choices), recs
+
+
+def local_share(ident: Any) -> float:
+    """What the kept local correction leaves of the model's residual on held-out blocks
+    (``choices.local_scores``' ``"local"``); 1 without a correction."""
+    if ident.local_fit is None:
+        return 1.0
+    return float(dict(ident.choices.local_scores)["local"])
 
 
 def chosen_velocity(fits: Sequence[tuple[Any, list[Any]]], scores: Sequence[float],
