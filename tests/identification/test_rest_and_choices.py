@@ -149,15 +149,12 @@ def test_velocity_source_chosen_by_the_finished_models(planar):
     assert set(scores) == {"measured", "position"} and scores["measured"] < scores["position"]
     assert "velocity source measured (residual of each source's model" in ident.choices.summary()
     # each source's score is that of the model identified with it alone and the friction law
-    # chosen on the first source: its residual on the fit data (without the local correction),
-    # times what the correction, where kept, leaves of it on held-out blocks
-    law = dict(velocity="position", cutoff=5.0, friction=ident.choices.friction)
-    plain = rd.identify(robot, coarse, model=model, local=False, **law)
-    local = rd.identify(robot, coarse, model=model, **law)
-    share = dict(local.choices.local_scores)["local"] if local.local_fit is not None else 1.0
+    # chosen on the first source: its residual on the fit data (without the local correction)
+    plain = rd.identify(robot, coarse, model=model, local=False, velocity="position", cutoff=5.0,
+                        friction=ident.choices.friction)
     y = coarse.tau
     assert scores["position"] == pytest.approx(
-        np.linalg.norm(y - plain.predict(coarse)) / np.linalg.norm(y) * share, rel=1e-9)
+        np.linalg.norm(y - plain.predict(coarse)) / np.linalg.norm(y), rel=1e-9)
     noisy = _velocity_case(model, 8, quantum=0.0, qd_noise=2.0)
     ident = rd.identify(robot, noisy, model=model, velocity="auto", cutoff=5.0)
     assert ident.choices.velocity == "position"

@@ -75,7 +75,6 @@ from robodyn.identification.unobserved import (
 from robodyn.identification.velocity_choice import (
     chosen_velocity,
     fit_residual,
-    local_share,
     same_law,
     same_law_options,
 )
@@ -235,14 +234,12 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     fits += [same_law(_model_fit(robot, recs, pays, target, same_law_options(opts, fits[0][0]),
                                  observed, hydro, *w), fits[0][0]) for w in winners[1:]]
     del winners
-    # each source's model finished as it predicts: its residual on the fit data, times what the
-    # local correction leaves of it on held-out blocks where that is kept
+    # each source's model as it predicts: its residual on the fit data; the local correction
+    # then fitted on the kept one (from the same residuals)
     res = [model_residuals(as_predicted(f, r, opts), r, pays, target) for f, r in fits]
-    done = [(with_corrections(f, r, pays, target, opts, e), r)
-            for (f, r), e in zip(fits, res, strict=True)]
-    scores = [fit_residual(r, e[1], target) * local_share(f)
-              for (f, r), e in zip(done, res, strict=True)]
-    return chosen_velocity(done, scores, scored)[0]
+    scores = [fit_residual(r, e[1], target) for (_, r), e in zip(fits, res, strict=True)]
+    result, recs = chosen_velocity(fits, scores, scored)
+    return with_corrections(result, recs, pays, target, opts, res[int(np.argmin(scores))])
 
 
 def _model_fit(robot: Robot, recs: list[Any], pays: list[Payload | None], target: str,

@@ -1,24 +1,29 @@
 """The velocity source, chosen by how well each source's finished model fits the data.
 
 With ``velocity="auto"`` and a recorded velocity, :func:`robodyn.identify` can take the joint
-velocity from the recorder or from differences of the positions. Both give the same parameters
-to fit (the same columns, the same count), and they differ in what the fit and every later
-prediction see: a quantised encoder's differences are steps, a tachometer is noisy, a
+velocity from the recorder or from differences of the positions. They differ in what the fit and
+every later prediction see: a quantised encoder's differences are steps, a tachometer is noisy, a
 recorder's velocity may be filtered or lag. Which is better shows in the model finished with
-each (linear step, friction law, ripple, prediction cut-off; :func:`with_model_terms
-<robodyn.identification.prediction_terms.with_model_terms>`), predicting the identification
-recordings' raw target as :meth:`Identification.predict
-<robodyn.identification.result.Identification.predict>` would: the source whose model leaves
-the smaller residual is kept. With the same number of parameters on the same samples and the
-same target, the two residuals carry the same fitting optimism, so the comparison needs no
-held-out data; each source's other settings (cut-off, dead band, Tikhonov weight) are still
-chosen by the held-out time blocks of :func:`robodyn.identification.choices.choose`.
+each: each source's cut-off and dead band chosen by the held-out time blocks among its own
+candidates (:func:`robodyn.identification.choices.choose`), then the linear step, the estimator
+and the terms of :func:`~robodyn.identification.prediction_terms.with_model_terms` (ripple,
+prediction cut-off, drive modes). The friction law is chosen once, on
+the first (plain) source's model, and the other source is fitted with the same law: both models
+then have the same terms on the same samples and the same target, so their residuals on the
+identification recordings carry the same fitting optimism and can be compared without held-out
+data (a law chosen per source made the comparison one of the laws: on a KUKA LWR4+ run's first
+half, position differences with the Stribeck law fitted it better than the recorder's velocity
+with the linear law, and predicted the second half worse, 0.0215 against 0.0134).
 
-Why not the time blocks for the source as well: their score is that of the linear step alone,
-against the target filtered at the plain cut-off, and on the real recordings in ``../shared``
-it disagreed with the finished models on three of nine splits (docs/identification.md,
-"Velocity source"); the finished models' residual picked, on every one of them, the source
-whose held-out prediction was better.
+The score of a source is its model's relative residual against the raw target, predicted as
+:meth:`Identification.predict <robodyn.identification.result.Identification.predict>` does
+(before the local correction, which is then fitted on the kept source alone); the smaller is
+kept. Why not the time blocks for the
+source as well, as before: their score is the linear step's (weighted least squares, no friction
+law, no drive modes), against the target filtered at the plain cut-off; on the real recordings in
+``../shared`` it disagreed with the finished models on three of the quality table's nine splits,
+and the finished models picked the source whose held-out prediction was better on all eighteen
+splits measured (docs/identification.md, "The velocity source").
 """
 
 from __future__ import annotations
@@ -32,7 +37,7 @@ import numpy as np
 from robodyn.identification.choices import Candidate
 from robodyn.identification.preprocess import target_signal
 
-__all__ = ["chosen_velocity", "fit_residual", "local_share", "same_law", "same_law_options"]
+__all__ = ["chosen_velocity", "fit_residual", "same_law", "same_law_options"]
 
 
 def fit_residual(recs: Sequence[Any], residuals: Sequence[np.ndarray], target: str) -> float:
@@ -65,14 +70,6 @@ def same_law(fit: tuple[Any, list[Any]], first: Any) -> tuple[Any, list[Any]]:
     choices = replace(ident.choices, friction=first.choices.friction,
                       friction_scores=first.choices.friction_scores)
     return replace(ident, choices=choices), recs
-
-
-def local_share(ident: Any) -> float:
-    """What the kept local correction leaves of the model's residual on held-out blocks
-    (``choices.local_scores``' ``"local"``); 1 without a correction."""
-    if ident.local_fit is None:
-        return 1.0
-    return float(dict(ident.choices.local_scores)["local"])
 
 
 def chosen_velocity(fits: Sequence[tuple[Any, list[Any]]], scores: Sequence[float],
