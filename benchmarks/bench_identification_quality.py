@@ -115,9 +115,10 @@ def _nominal(case: Case, model: rd.Model) -> Callable[[rd.Recording], np.ndarray
 METHODS: Sequence[tuple[str, dict, str]] = (
     ("robodyn default", {},
      "rd.identify(robot, fit, target=...): the physically consistent program with the Tikhonov "
-     "weight, velocity source, cut-off, friction law (linear or Stribeck), position ripple and "
-     "drive modes (one second-order mode per joint) chosen by held-out time blocks of the fit "
-     "data, and the predictions' Coulomb step smoothed over the fit data's velocity noise (over "
+     "weight, cut-off, friction law (linear or Stribeck), position ripple and drive modes (one "
+     "second-order mode per joint) chosen by held-out time blocks of the fit data, the velocity "
+     "source by the finished models' residual on the fit data (since 2026-12-07), and the "
+     "predictions' Coulomb step smoothed over the fit data's velocity noise (over "
      "at least 1e-3 rad/s where a joint is held); gross glitches (one-sample spikes, bursts "
      "of 3-5 rows) of the fit data dropped (spikes='auto'); a held-out recording that moves "
      "faster than the fit data predicted at its own motion band (prediction_cutoff='motion', "
