@@ -297,8 +297,12 @@ def choose(cands: Sequence[Candidate], stacked: Callable[[Candidate], Problem]
     """
     if len(cands) == 1:
         return [(cands[0], stacked(cands[0]), list(cands))], list(cands)
-    scored, problems, blocks_err = [], [], []
-    for cand in cands:
+    scored: list[Candidate] = []
+    # per velocity source: its best candidate so far (index, problem) and its plain candidate's
+    # block errors; a losing candidate's problem is dropped at once (peak memory: two per source)
+    best: dict[str, tuple[int, Problem]] = {}
+    plain: dict[str, np.ndarray] = {}
+    for i, cand in enumerate(cands):
         pr = stacked(cand)
         # the estimator's own row weights (per joint, from a first fit), the raw target held out;
         # squared error of each held-out block (K, L) relative to the whole target: candidates
@@ -309,18 +313,17 @@ def choose(cands: Sequence[Candidate], stacked: Callable[[Candidate], Problem]
         k = int(np.argmin(per_block.sum(axis=0)))  # each candidate at its best weight
         scored.append(replace(cand, score=float(np.sqrt(per_block[:, k].sum())),
                               lam=float(LAMBDA_GRID[k])))
-        blocks_err.append(per_block[:, k])
-        problems.append(pr)
-    out = []
-    for velocity in dict.fromkeys(c.velocity for c in cands):
-        group = [i for i, c in enumerate(cands) if c.velocity == velocity]
-        best = group[0]
-        for i in group[1:]:
-            # paired difference of the block errors against the group's plain candidate, its SE
-            d = blocks_err[i] - blocks_err[group[0]]
-            if d.sum() < -paired_se(d) and scored[i].score < scored[best].score:
-                best = i
-        out.append((scored[best], problems[best], [scored[i] for i in group]))
+        v = cand.velocity
+        if v not in best:  # the source's first (plain) candidate
+            best[v], plain[v] = (i, pr), per_block[:, k]
+            continue
+        # paired difference of the block errors against the source's plain candidate, its SE
+        d = per_block[:, k] - plain[v]
+        if d.sum() < -paired_se(d) and scored[i].score < scored[best[v][0]].score:
+            best[v] = (i, pr)
+        del pr
+    out = [(scored[i], pr, [s for s, c in zip(scored, cands, strict=True) if c.velocity == v])
+           for v, (i, pr) in best.items()]
     return out, scored
 
 

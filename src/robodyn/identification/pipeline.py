@@ -16,19 +16,23 @@ Steps (each a function of its own module):
    is in torque units, ``K_j i_j = Y_j p``;
 6. estimate (:mod:`robodyn.identification.estimate`, :mod:`robodyn.identification.consistent`);
 7. the full standard parameter set and a :class:`Robot` carrying it.
+
+Steps 2 to 5 for one candidate processing are :mod:`robodyn.identification.prepared`; the
+candidates are scored by :func:`robodyn.identification.choices.choose`, and the velocity source
+kept by :func:`robodyn.identification.velocity_choice.kept_source`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from functools import partial
 from typing import Any
 
 import numpy as np
-import sympy as sp
 
 from robodyn.identification.bandwidth import check_prediction_cutoff
-from robodyn.identification.base import BaseRelations, base_relations
+from robodyn.identification.base import BaseRelations
 from robodyn.identification.choices import (
     Candidate,
     Choices,
@@ -39,29 +43,25 @@ from robodyn.identification.choices import (
     reference_targets,
 )
 from robodyn.identification.completion import completed, consistent_completion
-from robodyn.identification.drive_gains import estimate_drive_gains
 from robodyn.identification.estimate import FOLDS, LinearFit, fit_linear
-from robodyn.identification.friction import without_friction
-from robodyn.identification.hydro_load import HydroLoad, hydro_load, hydro_rows
+from robodyn.identification.hydro_load import hydro_load
 from robodyn.identification.inputs import check_recording, checked_inputs
-from robodyn.identification.local_residual import model_residuals
 from robodyn.identification.options import IdentifyOptions
-from robodyn.identification.payload import Payload, payload_standard, payload_torque
-from robodyn.identification.prediction_terms import as_predicted, with_corrections, with_model_terms
-from robodyn.identification.preprocess import (
-    DEAD_BAND,
-    Preprocess,
-    Samples,
-    SharedRows,
-    auto_cutoff,
-    prediction_rows,
-    resolve_preprocess,
+from robodyn.identification.payload import Payload
+from robodyn.identification.prediction_terms import with_model_terms
+from robodyn.identification.prepared import (
+    CandidateSetup,
+    Drive,
+    Prepared,
+    candidate_problem,
+    nominal_standard,
+    stacked_rows,
 )
-from robodyn.identification.prior import joint_prior
+from robodyn.identification.preprocess import DEAD_BAND, SharedRows, auto_cutoff
 from robodyn.identification.result import BaseParameters, Identification
 from robodyn.identification.spikes import without_spikes
 from robodyn.identification.state_noise import state_noise_std, torque_variance
-from robodyn.identification.thermal import ThermalData, ThermalFit, thermal_data
+from robodyn.identification.thermal import ThermalFit
 from robodyn.identification.to_robot import robot_with_parameters
 from robodyn.identification.unobserved import (
     filled,
@@ -72,55 +72,18 @@ from robodyn.identification.unobserved import (
     unobserved_names,
     with_data,
 )
-from robodyn.identification.velocity_choice import (
-    chosen_velocity,
-    fit_residual,
-    same_law,
-    same_law_options,
-)
+from robodyn.identification.velocity_choice import kept_source
 from robodyn.keywords import resolve
 from robodyn.numeric.model import Model, compile_model
 from robodyn.robot.errors import IdentificationError
 from robodyn.robot.model import Robot
-from robodyn.symbolic.regressor import INERTIAL_NAMES, PER_JOINT, joint_columns, parameter_values
 
 __all__ = ["check_recording", "identify", "nominal_standard"]
 
 #: Floor of the measurement variance, as a fraction of the first fit's residual variance.
 MEAS_FLOOR = 0.01
-#: Fraction of a joint's samples at rest from which its friction offset is its own base parameter.
-REST_FRACTION = 0.01
 #: Unit directions whose singular value is below this fraction of the largest are reported.
 UNEXCITED_RTOL = 1e-6
-
-
-def nominal_standard(robot: Robot) -> np.ndarray:
-    """The description's standard parameter vector (15 n,) at its parameters' defaults."""
-    subs = robot.defaults()
-    return np.array([float(sp.sympify(v).xreplace(subs)) for v in parameter_values(robot)])
-
-
-def _stack(samples: Sequence[Samples], y_full: Sequence[np.ndarray], columns: np.ndarray,
-           gains: np.ndarray, loads: Sequence[np.ndarray],
-           extra: Sequence[np.ndarray] | None = None,
-           observed: Sequence[np.ndarray] | None = None
-           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``Phi`` (m, b + e), ``y`` (m,), joint of each row, CV block of each row (m = sum N_k n);
-    ``loads`` (N_k, n): the known payload torque of each recording, taken off the target;
-    ``extra`` (N_k, n, e): further columns appended after the base columns (thermal friction);
-    ``observed`` (n,) bool per recording: only the rows of joints with data are kept."""
-    phis, ys, joints, blocks = [], [], [], []
-    for i, (s, y, load) in enumerate(zip(samples, y_full, loads, strict=True)):
-        count, n = s.q.shape
-        rows = y[:, :, columns].reshape(count * n, -1)
-        if extra is not None:
-            rows = np.hstack([rows, extra[i].reshape(count * n, -1)])
-        phis.append(rows)
-        ys.append((s.y * gains[None, :] - load).reshape(-1))  # K_j i_j - P_j (or tau_j - P_j)
-        joints.append(np.tile(np.arange(n), count))
-        blocks.append(np.repeat(np.arange(count) * FOLDS // count, n))
-    counts = [s.q.shape[0] for s in samples]
-    return tuple(with_data(np.concatenate(a), observed, counts) for a in (phis, ys, joints, blocks))
 
 
 def identify(robot: Robot, recordings: Any, target: str | None = None, method: str = "consistent", *,
@@ -193,58 +156,24 @@ def identify(robot: Robot, recordings: Any, target: str | None = None, method: s
     measured = all(r.qd is not None and "qd" not in getattr(r, "estimated", frozenset()) for r in recs)
     temps = all(getattr(r, "temperature", None) is not None for r in recs)
 
-    def stacked(c: Candidate) -> Problem:
-        data = replace(_prepared(robot, recs, target, opts.friction, c.cutoff, opts.decimate,
-                                 c.velocity, c.dead_band, model, c.thermal, opts.sensor, rule, shared,
-                                 hydro), observed=observed)
-        drive, prior, loads = _gains_and_prior(robot, data, pays, target, opts.gains, opts.friction,
-                                               opts.sensor)
-        cols = data.relations.independent
-        th = data.thermal
-        phi, y, joint, blocks = _stack(data.samples, data.y_full, cols, drive.k, loads,
-                                       None if th is None else th.fit_rows, data.observed)
-        test = [prediction_rows(model, s, data.settings)[:, :, cols] for s in data.samples]
-        if th is not None:
-            test = [np.concatenate([a, b], axis=2) for a, b in zip(test, th.test_rows, strict=True)]
-        theta0 = np.concatenate([data.relations.to_base(prior), np.zeros(phi.shape[1] - cols.size)])
-        d = data.settings.decimate
-        # the common held-out target at the same samples, torque units, known loads taken off
-        held = np.concatenate([(ref[::d] * drive.k - load).reshape(-1)
-                               for ref, load in zip(reference, loads, strict=True)])
-        counts = [s.q.shape[0] for s in data.samples]
-        test = with_data(np.vstack([a.reshape(-1, phi.shape[1]) for a in test]), data.observed,
-                         counts)
-        return Problem(phi, y, theta0, joint, blocks, test, with_data(held, data.observed, counts),
-                       (data, drive, prior, loads))
-
     # the "auto" cut-off's rule, computed once for every candidate that uses it
     rule = auto_cutoff(recs) if opts.cutoff == "auto" else None
     cutoffs = cutoff_candidates(recs, opts.cutoff, rule)
-    reference = reference_targets(recs, target, cutoffs[0], rule)
     cands = candidates(opts.velocity, opts.dead_band, opts.thermal, measured, temps, DEAD_BAND, cutoffs)
-    shared = SharedRows(model)  # samples and rows of the candidates that differ in the band only
+    # samples and rows shared by the candidates that differ in the band only
+    setup = CandidateSetup(robot, recs, target, pays, opts, model, hydro, observed, rule,
+                           SharedRows(model), reference_targets(recs, target, cutoffs[0], rule))
     # each velocity source's candidates chosen by the blocks, its model finished; the source by
     # the finished models' fit (robodyn.identification.velocity_choice)
-    winners, scored = choose(cands, stacked)
-    shared.clear()
-    fits = [_model_fit(robot, recs, pays, target, opts, observed, hydro, *winners[0])]
-    if len(winners) == 1:
-        return with_corrections(*fits[0], pays, target, opts)
-    # the other source with the friction law chosen on the first: the same terms compared
-    fits += [same_law(_model_fit(robot, recs, pays, target, same_law_options(opts, fits[0][0]),
-                                 observed, hydro, *w), fits[0][0]) for w in winners[1:]]
-    del winners
-    # each source's model as it predicts: its residual on the fit data; the local correction
-    # then fitted on the kept one (from the same residuals)
-    res = [model_residuals(as_predicted(f, r, opts), r, pays, target) for f, r in fits]
-    scores = [fit_residual(r, e[1], target) for (_, r), e in zip(fits, res, strict=True)]
-    result, recs = chosen_velocity(fits, scores, scored)
-    return with_corrections(result, recs, pays, target, opts, res[int(np.argmin(scores))])
+    winners, scored = choose(cands, partial(candidate_problem, setup))
+    setup.shared.clear()
+    return kept_source(winners, scored, partial(_model_fit, robot, recs, pays, target,
+                                                observed=observed, hydro=hydro), opts, pays, target)
 
 
 def _model_fit(robot: Robot, recs: list[Any], pays: list[Payload | None], target: str,
-               opts: IdentifyOptions, observed: list[np.ndarray], hydro: Any, best: Candidate,
-               problem: Problem, scored: list[Candidate]) -> tuple[Identification, list[Any]]:
+               opts: IdentifyOptions, best: Candidate, problem: Problem, scored: list[Candidate], *,
+               observed: list[np.ndarray], hydro: Any) -> tuple[Identification, list[Any]]:
     """The model of the chosen candidate ``best`` (its ``problem``; ``scored``: its group's
     candidates): the linear step, the full parameters and the terms of
     :func:`~robodyn.identification.prediction_terms.with_model_terms`; with the recordings the
@@ -281,68 +210,6 @@ def _model_fit(robot: Robot, recs: list[Any], pays: list[Payload | None], target
 
 
 @dataclass(frozen=True, eq=False)
-class _Prepared:
-    """The processed data of :func:`identify` (steps 2 and 3).
-
-    Attributes
-    ----------
-    settings : Preprocess
-        The resolved preprocessing settings.
-    model : Model
-        The compiled model of the robot.
-    relations : BaseRelations
-        The base relations (without the friction columns for ``friction="none"``).
-    samples : list of Samples
-        Processed and decimated samples of each recording, (N_k, n).
-    y_full : list of ndarray
-        Filtered and decimated full regressor of each recording, (N_k, n, 15 n).
-    count : int
-        Total number of samples ``sum N_k`` after decimation.
-    thermal : ThermalData or None
-        The thermal friction columns (``thermal=True``).
-    full : list of Samples
-        The processed samples before decimation (N_k, n).
-    hydro : list of ndarray or None
-        The filtered hydrodynamic torque at each recording's ``full`` samples (N_k, n), N m, a
-        known load like a payload's (:mod:`robodyn.identification.hydro_load`); None for a dry
-        robot.
-    observed : list of ndarray of bool, shape (n,), or None
-        The joints with target data in each recording (:mod:`robodyn.identification.unobserved`);
-        None: all.
-    """
-
-    settings: Preprocess
-    model: Model
-    relations: BaseRelations
-    samples: list[Samples]
-    y_full: list[np.ndarray]
-    count: int
-    thermal: ThermalData | None = None
-    full: list[Samples] | None = None
-    hydro: list[np.ndarray] | None = None
-    observed: list[np.ndarray] | None = None
-
-
-@dataclass(frozen=True, eq=False)
-class _Drive:
-    """The drive gains of :func:`identify` and where they come from.
-
-    Attributes
-    ----------
-    k : ndarray, shape (n,)
-        Drive gain of each joint, N m / A (ones when absorbed or for ``target="tau"``).
-    source : str
-        Where ``k`` comes from (``Identification.gains_source``).
-    std : ndarray, shape (n,)
-        Standard deviation of ``k``, N m / A (inf when absorbed, NaN when unknown).
-    """
-
-    k: np.ndarray
-    source: str
-    std: np.ndarray
-
-
-@dataclass(frozen=True, eq=False)
 class _LinearStep:
     """The stacked identification problem of :func:`identify` and its linear fit (m = sum N_k n).
 
@@ -370,101 +237,7 @@ class _LinearStep:
     fit: LinearFit
 
 
-def _prepared(robot: Robot, recs: list[Any], target: str, friction: str, cutoff: float | str | None,
-              decimate: int | str, velocity: str, dead_band: float, model: Model,
-              thermal: bool = False, sensor: str = "motor", rule: float | None = None,
-              shared: SharedRows | None = None, hydro: HydroLoad | None = None) -> _Prepared:
-    """Preprocessed samples, filtered regressors and base relations of ``recs`` (steps 2 and 3).
-
-    ``rule``: the recordings' "auto" cut-off when already computed (Hz); ``shared``: the
-    samples and rows of the settings seen before in this identification. Raises
-    :class:`IdentificationError` when the
-    ``sum N_k n`` equations left after decimation are fewer than twice the ``b`` base parameters.
-    """
-    settings = resolve_preprocess(recs, cutoff, decimate, velocity, dead_band=dead_band, auto=rule)
-    full, y_full = (shared or SharedRows(model)).get(recs, settings, target)
-    # the fluid's torque, from the description: a known load (taken off in _gains_and_prior)
-    taken = None if hydro is None else hydro_rows(hydro, full, settings)
-    samples = [_decimated(s, settings) for s in full]
-    rotor = np.arange(robot.dof) * PER_JOINT + len(INERTIAL_NAMES)
-    relations = base_relations(model, at_rest=_at_rest(samples, settings.dead_band),
-                               unseen=rotor if sensor == "link" else None)
-    if friction == "none":
-        relations = _without_friction_columns(relations)
-    count = sum(s.q.shape[0] for s in samples)
-    b = relations.independent.size
-    if count * robot.dof < 2 * b:
-        raise IdentificationError(
-            f"recordings: too few samples for the parameters: {count} samples x {robot.dof} joints "
-            f"= {count * robot.dof} equations after decimation by {settings.decimate} for {b} base "
-            f"parameters (at least {2 * b} needed; record longer or pass decimate=1)")
-    return _Prepared(settings, model, relations, samples, y_full, count,
-                     thermal_data(recs, full, settings) if thermal else None, full, taken)
-
-
-def _at_rest(samples: Sequence[Samples], band: float) -> np.ndarray:
-    """Joints (n,) bool with at least ``REST_FRACTION`` of their fitted samples at rest
-    (``|qd| < band``, or exactly 0: a joint held still): their offset ``Fo`` is then seen alone."""
-    qd = np.abs(np.vstack([s.qd for s in samples]))
-    rest = (qd < band) | (qd == 0.0)
-    return np.mean(rest, axis=0) >= REST_FRACTION
-
-
-def _gains_and_prior(robot: Robot, data: _Prepared, pays: list[Payload | None], target: str,
-                     gains: str, friction: str, sensor: str = "motor"
-                     ) -> tuple[_Drive, np.ndarray, list[np.ndarray]]:
-    """Drive gains, the prior (15 n,) and the known torque (N_k, n), N m, of each recording: its
-    payload's and an underwater arm's hydrodynamic torque (step 5).
-
-    With ``target="current"`` and a payload in some recording, the gains are estimated from the
-    payload runs (:func:`_payload_gains`); for ``friction="none"`` the prior has no friction.
-    """
-    nominal = nominal_standard(robot)
-    loads = [np.zeros_like(s.q) if p is None else payload_torque(y, payload_standard(robot, p))
-             for s, y, p in zip(data.samples, data.y_full, pays, strict=True)]
-    if data.hydro is not None:  # the fluid's torque at the decimated samples
-        d = data.settings.decimate
-        loads = [load + h[::d] for load, h in zip(loads, data.hydro, strict=True)]
-    has_payload = any(p is not None for p in pays)
-    k, k_source, prior = joint_prior(robot, data.samples, data.y_full, nominal, target, gains,
-                                     loads, data.observed)
-    drive = _Drive(k, k_source, np.full(robot.dof, np.inf if k_source.startswith("absorbed") else np.nan))
-    if target == "current" and has_payload:
-        drive, prior = _payload_gains(robot, data, loads, drive, prior)
-    if friction == "none":
-        prior = without_friction(prior)
-    if sensor == "link":
-        prior = prior.copy()
-        prior[len(INERTIAL_NAMES)::PER_JOINT] = 0.0  # Ia: the sensor does not see the rotor
-    return drive, prior, loads
-
-
-def _payload_gains(robot: Robot, data: _Prepared, loads: list[np.ndarray], drive: _Drive,
-                   prior: np.ndarray) -> tuple[_Drive, np.ndarray]:
-    """Drive gains (n,), N m / A, estimated from runs with and without a payload.
-
-    ``loads`` (N_k, n) is the payload torque of each recording, N m. Returns the gains and a
-    copy of ``prior`` (15 n,) whose drive and friction terms, fitted in the units of
-    ``drive.k``, are rescaled to the estimated gains.
-    """
-    k = drive.k
-    phi, y, joint, _ = _stack(data.samples, data.y_full, data.relations.independent, np.ones(robot.dof),
-                              [np.zeros_like(x) for x in loads], observed=data.observed)
-    known = with_data(np.concatenate([x.reshape(-1) for x in loads]), data.observed,
-                      [len(x) for x in loads])
-    seen = np.unique(joint)  # a joint without data keeps its gain (std inf: not estimated)
-    est = estimate_drive_gains(phi, y, known, np.searchsorted(seen, joint),
-                               tuple(robot.joint_names[j] for j in seen))
-    gains, std = k.copy(), np.full(robot.dof, np.inf)
-    gains[seen], std[seen] = est.gains, est.std
-    # the prior's drive and friction terms were fitted in the units of the absorbed gains
-    prior = prior.copy()
-    for j in range(robot.dof):
-        prior[joint_columns(j)] *= gains[j] / k[j]
-    return _Drive(gains, "payload", std), prior
-
-
-def _linear_step(robot: Robot, data: _Prepared, k: np.ndarray, loads: list[np.ndarray],
+def _linear_step(robot: Robot, data: Prepared, k: np.ndarray, loads: list[np.ndarray],
                  prior: np.ndarray, method: str, regularization: float | str | None, weights: str,
                  state_noise: Any) -> tuple[_LinearStep, ThermalFit | None]:
     """The stacked problem and its (weighted) least-squares fit toward ``prior`` (steps 4 and 6),
@@ -477,7 +250,7 @@ def _linear_step(robot: Robot, data: _Prepared, k: np.ndarray, loads: list[np.nd
     step (weights, the consistent program) sees the base columns only.
     """
     th, cols = data.thermal, data.relations.independent
-    phi, y, joint, blocks = _stack(data.samples, data.y_full, cols, k, loads,
+    phi, y, joint, blocks = stacked_rows(data.samples, data.y_full, cols, k, loads,
                                    None if th is None else th.fit_rows, data.observed)
     phi, extra = phi[:, :cols.size], phi[:, cols.size:]  # base columns, thermal columns
     theta0 = data.relations.to_base(prior)
@@ -515,7 +288,7 @@ def _thermal_coefficients(phi: np.ndarray, y: np.ndarray, theta0: np.ndarray, jo
     return coef
 
 
-def _state_noise_fit(robot: Robot, data: _Prepared, step: _LinearStep, prior: np.ndarray,
+def _state_noise_fit(robot: Robot, data: Prepared, step: _LinearStep, prior: np.ndarray,
                      regularization: float | str | None, state_noise: Any) -> LinearFit:
     """The fit again with row weights ``1 / sigma_tau`` (m,) from the first fit ``step.fit``.
 
@@ -555,8 +328,8 @@ def _estimate_standard(robot: Robot, relations: BaseRelations, step: _LinearStep
     return theta, consistent_completion(relations, completed(relations, theta, prior), robot.dof)
 
 
-def _identification(robot: Robot, data: _Prepared, step: _LinearStep, theta: np.ndarray,
-                    standard: np.ndarray, drive: _Drive, target: str, method: str) -> Identification:
+def _identification(robot: Robot, data: Prepared, step: _LinearStep, theta: np.ndarray,
+                    standard: np.ndarray, drive: Drive, target: str, method: str) -> Identification:
     """The :class:`Identification` of base parameters ``theta`` (b,) and standard set (15 n,)."""
     table = _table(data.relations, theta, step.fit, step.theta0)
     ident_robot = robot_with_parameters(robot, standard, drive.k if target == "current" else None,
@@ -570,21 +343,6 @@ def _identification(robot: Robot, data: _Prepared, step: _LinearStep, theta: np.
         condition=step.fit.condition, singular_values=s, unexcited_directions=weak,
         residual_std=step.fit.sigma / drive.k, samples=data.count, relations=data.relations,
         _model=data.model)
-
-
-def _without_friction_columns(relations: BaseRelations) -> BaseRelations:
-    """The base relations with the friction parameters (Fv, Fcp, Fcn, Fo) left out; they only
-    ever combine among themselves, so the other base parameters are unchanged."""
-    keep = np.array([c % PER_JOINT <= len(INERTIAL_NAMES) for c in relations.independent])
-    return replace(relations, independent=relations.independent[keep], beta=relations.beta[keep])
-
-
-def _decimated(s: Samples, settings: Preprocess) -> Samples:
-    d = settings.decimate
-    if d == 1:
-        return s
-    return Samples(s.t[::d], s.q[::d], s.qd[::d], s.qdd[::d], None if s.y is None else s.y[::d],
-                   s.source)
 
 
 def _table(relations: Any, theta: np.ndarray, fit: LinearFit, theta0: np.ndarray) -> BaseParameters:

@@ -28,16 +28,61 @@ splits measured (docs/identification.md, "The velocity source").
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
-from robodyn.identification.choices import Candidate
+from robodyn.identification.choices import Candidate, Problem
+from robodyn.identification.local_residual import model_residuals
+from robodyn.identification.prediction_terms import as_predicted, with_corrections
 from robodyn.identification.preprocess import target_signal
 
-__all__ = ["chosen_velocity", "fit_residual", "same_law", "same_law_options"]
+__all__ = ["chosen_velocity", "fit_residual", "kept_source", "same_law", "same_law_options"]
+
+#: ``fit(opts, candidate, problem, scored) -> (Identification, recordings)``: a finished model.
+ModelFit = Callable[[Any, Candidate, Problem, list[Candidate]], tuple[Any, list[Any]]]
+
+
+def kept_source(winners: list[tuple[Candidate, Problem, list[Candidate]]], scored: list[Candidate],
+                fit: ModelFit, opts: Any, pays: list[Any], target: str) -> Any:
+    """The identification of the kept velocity source, with its corrections.
+
+    Parameters
+    ----------
+    winners : list of (Candidate, Problem, list of Candidate)
+        Each source's chosen candidate, its problem and its scored group
+        (:func:`~robodyn.identification.choices.choose`); emptied as the models are fitted, so
+        that each problem is freed once its model is.
+    scored : list of Candidate
+        Every candidate scored (all sources).
+    fit : callable
+        The finished model of one candidate (the pipeline's linear step, estimate and
+        :func:`~robodyn.identification.prediction_terms.with_model_terms`).
+    opts : IdentifyOptions
+    pays : list of Payload or None
+    target : {"tau", "current"}
+
+    Returns
+    -------
+    Identification
+        The model of the smaller :func:`fit_residual` (the only one with a single source),
+        the local correction fitted on it alone.
+    """
+    fits = [fit(opts, *winners.pop(0))]
+    if not winners:
+        return with_corrections(*fits[0], pays, target, opts)
+    # the other source with the friction law chosen on the first: the same terms compared
+    law = same_law_options(opts, fits[0][0])
+    while winners:
+        fits.append(same_law(fit(law, *winners.pop(0)), fits[0][0]))
+    # each source's model as it predicts: its residual on the fit data; the local correction
+    # then fitted on the kept one (from the same residuals)
+    res = [model_residuals(as_predicted(f, r, opts), r, pays, target) for f, r in fits]
+    scores = [fit_residual(r, e[1], target) for (_, r), e in zip(fits, res, strict=True)]
+    result, recs = chosen_velocity(fits, scores, scored)
+    return with_corrections(result, recs, pays, target, opts, res[int(np.argmin(scores))])
 
 
 def fit_residual(recs: Sequence[Any], residuals: Sequence[np.ndarray], target: str) -> float:
