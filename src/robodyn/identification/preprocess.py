@@ -437,10 +437,11 @@ class SharedRows:
 
     def _buffer(self, size: int) -> np.ndarray:
         """The unfiltered rows' scratch buffer, at least ``size`` float64: grown to twice the
-        request when needed (memory never written costs nothing; a candidate evaluated at twice
-        the rate, a wider cut-off's, then touches only the second half)."""
+        request when needed, within :data:`ROWS_BYTES` (memory never written costs nothing on
+        Linux, a reservation elsewhere; a candidate evaluated at twice the rate, a wider
+        cut-off's, then touches only the second half)."""
         if self._scratch.size < size:
-            self._scratch = np.empty(2 * size)
+            self._scratch = np.empty(max(size, min(2 * size, ROWS_BYTES // 8)))
         return self._scratch
 
     def clear(self) -> None:
