@@ -154,3 +154,38 @@ def test_codegen_refuses_a_robot_without_forward_dynamics(massless, capsys, tmp_
     errors = [line for line in err.splitlines() if line.startswith("robodyn: error:")]
     assert len(errors) == 1 and "singular in every configuration" in errors[0]
     assert "joint 'wrist'" in errors[0]
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_the_compiled_batches_count_the_blocks_with_a_non_finite_output(tmp_path, threads):
+    # the C batches of the kernels a singular M breaks count the blocks whose checked outputs
+    # are not finite (codegen.c_outputs.FINITE_CHECKED), so that finite results are not read
+    # back; a count of 0 must mean finite, wherever the singular state sits (first block, a
+    # middle one, the last, partial one) and on any number of threads
+    from robodyn.codegen.cpu import BLOCK
+
+    path = tmp_path / "point_mass_rr.yaml"
+    path.write_text(POINT_MASS)
+    model = rd.compile_model(rd.load(path))
+    count = 3 * BLOCK + 3  # three full blocks and a partial one at any block width
+    rng = np.random.default_rng(7)
+    q = np.column_stack([rng.uniform(-1, 1, count), rng.uniform(0.3, 2.5, count)])  # bent: regular
+    qd, tau = rng.normal(size=(count, 2)), rng.normal(size=(count, 2))
+    d = model._derivative_model
+    calls = {"forward_dynamics": lambda q: model._call_counted(
+                 "forward_dynamics", q, qd, tau, threads=threads),
+             "state_derivative": lambda q: model._call_counted(
+                 "state_derivative", np.hstack([q, qd]), tau, threads=threads),
+             "forward_dynamics_derivatives": lambda q: d._call_counted(
+                 "forward_dynamics_derivatives", q, qd, tau, threads=threads)}
+    for name, call in calls.items():
+        out, bad = call(q)
+        assert bad == 0 and np.all(np.isfinite(out)), name
+        for k in (0, BLOCK + 1, count - 1):
+            stretched = q.copy()
+            stretched[k, 1] = 0.0  # M singular at state k only
+            out, bad = call(stretched)
+            assert bad == 1, (name, k)
+            assert not np.all(np.isfinite(out[k])) and np.all(np.isfinite(np.delete(out, k, 0))), name
+    with pytest.raises(SingularMassMatrixError):
+        model.forward_dynamics_derivatives(stretched, qd, tau, threads=threads)

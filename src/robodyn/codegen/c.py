@@ -6,6 +6,9 @@ For each kernel ``k`` the source defines::
     void PREFIXk_batch(long count, const double *in1, ..., double *out);  count states
     void PREFIXk_batch_threads(long count, int threads, ...);             the same on threads
 
+and ``long PREFIXk_batch_nonfinite(...)``, the batch counting its blocks with a non-finite
+output, for the kernels a singular mass matrix breaks (:data:`~robodyn.codegen.c_outputs.FINITE_CHECKED`),
+
 plus :func:`simulation_source`'s ``PREFIXsimulate`` (a whole trajectory, RK4 or semi-implicit
 Euler, under a sampled state-feedback law, in one call) and ``PREFIXsimulate_ensemble`` (many
 trajectories at once, a block of them per vector loop).
@@ -59,7 +62,14 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
 from robodyn.codegen.base import GeneratedFile, Printer, identifier
-from robodyn.codegen.c_outputs import STREAM_MIN_BYTES, copy_out_source, output_lines, staged_outputs
+from robodyn.codegen.c_outputs import (
+    FINITE_CHECKED,
+    STREAM_MIN_BYTES,
+    copy_out_source,
+    nonfinite_lines,
+    output_lines,
+    staged_outputs,
+)
 from robodyn.codegen.c_simulation import (
     ensemble_signature,
     ensemble_source,
@@ -330,12 +340,15 @@ class CPrinter(Printer):
         params = ", ".join(_parameters(kernel))
         stream = (f"count >= {-(-STREAM_MIN_BYTES // out.staged_bytes)}L" if out.staged_bytes
                   else "(void)count, 0")
+        checked = kernel.name in FINITE_CHECKED
         return "\n".join([
             *out.tables,
             f"/* {kernel.name} for the states begin <= j < end stored one after another, {BLOCK} at a "
-            "time. */",
-            f"static void {self.prefix}{kernel.name}_range(long begin, long end, {params}, int stream_) {{",
+            "time; returns " + ("the number of blocks with a non-finite output. */" if checked
+                                else "0. */"),
+            f"static long {self.prefix}{kernel.name}_range(long begin, long end, {params}, int stream_) {{",
             f"    double {', '.join(arrays + out.arrays)};",
+            "    long nonfinite_ = 0;",
             *(out.start or ["    (void)stream_;"]),
             f"    for (long k0_ = begin; k0_ < end; k0_ += {BLOCK}) {{",
             f"        const int m_ = end - k0_ < {BLOCK} ? (int)(end - k0_) : {BLOCK};",
@@ -343,6 +356,7 @@ class CPrinter(Printer):
             *trig,
             *out.fill,
             f"        {self.prefix}{core.name}(m_, {', '.join(args)});",
+            *(nonfinite_lines(kernel, core, computed or {}, BLOCK) if checked else []),
             *(["        for (int k_ = 0; k_ < m_; ++k_) {",
                "            const long j_ = k0_ + k_;",
                *out.scatter,
@@ -350,6 +364,7 @@ class CPrinter(Printer):
             *out.per_block,
             "    }",
             *([f"    if (stream_) {self.prefix}stream_fence();"] if out.staged_bytes else []),
+            "    return nonfinite_;",
             "}",
             "",
             f"/* Whether a batch of count states writes {kernel.name}'s staged outputs by streaming "
@@ -386,24 +401,26 @@ class CPrinter(Printer):
         inner = f"{self.prefix}{kernel.name}_threads_"
         params = ", ".join(_parameters(kernel))
         lines = [
-            f"/* {kernel.name} for count states on `threads` threads (OpenMP; one without). */",
-            f"static void {inner}(long count, int threads, int stream, {params}) {{",
+            f"/* {kernel.name} for count states on `threads` threads (OpenMP; one without); the "
+            "ranges' count. */",
+            f"static long {inner}(long count, int threads, int stream, {params}) {{",
             "#ifdef _OPENMP",
             f"    if (threads > 1 && count > {BLOCK}) {{",
             "        /* whole blocks, at most THREAD_CHUNK states, at least one piece per thread */",
             f"        const long share = (count / threads + {BLOCK - 1}) / {BLOCK} * {BLOCK};",
             f"        const long piece = share < {THREAD_CHUNK} ? share : {THREAD_CHUNK};",
             "        const long pieces = (count + piece - 1) / piece;",
-            "#pragma omp parallel for num_threads(threads) schedule(static)",
+            "        long nonfinite = 0;",
+            "#pragma omp parallel for num_threads(threads) schedule(static) reduction(+:nonfinite)",
             "        for (long p_ = 0; p_ < pieces; ++p_) {",
             "            const long end = piece * p_ + piece < count ? piece * p_ + piece : count;",
-            f"            {rng}(piece * p_, end, {names}, stream);",
+            f"            nonfinite += {rng}(piece * p_, end, {names}, stream);",
             "        }",
-            "        return;",
+            "        return nonfinite;",
             "    }",
             "#endif",
             "    (void)threads;",
-            f"    {rng}(0, count, {names}, stream);",
+            f"    return {rng}(0, count, {names}, stream);",
             "}",
             "",
             self.signature(kernel, batch=True, threads=True) + " {",
@@ -416,7 +433,18 @@ class CPrinter(Printer):
                       self.stream_signature(kernel) + " {",
                       f"    {inner}(count, threads, stream, {names});",
                       "}"]
+        if kernel.name in FINITE_CHECKED:
+            lines += ["", f"/* {kernel.name}'s batch (stream as for _batch_stream, ignored without "
+                      "staged outputs): the number of blocks with a non-finite output. */",
+                      self.nonfinite_signature(kernel) + " {",
+                      f"    return {inner}(count, threads, stream, {names});",
+                      "}"]
         return "\n".join(lines) + "\n"
+
+    def nonfinite_signature(self, kernel: Kernel) -> str:
+        """The C prototype of ``PREFIXk_batch_nonfinite`` (without the trailing semicolon)."""
+        return (f"long {self.prefix}{kernel.name}_batch_nonfinite(long count, int threads, "
+                f"int stream, {', '.join(_parameters(kernel))})")
 
     def stream_signature(self, kernel: Kernel) -> str:
         """The C prototype of ``PREFIXk_batch_stream`` (without the trailing semicolon)."""
@@ -433,6 +461,8 @@ class CPrinter(Printer):
             lines.append(self.signature(kernel, batch=True, threads=True).replace("restrict ", "") + ";")
             if staged_outputs(kernel, self._direct(kernel)):
                 lines.append(self.stream_signature(kernel).replace("restrict ", "") + ";")
+            if kernel.name in FINITE_CHECKED:
+                lines.append(self.nonfinite_signature(kernel).replace("restrict ", "") + ";")
         if with_simulation and "state_derivative" in kset.names:
             runtime = len(kset.runtime_parameters)
             lines.append(simulate_signature(self.prefix, runtime) + ";")

@@ -182,9 +182,9 @@ class Model:
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
         self._require_dynamics()
-        qdd = self._call("forward_dynamics", q, qd, tau, threads=threads, parameters=parameters,
-                         out=out)
-        return self._nonsingular(qdd, q, parameters)
+        qdd, bad = self._call_counted("forward_dynamics", q, qd, tau, threads=threads,
+                                      parameters=parameters, out=out)
+        return self._nonsingular(qdd, q, parameters, bad)
 
     def state_derivative(self, x: np.ndarray, tau: np.ndarray, *, threads: int = 1,
                          parameters: ParameterValues = None,
@@ -197,9 +197,9 @@ class Model:
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
         self._require_dynamics()
-        xd = self._call("state_derivative", x, tau, threads=threads, parameters=parameters,
-                        out=out)
-        return self._nonsingular(xd, np.asarray(x, dtype=float)[..., : self.dof], parameters)
+        xd, bad = self._call_counted("state_derivative", x, tau, threads=threads,
+                                     parameters=parameters, out=out)
+        return self._nonsingular(xd, np.asarray(x, dtype=float)[..., : self.dof], parameters, bad)
 
     def check_mass_matrix(self, q: np.ndarray, parameters: ParameterValues = None) -> None:
         """Raise :class:`SingularMassMatrixError` when ``M(q)`` is not positive definite.
@@ -236,10 +236,12 @@ class Model:
         if self.singular is not None:
             raise SingularMassMatrixError(self.singular)
 
-    def _nonsingular(self, out: np.ndarray, q: np.ndarray,
-                     parameters: ParameterValues = None) -> np.ndarray:
-        """``out`` unchanged when finite; otherwise check ``M`` at the first non-finite row."""
-        if np.all(np.isfinite(out)):
+    def _nonsingular(self, out: np.ndarray, q: np.ndarray, parameters: ParameterValues = None,
+                     nonfinite: int | None = None) -> np.ndarray:
+        """``out`` unchanged when finite; otherwise check ``M`` at the first non-finite row.
+        ``nonfinite``: the kernel's own count of blocks with a non-finite output (0: finite,
+        nothing read back; None: not counted)."""
+        if nonfinite == 0 or np.all(np.isfinite(out)):
             return out
         rows = np.atleast_2d(np.asarray(q, dtype=float))
         bad = ~np.all(np.isfinite(out.reshape(rows.shape[0], -1)), axis=1)
@@ -350,11 +352,11 @@ class Model:
             When ``M(q)`` is singular at a state (finite inputs, non-finite result).
         """
         self._require_dynamics()
-        d = self._derivative_model._call("forward_dynamics_derivatives", q, qd, tau, threads=threads,
-                                         parameters=parameters, out=out)
+        d, bad = self._derivative_model._call_counted("forward_dynamics_derivatives", q, qd, tau,
+                                                      threads=threads, parameters=parameters, out=out)
         n = self.dof
         # singular M: 1/L_jj and so (M^-1)_jj are non-finite; the diagonal spares reading it all
-        self._nonsingular(np.diagonal(d[..., 2 * n:], axis1=-2, axis2=-1), q, parameters)
+        self._nonsingular(np.diagonal(d[..., 2 * n:], axis1=-2, axis2=-1), q, parameters, bad)
         return d[..., :n], d[..., n:2 * n], d[..., 2 * n:]
 
     def regressor_derivatives(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, *,
@@ -423,6 +425,13 @@ class Model:
 
     def _call(self, name: str, *arrays: np.ndarray, threads: int = 1,
               parameters: ParameterValues = None, out: np.ndarray | None = None) -> np.ndarray:
+        return self._call_counted(name, *arrays, threads=threads, parameters=parameters, out=out)[0]
+
+    def _call_counted(self, name: str, *arrays: np.ndarray, threads: int = 1,
+                      parameters: ParameterValues = None, out: np.ndarray | None = None
+                      ) -> tuple[np.ndarray, int | None]:
+        """Kernel ``name`` on ``arrays``; with the number of blocks whose outputs are not all
+        finite where the compiled batch counts them (``PREFIXk_batch_nonfinite``), else None."""
         threads = thread_count(threads)
         inputs, result_shape = kernel_signature(name, self.dof)
         batch_shape: tuple[int, ...] | None = None
@@ -448,29 +457,30 @@ class Model:
             with np.errstate(divide="ignore", invalid="ignore"):
                 result = getattr(self._impl, name)(*args).reshape(out_shape)
             if target is None:
-                return result
+                return result, None
             target[...] = result
-            return target
+            return target, None
         ffi, lib = self._impl.ffi, self._impl.lib
         # C-contiguous float64 inputs are passed without a copy
         args = [np.ascontiguousarray(a) for a in args]
         out = np.empty(out_shape) if target is None else target
         ptrs = [ffi.from_buffer("double[]", a) for a in args]
         out_ptr = ffi.from_buffer("double[]", out)
-        stream_name = f"{_PREFIX}{name}_batch_stream"
-        staged = getattr(lib, stream_name) if batch_shape and stream_name in self._functions else None
-        if staged is not None:
-            # streaming stores into a large reused matrix; cached ones into fresh memory, whose
-            # lines the operating system has just zeroed through the cache
-            stream = int(target is not None and out.nbytes >= STREAM_MIN_BYTES)
-            staged(batch_shape[0], threads, stream, *ptrs, out_ptr)
+        stream_name, counted = f"{_PREFIX}{name}_batch_stream", f"{_PREFIX}{name}_batch_nonfinite"
+        # streaming stores into a large reused matrix; cached ones into fresh memory, whose
+        # lines the operating system has just zeroed through the cache
+        stream = int(target is not None and out.nbytes >= STREAM_MIN_BYTES)
+        if batch_shape and counted in self._functions:
+            return out, int(getattr(lib, counted)(batch_shape[0], threads, stream, *ptrs, out_ptr))
+        if batch_shape and stream_name in self._functions:
+            getattr(lib, stream_name)(batch_shape[0], threads, stream, *ptrs, out_ptr)
         elif batch_shape and threads > 1:
             getattr(lib, f"{_PREFIX}{name}_batch_threads")(batch_shape[0], threads, *ptrs, out_ptr)
         elif batch_shape:
             getattr(lib, f"{_PREFIX}{name}_batch")(batch_shape[0], *ptrs, out_ptr)
         else:
             getattr(lib, f"{_PREFIX}{name}")(*ptrs, out_ptr)
-        return out
+        return out, None
 
 
 def compile_model(robot: Robot, backend: Backend = "c", *,
