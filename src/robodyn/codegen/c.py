@@ -7,9 +7,8 @@ For each kernel ``k`` the source defines::
     void PREFIXk_batch_threads(long count, int threads, ...);             the same on threads
 
 and ``long PREFIXk_batch_nonfinite(...)``, the batch counting its blocks with a non-finite
-output, for the kernels a singular mass matrix breaks (:data:`~robodyn.codegen.c_outputs.FINITE_CHECKED`),
-
-plus :func:`simulation_source`'s ``PREFIXsimulate`` (a whole trajectory, RK4 or semi-implicit
+output, for the kernels a singular mass matrix breaks (``c_outputs.FINITE_CHECKED``), plus
+:func:`simulation_source`'s ``PREFIXsimulate`` (a whole trajectory, RK4 or semi-implicit
 Euler, under a sampled state-feedback law, in one call) and ``PREFIXsimulate_ensemble`` (many
 trajectories at once, a block of them per vector loop).
 

@@ -11,8 +11,29 @@ from robodyn.codegen.singular import structural_singularity, without_infinities
 from robodyn.robot.errors import InputError, SingularMassMatrixError
 from robodyn.robot.model import Robot
 
-__all__ = ["check_structure", "out_buffer", "structural_singularity", "thread_count",
+__all__ = ["batch_inputs", "check_structure", "out_buffer", "structural_singularity", "thread_count",
            "without_infinities"]
+
+
+def batch_inputs(name: str, inputs: Sequence[tuple[str, int]], arrays: Sequence[np.ndarray]
+                 ) -> tuple[list[np.ndarray], tuple[int, ...]]:
+    """The inputs of kernel ``name`` as float64 arrays, (width,) or (N, width) each as ``inputs``
+    ((name, width) per argument) says, and their common batch shape (() or (N,))."""
+    batch_shape: tuple[int, ...] | None = None
+    args = []
+    for (arg_name, width), value in zip(inputs, arrays, strict=True):
+        arr = np.asarray(value, dtype=np.float64)
+        if arr.ndim not in (1, 2) or arr.shape[-1] != width:
+            raise InputError(f"{name}: {arg_name} must have shape ({width},) or (N, {width}), "
+                             f"got {arr.shape}")
+        if batch_shape is None:
+            batch_shape = arr.shape[:-1]
+        elif arr.shape[:-1] != batch_shape:
+            raise InputError(f"{name}: {arg_name} has shape {arr.shape}, but the first "
+                             f"argument's batch shape is {batch_shape}")
+        args.append(arr)
+    assert batch_shape is not None
+    return args, batch_shape
 
 
 def out_buffer(out: np.ndarray, shape: tuple[int, ...], inputs: Sequence[np.ndarray],

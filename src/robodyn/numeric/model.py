@@ -32,6 +32,7 @@ from robodyn.codegen.kernels import (
 )
 from robodyn.codegen.python import PythonPrinter
 from robodyn.numeric.checks import (
+    batch_inputs,
     out_buffer,
     structural_singularity,
     thread_count,
@@ -434,20 +435,7 @@ class Model:
         finite where the compiled batch counts them (``PREFIXk_batch_nonfinite``), else None."""
         threads = thread_count(threads)
         inputs, result_shape = kernel_signature(name, self.dof)
-        batch_shape: tuple[int, ...] | None = None
-        args = []
-        for (arg_name, width), value in zip(inputs, arrays, strict=True):
-            arr = np.asarray(value, dtype=np.float64)
-            if arr.ndim not in (1, 2) or arr.shape[-1] != width:
-                raise InputError(f"{name}: {arg_name} must have shape ({width},) or (N, {width}), "
-                                 f"got {arr.shape}")
-            if batch_shape is None:
-                batch_shape = arr.shape[:-1]
-            elif arr.shape[:-1] != batch_shape:
-                raise InputError(f"{name}: {arg_name} has shape {arr.shape}, but the first "
-                                 f"argument's batch shape is {batch_shape}")
-            args.append(arr)
-        assert batch_shape is not None
+        args, batch_shape = batch_inputs(name, inputs, arrays)
         if self.runtime_parameters or parameters is not None:
             args.append(self.parameter_input(parameters, batch_shape, name))
         out_shape = batch_shape + result_shape
