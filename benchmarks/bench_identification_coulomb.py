@@ -26,11 +26,12 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1]))
+# first: the quality benchmark it imports limits BLAS and OpenMP to one thread before NumPy
+# loads, as for the table's own figures (2 BLAS threads moved the Kinova torque row's 4th digit)
 import bench_identification_weight as weight  # noqa: E402
+import numpy as np  # noqa: E402
 import results  # noqa: E402
 
 import robodyn as rd  # noqa: E402
