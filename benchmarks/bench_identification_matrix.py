@@ -13,9 +13,12 @@ another excitation run and a jointwise run with static holds; ``other``: another
 ``period``: the last quarter of the fit run). Printed: raw and filtered held-out error of the
 textbook and of the default, and the noise floor; nothing is written to the results file (the
 figures quoted in docs/identification.md from it name their configuration).
+``--stamp-tick SECONDS`` rounds every recording's stamps to a logger clock of that tick while
+the samples were taken as the sensors say (``0.002`` at 94 Hz: stamps 10 or 12 ms apart, as
+issue 20's cobot logs them, on samples taken every 10.6 ms).
 
 Run: ``python benchmarks/bench_identification_matrix.py lwr4:1000:tau:1:jointwise
-[ARM:RATE:TARGET:SEED:VALIDATION ...]`` (no argument: the configurations of
+[ARM:RATE:TARGET:SEED:VALIDATION ...] [--stamp-tick SECONDS]`` (no configuration: those of
 :data:`DEFAULT_CONFIGURATIONS`).
 """
 
@@ -68,8 +71,10 @@ def _plant(desc: rd.Robot, arm: str, target: str, seed: int) -> rd.Robot:
     return plant if target != "current" or arm == "puma" else qc.with_drives(plant, 100 + seed)
 
 
-def case(arm: str, rate: float, target: str, seed: int, validation: str) -> quality.Case:
-    """The fit and held-out recordings of one configuration (module docstring)."""
+def case(arm: str, rate: float, target: str, seed: int, validation: str,
+         stamp_tick: float = 0.0) -> quality.Case:
+    """The fit and held-out recordings of one configuration (module docstring); ``stamp_tick``
+    > 0: the stamps rounded to that clock (:func:`quality_cases.ticked`)."""
     from robodyn.studies.testprog import jointwise
     from robodyn.studies.virtual_lab import Sensors, virtual_lab
 
@@ -87,12 +92,15 @@ def case(arm: str, rate: float, target: str, seed: int, validation: str) -> qual
     if validation == "jointwise":
         programs.append(jointwise(model, speeds=(0.5,), stroke=0.8))
     recs = [virtual_lab(plant, p, sensors=sens, seed=s).recording for s, p in enumerate(programs, 1)]
+    if stamp_tick > 0:
+        recs = [qc.ticked(r, stamp_tick) for r in recs]
     recs = ([qc._rounded(r, 4) for r in recs] if target == "current" else
             [qc._gapped(r, np.random.default_rng(s), gaps=20, length=15) for s, r in enumerate(recs)])
     if validation == "period":
         k = int(0.75 * recs[0].n_samples)
         recs = [recs[0].slice(recs[0].t[0], recs[0].t[k - 1]), recs[0].slice(recs[0].t[k], recs[0].t[-1])]
-    name = f"{arm} {rate:g} Hz {target} seed {seed} {validation}"
+    name = f"{arm} {rate:g} Hz {target} seed {seed} {validation}" + (
+        f" stamps to {stamp_tick * 1e3:g} ms" if stamp_tick > 0 else "")
     return quality.Case(name, desc, None if urdf is None else str(urdf), recs[:1], recs[1:], target)
 
 
@@ -101,13 +109,18 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("configurations", nargs="*", type=configuration,
                         help="ARM:RATE:TARGET:SEED:VALIDATION (default: the documented set)")
+    parser.add_argument("--stamp-tick", type=float, default=0.0, metavar="SECONDS",
+                        help="round the stamps to a logger clock of this tick (0.002: 10/12 ms "
+                             "steps at 94 Hz); the samples stay where they were taken")
     args = parser.parse_args()
+    if args.stamp_tick < 0:
+        parser.error("--stamp-tick must be 0 (off) or a positive number of seconds")
     warnings.simplefilter("ignore")
     chosen = args.configurations or [configuration(c) for c in DEFAULT_CONFIGURATIONS]
     quality.METHODS = [m for m in quality.METHODS if m[0] == "robodyn default"]
     for conf in chosen:
         rows: list[list[str]] = []
-        entry = quality.run_case(case(*conf), rows)
+        entry = quality.run_case(case(*conf, stamp_tick=args.stamp_tick), rows)
         m = entry["models"]
         print(f"{entry['data_set']}: textbook {m['textbook']['raw']:.4f} / "
               f"{m['textbook']['filtered']:.4f}, default {m['robodyn default']['raw']:.4f} / "

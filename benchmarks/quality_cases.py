@@ -99,6 +99,17 @@ def _rounded(rec: rd.Recording, decimals: int) -> rd.Recording:
                         joint_names=rec.joint_names, source=rec.source + f" ({decimals} decimals)")
 
 
+def ticked(rec: rd.Recording, tick: float) -> rd.Recording:
+    """``rec`` with its stamps rounded to a logger clock of ``tick`` seconds (the samples as
+    taken); a stamp that does not advance past the one before is refused."""
+    t = tick * np.round(np.asarray(rec.t) / tick)
+    if np.any(np.diff(t) <= 0):
+        raise ValueError(f"stamp tick {tick:g} s: two samples of {rec.source} share a stamp")
+    # a new recording: its velocity estimate is made on the new stamps
+    return rd.Recording(t=t, q=rec.q, tau=rec.tau, current=rec.current, joint_names=rec.joint_names,
+                        source=rec.source + f" (stamps to {tick * 1e3:g} ms)")
+
+
 def _gapped(rec: rd.Recording, rng: np.random.Generator, gaps: int, length: int) -> rd.Recording:
     """The recording with ``gaps`` runs of ``length`` samples dropped (a logger's lost packets)."""
     keep = np.ones(rec.n_samples, bool)

@@ -1,0 +1,54 @@
+"""The virtual lab's logger-clock stamps of the identification benchmarks (``quality_cases.ticked``).
+
+``bench_identification_matrix.py --stamp-tick`` rounds each recording's stamps to a coarse clock:
+samples taken every 10.6 ms (94 Hz) and stamped by a 2 ms clock come out 10 or 12 ms apart, each
+stamp within half a tick of the instant, the measured values untouched; a tick so coarse that two
+samples share a stamp is refused, naming the recording.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import numpy as np
+import pytest
+
+import robodyn as rd
+
+BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
+
+
+@pytest.fixture(scope="module")
+def cases() -> ModuleType:
+    """``benchmarks/quality_cases.py`` loaded as a module."""
+    spec = importlib.util.spec_from_file_location("quality_cases", BENCHMARKS / "quality_cases.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # its dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return module
+
+
+def _log(period: float, count: int) -> rd.Recording:
+    t = period * np.arange(count)
+    q = np.column_stack([np.sin(2.0 * t), np.cos(3.0 * t)])
+    return rd.Recording(t=t, q=q, current=0.1 * q, joint_names=("a", "b"), source="log.csv")
+
+
+def test_a_2_ms_clock_stamps_94_hz_samples_10_or_12_ms_apart(cases: ModuleType) -> None:
+    rec = _log(0.0106, 500)
+    out = cases.ticked(rec, 0.002)
+    steps = np.unique(np.round(np.diff(out.t) * 1e3, 9))
+    assert set(steps) == {10.0, 12.0}
+    assert np.max(np.abs(out.t - rec.t)) <= 0.001 + 1e-12
+    np.testing.assert_array_equal(out.q, rec.q)
+    np.testing.assert_array_equal(out.current, rec.current)
+    assert np.allclose(out.t / 0.002, np.round(out.t / 0.002), atol=1e-9)
+
+
+def test_a_tick_that_merges_two_samples_is_refused_naming_the_recording(cases: ModuleType) -> None:
+    with pytest.raises(ValueError, match="log.csv"):
+        cases.ticked(_log(0.0106, 50), 0.02)
