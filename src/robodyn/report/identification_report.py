@@ -180,7 +180,7 @@ def _slug(text: str) -> str:
 # ----------------------------------------------------------------------------------------------
 
 
-def kinova_section(out: Path, data_dir: Path | None = None, method: str = "wls",
+def kinova_section(out: Path, data_dir: Path | None = None, method: str = "consistent",
                    friction_models: Sequence[str] = ("none", "linear", "stribeck", "load",
                                                      "polynomial")) -> tuple[str, bool]:
     """The demo's Kinova Gen3 section: identify on whole-arm runs, validate on held-out data.
@@ -197,9 +197,10 @@ def kinova_section(out: Path, data_dir: Path | None = None, method: str = "wls",
     data_dir : Path, optional
         The recordings (default: ``../shared/data/kinova-gen3`` beside the repository root).
     method : {"ols", "wls", "consistent"}
+        The estimator (default: rd.identify's, the physically consistent one).
     friction_models : sequence of str
-        Friction models whose held-out error is tabulated (each identified anew; empty: no
-        table).
+        Friction models whose held-out error is tabulated (each identified anew with the main
+        fit's velocity source, cut-off and Tikhonov weight; empty: no table).
 
     Returns
     -------
@@ -228,9 +229,14 @@ def kinova_section(out: Path, data_dir: Path | None = None, method: str = "wls",
         if friction_models:
             from robodyn.identification.friction_comparison import friction_table
 
+            # the main fit's processing for every law, so that the law alone differs (and
+            # each fit skips the processing's cross-validation: half the time)
+            c = ident.choices
+            same = ({} if c is None else
+                    {"velocity": c.velocity, "cutoff": c.cutoff, "regularization": c.regularization})
             with progress(f"Kinova Gen3: held-out error of {len(friction_models)} friction models"):
                 ft = friction_table(robot, train, test, models=friction_models, target="current",
-                                    method=method)
+                                    method=method, model=model, **same)
             friction_html = _friction_html(ft, robot.joint_names)
         folder = out / "kinova"
         held_id, held_urdf, jw_id, jw_urdf, parts = _validations(out, robot, model, ident, test,
