@@ -11,6 +11,7 @@ import functools
 import importlib.util
 import json
 import re
+import sys
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -19,13 +20,20 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 @functools.cache
-def load_renderer() -> ModuleType:
-    """``benchmarks/render_readme.py`` loaded as a module (``benchmarks/`` is not a package)."""
-    spec = importlib.util.spec_from_file_location("render_readme", ROOT / "benchmarks" / "render_readme.py")
+def benchmark_module(name: str) -> ModuleType:
+    """``benchmarks/<name>.py`` loaded as a module (``benchmarks/`` is not a package), registered
+    in ``sys.modules`` under ``name`` (its dataclasses look their module up there)."""
+    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
     spec.loader.exec_module(module)
     return module
+
+
+def load_renderer() -> ModuleType:
+    """``benchmarks/render_readme.py`` loaded as a module."""
+    return benchmark_module("render_readme")
 
 
 def readme_sections() -> dict[str, re.Match[str]]:

@@ -8,28 +8,19 @@ samples share a stamp is refused, naming the recording.
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 import pytest
 
 import robodyn as rd
-
-BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
+from tests.readme_results import benchmark_module
 
 
 @pytest.fixture(scope="module")
 def cases() -> ModuleType:
     """``benchmarks/quality_cases.py`` loaded as a module."""
-    spec = importlib.util.spec_from_file_location("quality_cases", BENCHMARKS / "quality_cases.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # its dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+    return benchmark_module("quality_cases")
 
 
 def _log(period: float, count: int) -> rd.Recording:

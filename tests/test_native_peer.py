@@ -7,28 +7,20 @@ that the model file carries the benchmark's Pinocchio model number for number.
 
 from __future__ import annotations
 
-import importlib.util
 import sys
-from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 import pytest
 
 from robodyn.codegen.build import CFLAGS, SCALAR_GCC_FLAGS, applied_flags
-
-BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
+from tests.readme_results import benchmark_module
 
 
 @pytest.fixture(scope="module")
 def peer() -> ModuleType:
     """``benchmarks/native_peer.py`` loaded as a module."""
-    spec = importlib.util.spec_from_file_location("native_peer", BENCHMARKS / "native_peer.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # its dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+    return benchmark_module("native_peer")
 
 
 def test_no_cxx_compiler_is_one_line(peer, monkeypatch):
