@@ -9,17 +9,20 @@ import numpy as np
 
 from robodyn.identification.friction import FRICTION_MODELS
 from robodyn.identification.pipeline import identify
+from robodyn.robot.errors import IdentificationError
 from robodyn.validation.heldout import held_out_error
 
 __all__ = ["friction_table"]
 
 
 def friction_table(robot: Any, train: Any, test: Sequence[Any], models: Sequence[str] = FRICTION_MODELS,
-                   **options: Any) -> Any:
+                   *, like: Any = None, **options: Any) -> Any:
     """Held-out error of each friction model.
 
     Each model is identified on ``train`` (``rd.identify(robot, train, friction=model,
-    **options)``) and predicts every recording of ``test``.
+    **options)``) and predicts every recording of ``test``. With ``like`` (an identification of
+    the same data), every model is identified with its velocity source, cut-off and Tikhonov
+    weight, so that the law alone differs (and no fit repeats their cross-validation).
 
     Parameters
     ----------
@@ -28,6 +31,9 @@ def friction_table(robot: Any, train: Any, test: Sequence[Any], models: Sequence
     test : sequence of Recording
     models : sequence of str
         Among ``FRICTION_MODELS``.
+    like : Identification, optional
+        Sets ``velocity``, ``cutoff`` and ``regularization`` to ``like``'s (its
+        ``preprocess.velocity``, ``preprocess.cutoff`` and ``regularization``).
     **options
         Passed to :func:`robodyn.identification` (target, method, cutoff, ...).
 
@@ -39,9 +45,22 @@ def friction_table(robot: Any, train: Any, test: Sequence[Any], models: Sequence
         the reference filter of :mod:`robodyn.validation.heldout`), ``noise_floor``
         (``||y - y_f|| / ||y||``) and
         ``relative_error_<joint>`` per joint (raw).
+
+    Raises
+    ------
+    IdentificationError
+        ``like`` together with an option it sets.
     """
     import pandas as pd
 
+    if like is not None:
+        same = {"velocity": like.preprocess.velocity, "cutoff": like.preprocess.cutoff,
+                "regularization": like.regularization}
+        clash = sorted(set(same) & set(options))
+        if clash:
+            raise IdentificationError(f"friction_table: like= sets {', '.join(clash)}; pass "
+                                      "either like= or those options")
+        options = {**options, **same}
     rows = []
     for model in models:
         ident = identify(robot, train, friction=model, **options)

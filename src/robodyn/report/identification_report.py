@@ -231,12 +231,9 @@ def kinova_section(out: Path, data_dir: Path | None = None, method: str = "consi
 
             # the main fit's processing for every law, so that the law alone differs (and
             # each fit skips the processing's cross-validation: half the time)
-            c = ident.choices
-            same = ({} if c is None else
-                    {"velocity": c.velocity, "cutoff": c.cutoff, "regularization": c.regularization})
             with progress(f"Kinova Gen3: held-out error of {len(friction_models)} friction models"):
                 ft = friction_table(robot, train, test, models=friction_models, target="current",
-                                    method=method, model=model, **same)
+                                    method=method, model=model, like=ident)
             friction_html = _friction_html(ft, robot.joint_names)
         folder = out / "kinova"
         held_id, held_urdf, jw_id, jw_urdf, parts = _validations(out, robot, model, ident, test,
