@@ -105,9 +105,10 @@ def ticked(rec: rd.Recording, tick: float) -> rd.Recording:
     t = tick * np.round(np.asarray(rec.t) / tick)
     if np.any(np.diff(t) <= 0):
         raise ValueError(f"stamp tick {tick:g} s: two samples of {rec.source} share a stamp")
-    # a new recording: its velocity estimate is made on the new stamps
-    return rd.Recording(t=t, q=rec.q, tau=rec.tau, current=rec.current, joint_names=rec.joint_names,
-                        source=rec.source + f" (stamps to {tick * 1e3:g} ms)")
+    # a new recording: a measured velocity is kept, an estimated one is made on the new stamps
+    qd = None if "qd" in rec.estimated else rec.qd
+    return rd.Recording(t=t, q=rec.q, qd=qd, tau=rec.tau, current=rec.current,
+                        joint_names=rec.joint_names, source=rec.source + f" (stamps to {tick * 1e3:g} ms)")
 
 
 def _gapped(rec: rd.Recording, rng: np.random.Generator, gaps: int, length: int) -> rd.Recording:

@@ -40,6 +40,15 @@ def test_a_2_ms_clock_stamps_94_hz_samples_10_or_12_ms_apart(cases: ModuleType) 
     assert np.allclose(out.t / 0.002, np.round(out.t / 0.002), atol=1e-9)
 
 
+def test_a_measured_velocity_is_kept_and_an_estimated_one_made_anew(cases: ModuleType) -> None:
+    rec = _log(0.0106, 500)
+    measured = rd.Recording(t=rec.t, q=rec.q, qd=np.ones_like(rec.q), current=rec.current,
+                            joint_names=("a", "b"), source="log.csv")
+    np.testing.assert_array_equal(cases.ticked(measured, 0.002).qd, measured.qd)
+    out = cases.ticked(rec, 0.002)
+    assert "qd" in out.estimated and not np.array_equal(out.qd, rec.qd)
+
+
 def test_a_tick_that_merges_two_samples_is_refused_naming_the_recording(cases: ModuleType) -> None:
     with pytest.raises(ValueError, match="log.csv"):
         cases.ticked(_log(0.0106, 50), 0.02)

@@ -1,8 +1,9 @@
 """``friction_table(..., like=ident)``: every law is identified with the processing of ``like``.
 
-The laws are compared like for like when only the law differs: the velocity source, cut-off and
-Tikhonov weight are ``like``'s, passed to each ``rd.identify`` call beside the law (checked by
-recording the calls), and an option that ``like`` sets cannot be given as well.
+The laws are compared like for like when only the law differs: the velocity source, cut-off,
+Coulomb dead band and Tikhonov weight are ``like``'s, passed to each ``rd.identify`` call beside
+the law (checked by recording the calls), and an option that ``like`` sets cannot be given as
+well.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ def _recording(seed: int) -> rd.Recording:
 
 
 def _like() -> SimpleNamespace:
-    return SimpleNamespace(preprocess=SimpleNamespace(velocity="measured", cutoff=4.5),
+    return SimpleNamespace(preprocess=SimpleNamespace(velocity="measured", cutoff=4.5, dead_band=0.002),
                            regularization=0.03)
 
 
@@ -43,13 +44,14 @@ def test_each_law_is_identified_with_the_processing_of_like(monkeypatch) -> None
                                                target="tau", method="wls")
     assert [c["friction"] for c in calls] == ["none", "stribeck"]
     for c in calls:
-        assert (c["velocity"], c["cutoff"], c["regularization"]) == ("measured", 4.5, 0.03)
+        assert (c["velocity"], c["cutoff"], c["dead_band"], c["regularization"]) == (
+            "measured", 4.5, 0.002, 0.03)
         assert (c["target"], c["method"]) == ("tau", "wls")
     # the prediction is 0.9 y: relative error 0.1 on every row
     assert np.allclose(table["relative_error"], 0.1)
 
 
-@pytest.mark.parametrize("option", ["cutoff", "velocity", "regularization"])
+@pytest.mark.parametrize("option", ["cutoff", "velocity", "dead_band", "regularization"])
 def test_like_and_an_option_it_sets_are_refused(option) -> None:
     robot = SimpleNamespace(joint_names=("a", "b"))
     with pytest.raises(IdentificationError, match=option):

@@ -21,8 +21,8 @@ def friction_table(robot: Any, train: Any, test: Sequence[Any], models: Sequence
 
     Each model is identified on ``train`` (``rd.identify(robot, train, friction=model,
     **options)``) and predicts every recording of ``test``. With ``like`` (an identification of
-    the same data), every model is identified with its velocity source, cut-off and Tikhonov
-    weight, so that the law alone differs (and no fit repeats their cross-validation).
+    the same data), every model is identified with its velocity source, cut-off, Coulomb dead band
+    and Tikhonov weight, so that the law alone differs (and no fit repeats their cross-validation).
 
     Parameters
     ----------
@@ -32,8 +32,8 @@ def friction_table(robot: Any, train: Any, test: Sequence[Any], models: Sequence
     models : sequence of str
         Among ``FRICTION_MODELS``.
     like : Identification, optional
-        Sets ``velocity``, ``cutoff`` and ``regularization`` to ``like``'s (its
-        ``preprocess.velocity``, ``preprocess.cutoff`` and ``regularization``).
+        Sets ``velocity``, ``cutoff``, ``dead_band`` and ``regularization`` to ``like``'s (its
+        ``preprocess.velocity``, ``.cutoff`` and ``.dead_band``, and ``regularization``).
     **options
         Passed to :func:`robodyn.identification` (target, method, cutoff, ...).
 
@@ -54,7 +54,8 @@ def friction_table(robot: Any, train: Any, test: Sequence[Any], models: Sequence
     import pandas as pd
 
     if like is not None:
-        same = {"velocity": like.preprocess.velocity, "cutoff": like.preprocess.cutoff,
+        pre = like.preprocess
+        same = {"velocity": pre.velocity, "cutoff": pre.cutoff, "dead_band": pre.dead_band,
                 "regularization": like.regularization}
         clash = sorted(set(same) & set(options))
         if clash:

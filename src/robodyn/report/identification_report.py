@@ -200,7 +200,7 @@ def kinova_section(out: Path, data_dir: Path | None = None, method: str = "consi
         The estimator (default: rd.identify's, the physically consistent one).
     friction_models : sequence of str
         Friction models whose held-out error is tabulated (each identified anew with the main
-        fit's velocity source, cut-off and Tikhonov weight; empty: no table).
+        fit's velocity source, cut-off, dead band and Tikhonov weight; empty: no table).
 
     Returns
     -------
